@@ -1,0 +1,112 @@
+"""Command line: `python3 -m orfa sim ...` and `python3 -m orfa request ...`."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import time
+from typing import List, Optional, TextIO
+
+from . import protocol as p
+from .gateway import Gateway
+from .sim import BOARDS, SimBoard, SimError
+
+
+def _int(text: str) -> int:
+    return int(text, 0)
+
+
+def expects_reply(line: str) -> bool:
+    """Whether the gateway answers this line (empty and comment lines: no)."""
+    return bool(line.strip(" ")) and not line.startswith("#")
+
+
+def terminal(gw: Gateway, stdin: TextIO, stdout: TextIO) -> int:
+    """A line console: each input line is a request, its reply is printed."""
+    interactive = stdin.isatty()
+    while True:
+        if interactive:
+            stdout.write("orfa> ")
+            stdout.flush()
+        line = stdin.readline()
+        if not line:
+            return 0
+        line = line.rstrip("\r\n")
+        if not expects_reply(line):
+            if line.strip(" "):
+                gw.send(p.encode_request(line))
+            continue
+        try:
+            reply = gw.request(line)
+        except (p.OrfaError, ValueError) as exc:
+            reply = "host: %s" % exc
+        stdout.write(reply + "\n")
+        stdout.flush()
+
+
+def cmd_sim(args) -> int:
+    try:
+        board = SimBoard(args.board, eeproms=args.eeprom, trace=False,
+                         firmware=args.firmware).start()
+    except SimError as exc:
+        print("orfa: %s" % exc, file=sys.stderr)
+        return 2
+    stop = []
+    signal.signal(signal.SIGTERM, lambda *_: stop.append(1) or _raise_interrupt())
+    try:
+        print(board.port, flush=True)
+        if args.terminal:
+            with Gateway(board.port) as gw:
+                return terminal(gw, sys.stdin, sys.stdout)
+        while board.running:
+            time.sleep(0.2)
+        print("orfa: the simulator stopped: %s" % board.stderr, file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        board.stop()
+
+
+def _raise_interrupt():
+    raise KeyboardInterrupt
+
+
+def cmd_request(args) -> int:
+    with Gateway(args.port, baudrate=args.baud, timeout=args.timeout) as gw:
+        for line in args.requests:
+            try:
+                reply = gw.request(line)
+            except (p.OrfaError, ValueError) as exc:
+                print("orfa: %s" % exc, file=sys.stderr)
+                return 1
+            print(reply)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="orfa", description="ORFA host tools")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    sim = sub.add_parser("sim", help="run a simulated board and print its port")
+    sim.add_argument("--board", choices=BOARDS, default="m32d")
+    sim.add_argument("--eeprom", type=_int, action="append", default=[],
+                     metavar="ADDR", help="attach a 24C02-like EEPROM (repeatable)")
+    sim.add_argument("--firmware", help="ELF to run (default: build/<board>-gate/orfa.elf)")
+    sim.add_argument("--terminal", action="store_true",
+                     help="also open a line console on the board")
+    sim.set_defaults(func=cmd_sim)
+
+    req = sub.add_parser("request", help="send requests, print the replies")
+    req.add_argument("--port", required=True, help="serial port or pyserial URL")
+    req.add_argument("--baud", type=int, default=115200)
+    req.add_argument("--timeout", type=float, default=2.0)
+    req.add_argument("requests", nargs="+", metavar="REQUEST")
+    req.set_defaults(func=cmd_request)
+    return parser
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    args = build_parser().parse_args(argv)
+    return args.func(args)

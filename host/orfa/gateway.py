@@ -1,0 +1,143 @@
+"""A gateway on a serial line: requests out, reply lines back.
+
+The transport is `serial.serial_for_url(url)`, so `loop://`, `socket://`, a
+pseudo-terminal path (the simulator's link) and a real port are the same.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Iterable, List, Optional, Sequence
+
+import serial
+
+from . import protocol as p
+
+
+class Gateway:
+    """An ORFA gateway on one serial port; a context manager."""
+
+    def __init__(self, url: str, baudrate: int = 115200, timeout: float = 2.0,
+                 local_address: int = p.DEFAULT_LOCAL_ADDRESS):
+        self.timeout = timeout
+        self.local = local_address
+        self.serial = serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
+
+    # --- lifetime -----------------------------------------------------------
+    def close(self) -> None:
+        self.serial.close()
+
+    def __enter__(self) -> "Gateway":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # --- lines ----------------------------------------------------------------
+    def send(self, data: bytes) -> None:
+        """Write raw bytes (no checks, no terminator added)."""
+        self.serial.write(data)
+        self.serial.flush()
+
+    def read_reply(self, timeout: Optional[float] = None) -> str:
+        """The next reply line without its CR LF; ReplyTimeout if none comes."""
+        deadline = time.monotonic() + (self.timeout if timeout is None else timeout)
+        buf = bytearray()
+        while not buf.endswith(b"\r\n"):
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise p.ReplyTimeout("no reply line (got %r)" % bytes(buf))
+            chunk = self.serial.read_until(b"\n")
+            buf += chunk
+            if buf.endswith(b"\n") and not buf.endswith(b"\r\n"):
+                raise p.ProtocolError("reply line not ended by CR LF: %r" % bytes(buf))
+        return p.strip_reply(bytes(buf))
+
+    def read_available(self, quiet: float = 0.3) -> bytes:
+        """Whatever arrives until the line has been quiet for `quiet` seconds."""
+        out = bytearray()
+        self.serial.timeout = quiet
+        try:
+            while True:
+                chunk = self.serial.read(4096)
+                if not chunk:
+                    return bytes(out)
+                out += chunk
+        finally:
+            self.serial.timeout = self.timeout
+
+    def request(self, line: str) -> str:
+        """Send one request, return its reply text (ERROR replies included)."""
+        self.send(p.encode_request(line))
+        return self.read_reply()
+
+    def pipeline(self, lines: Sequence[str]) -> List[str]:
+        """Send every request in one write, then read one reply per request."""
+        data = b"".join(p.encode_request(line) for line in lines)
+        self.send(data)
+        return [self.read_reply() for _ in lines]
+
+    # --- commands -------------------------------------------------------------
+    def version(self) -> str:
+        return p.parse_version(self.request(p.format_version()))
+
+    def clear_bus(self) -> None:
+        p.parse_clear(self.request(p.format_clear()))
+
+    def local_address(self, new: Optional[int] = None) -> int:
+        addr = p.parse_local_address(self.request(p.format_local_address(new)))
+        self.local = addr
+        return addr
+
+    def clock(self, khz: Optional[int] = None) -> int:
+        return p.parse_clock(self.request(p.format_clock(khz)))
+
+    def transaction(self, frames: Sequence[p.Frame]) -> List[p.FrameResult]:
+        frames = list(frames)
+        line = p.format_transaction(frames)
+        return p.parse_transaction(self.request(line), frames)
+
+    def write(self, addr: int, data: Iterable[int] = b"") -> int:
+        """Write data to a device; returns the number of acknowledged bytes."""
+        (result,) = self.transaction([p.Write(addr, bytes(data))])
+        return result.acks
+
+    def probe(self, addr: int) -> bool:
+        """True if a device acknowledges its address."""
+        try:
+            self.write(addr)
+        except p.AddressNackError:
+            return False
+        return True
+
+    def read(self, addr: int, count: int) -> bytes:
+        (result,) = self.transaction([p.Read(addr, count)])
+        return result.data
+
+    # --- register semantics (docs/registers.md) ---------------------------------
+    def write_register(self, addr: Optional[int], reg: int, data: Iterable[int] = b"") -> None:
+        """Write data to register reg of addr (None: the gateway itself)."""
+        addr = self.local if addr is None else addr
+        self.transaction(p.register_write_frames(addr, reg, data))
+
+    def read_register(self, addr: Optional[int], reg: int, count: int) -> bytes:
+        """Select register reg of addr (None: the gateway itself), read count bytes."""
+        addr = self.local if addr is None else addr
+        results = self.transaction(p.register_read_frames(addr, reg, count))
+        return results[-1].data
+
+    def drivers(self) -> List[p.DriverRecord]:
+        """The gateway's own introspection records, driver 1 first."""
+        (count,) = self.read_register(None, 0x00, 1)
+        records: List[p.DriverRecord] = []
+        per_read = 10
+        for first in range(1, count + 1, per_read):
+            n = min(per_read, count + 1 - first)
+            data = self.transaction([p.Write(self.local, bytes([0x00, first])),
+                                     p.Read(self.local, 6 * n)])[-1].data
+            records += p.DriverRecord.parse_many(data)
+        return records
+
+    def status(self) -> int:
+        """The gateway's status register (result of the last register access)."""
+        return self.read_register(None, 0x01, 1)[0]

@@ -1,0 +1,191 @@
+"""Simulated boards: start build/sim/orfa-sim on a firmware ELF, talk to its port.
+
+Every SimBoard gets its own temporary directory (link path, trace file, the
+simulator's stdout/stderr), so any number run in parallel.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+from typing import Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
+
+#: The repository root (host/orfa/../..), so nothing needs installing.
+REPO_ROOT = Path(__file__).resolve().parents[2]
+BOARDS = ("m32d", "m128s")
+BUILD_HINT = "run `make all-boards sim` in %s" % REPO_ROOT
+
+
+class SimError(RuntimeError):
+    """The simulator could not be started or died."""
+
+
+def sim_path() -> Path:
+    return REPO_ROOT / "build" / "sim" / "orfa-sim"
+
+
+def firmware_path(board: str, mode: str = "gate") -> Path:
+    return REPO_ROOT / "build" / ("%s-%s" % (board, mode)) / "orfa.elf"
+
+
+def missing_builds(boards: Iterable[str] = BOARDS) -> List[Path]:
+    """The simulator and firmware files that are not built yet."""
+    paths = [sim_path()] + [firmware_path(b) for b in boards]
+    return [path for path in paths if not path.is_file()]
+
+
+class TraceEvent(NamedTuple):
+    """One trace line: `<cycle> <kind...> <fields...>` (docs/simulator.md)."""
+
+    cycle: int
+    kind: str           # "uart rx", "uart tx", "twi start", "twi addr", ..., "reset"
+    fields: Tuple[str, ...]
+
+
+def parse_trace_line(line: str) -> TraceEvent:
+    words = line.split()
+    if len(words) < 2 or not words[0].isdigit():
+        raise ValueError("not a trace line: %r" % line)
+    cycle = int(words[0])
+    if words[1] in ("uart", "twi") and len(words) >= 3:
+        return TraceEvent(cycle, words[1] + " " + words[2], tuple(words[3:]))
+    return TraceEvent(cycle, words[1], tuple(words[2:]))
+
+
+def parse_trace(text: str) -> List[TraceEvent]:
+    return [parse_trace_line(line) for line in text.splitlines() if line.strip()]
+
+
+class SimBoard:
+    """A simulated ORFA board running as a child process; a context manager.
+
+    `.port` is the link to the board's serial port (open it with pyserial or
+    Gateway); `.trace_path` the trace file (if trace=True).
+    """
+
+    def __init__(self, board: str = "m32d", eeproms: Sequence[int] = (),
+                 trace: bool = True, firmware: Union[str, Path, None] = None,
+                 start_timeout: float = 15.0, extra_args: Sequence[str] = ()):
+        if board not in BOARDS:
+            raise ValueError("board must be one of %s" % (BOARDS,))
+        self.board = board
+        self.eeproms = tuple(eeproms)
+        self.firmware = Path(firmware) if firmware else firmware_path(board)
+        self.start_timeout = start_timeout
+        self.extra_args = tuple(extra_args)
+        self.want_trace = trace
+        self.dir: Optional[Path] = None
+        self.port = ""
+        self.trace_path: Optional[Path] = None
+        self.proc: Optional[subprocess.Popen] = None
+        self.banner = ""
+
+    # --- lifetime -------------------------------------------------------------
+    def command(self) -> List[str]:
+        cmd = [str(sim_path()), "--board", self.board, "--link", self.port]
+        for addr in self.eeproms:
+            cmd += ["--eeprom", "0x%02X" % addr]
+        if self.trace_path is not None:
+            cmd += ["--trace", str(self.trace_path)]
+        return cmd + list(self.extra_args) + [str(self.firmware)]
+
+    def start(self) -> "SimBoard":
+        for path in (sim_path(), self.firmware):
+            if not path.is_file():
+                raise SimError("%s is missing: %s" % (path, BUILD_HINT))
+        self.dir = Path(tempfile.mkdtemp(prefix="orfa-sim-%s-" % self.board))
+        self.port = str(self.dir / "tty")
+        self.trace_path = self.dir / "trace.log" if self.want_trace else None
+        self._stdout = open(self.dir / "stdout", "wb")
+        self._stderr = open(self.dir / "stderr", "wb")
+        self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL,
+                                     stdout=self._stdout, stderr=self._stderr)
+        deadline = time.monotonic() + self.start_timeout
+        while not os.path.exists(self.port):
+            if self.proc.poll() is not None:
+                msg = "orfa-sim exited with %d before its link appeared" % self.proc.returncode
+                self._fail(msg)
+            if time.monotonic() > deadline:
+                self._fail("orfa-sim made no link within %.0f s" % self.start_timeout)
+            time.sleep(0.01)
+        self.banner = self._read("stdout")
+        return self
+
+    def _read(self, name: str) -> str:
+        try:
+            return (self.dir / name).read_text(errors="replace")
+        except OSError:
+            return ""
+
+    def _fail(self, msg: str) -> None:
+        cmd = " ".join(self.command())
+        stderr = self._read("stderr")
+        self.stop()
+        raise SimError("%s\n  command: %s\n  stderr: %s" % (msg, cmd, stderr.strip() or "(empty)"))
+
+    def stop(self, keep_dir: bool = False) -> Optional[int]:
+        """SIGTERM the simulator, wait for it; returns its exit status."""
+        status = None
+        if self.proc is not None:
+            if self.proc.poll() is None:
+                self.proc.send_signal(signal.SIGTERM)
+                try:
+                    self.proc.wait(timeout=5)
+                except subprocess.TimeoutExpired:
+                    self.proc.kill()
+                    self.proc.wait()
+            status = self.proc.returncode
+            self.proc = None
+            self._stdout.close()
+            self._stderr.close()
+        if self.dir is not None and not keep_dir:
+            shutil.rmtree(self.dir, ignore_errors=True)
+            self.dir = None
+        return status
+
+    def __enter__(self) -> "SimBoard":
+        return self.start()
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    @property
+    def running(self) -> bool:
+        return self.proc is not None and self.proc.poll() is None
+
+    @property
+    def stderr(self) -> str:
+        return self._read("stderr") if self.dir else ""
+
+    # --- trace ------------------------------------------------------------------
+    def trace_text(self) -> str:
+        if self.trace_path is None:
+            raise SimError("this board was started without a trace")
+        try:
+            return self.trace_path.read_text()
+        except FileNotFoundError:
+            return ""
+
+    def trace_mark(self) -> int:
+        """A position in the trace; trace_events(since=mark) gives what follows."""
+        return len(self.trace_text().encode())
+
+    def trace_events(self, since: int = 0, kinds: Optional[Iterable[str]] = None
+                     ) -> List[TraceEvent]:
+        """Parsed trace events after position `since`, optionally only some kinds.
+
+        A kind matches by prefix: "twi" gives every bus event.
+        """
+        data = self.trace_text().encode()[since:]
+        text = data.decode()
+        cut = text.rfind("\n")
+        events = parse_trace(text[:cut + 1])
+        if kinds is not None:
+            kinds = tuple(kinds)
+            events = [e for e in events if e.kind.startswith(kinds)]
+        return events
