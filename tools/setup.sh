@@ -1,0 +1,60 @@
+#!/bin/sh
+# Install what building and testing ORFA needs on a fresh Debian machine.
+# Idempotent and quiet when everything is there already.
+set -eu
+
+APT_PACKAGES="gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev"
+# python module:pip package
+PY_PACKAGES="serial:pyserial pytest:pytest"
+
+if [ "$(id -u)" -eq 0 ]; then
+	SUDO=""
+elif command -v sudo >/dev/null 2>&1; then
+	SUDO="sudo"
+else
+	SUDO=""
+fi
+
+updated=""
+apt_install() {
+	if [ -z "$updated" ]; then
+		$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+		updated=yes
+	fi
+	$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$@" >/dev/null
+}
+
+missing=""
+for pkg in $APT_PACKAGES; do
+	if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+		missing="$missing $pkg"
+	fi
+done
+if [ -n "$missing" ]; then
+	echo "setup: installing$missing"
+	apt_install $missing
+fi
+
+PYTHON=${PYTHON:-python3}
+if ! command -v "$PYTHON" >/dev/null 2>&1; then
+	echo "setup: installing python3"
+	apt_install python3 python3-pip
+fi
+
+pip_missing=""
+for entry in $PY_PACKAGES; do
+	module=${entry%%:*}
+	package=${entry#*:}
+	if ! "$PYTHON" -c "import $module" >/dev/null 2>&1; then
+		pip_missing="$pip_missing $package"
+	fi
+done
+if [ -n "$pip_missing" ]; then
+	echo "setup: pip installing$pip_missing"
+	if ! "$PYTHON" -m pip --version >/dev/null 2>&1; then
+		apt_install python3-pip
+	fi
+	# Debian's python marks itself externally managed (PEP 668).
+	"$PYTHON" -m pip install -q $pip_missing 2>/dev/null ||
+		"$PYTHON" -m pip install -q --break-system-packages $pip_missing
+fi
