@@ -1,0 +1,112 @@
+# ORFA firmware, simulator and tests.
+#
+#   make [BOARD=m32d|m128s] [MODE=gate|slave] [BAUD=115200] [ADDR=0x10] [DRIVERS="..."]
+#   make all-boards     every board and mode
+#   make size           flash and static RAM of every build in build/
+#   make sim            build/sim/orfa-sim
+#   make unit           host-compiled unit tests of the parser and register logic
+#   make test           install what is missing, build everything, run all tests
+#   make bench          cycle-exact benchmark table
+#   make demo           a simulated M32-D gateway to talk to
+
+BOARD ?= m32d
+MODE ?= gate
+BAUD ?= 115200
+ADDR ?= 0x10
+
+BOARDS := m32d m128s
+MODES := gate
+
+include boards/$(BOARD)/board.mk
+
+# Drivers linked into the register table, in register order. Leave drivers out
+# with DRIVERS="..." (introspection is always in: it owns registers 0x00-0x01).
+DRIVERS ?= $(BOARD_DRIVERS)
+
+BUILD := build/$(BOARD)-$(MODE)
+CC := avr-gcc
+OBJCOPY := avr-objcopy
+AVR_SIZE := avr-size
+
+FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) -DORFA_BAUD=$(BAUD) \
+	-DORFA_ADDR=$(ADDR) -DORFA_MODE_$(MODE) \
+	-std=gnu99 -Os -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
+	-fshort-enums -mcall-prologues -I. -Iboards/$(BOARD) \
+	'-DORFA_DRIVER_LIST=$(foreach d,$(DRIVERS),X($(d)))'
+FW_LDFLAGS := -mmcu=$(BOARD_MCU) -Wl,--gc-sections
+
+FW_SRC := firmware/main.c firmware/regmap.c firmware/intro.c firmware/uart.c \
+	firmware/twi_master.c firmware/mcu.c \
+	$(foreach d,$(DRIVERS),drivers/drv_$(d).c)
+ifeq ($(MODE),gate)
+FW_SRC += serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
+endif
+ifeq ($(MODE),slave)
+FW_SRC += i2c_slave/i2c_slave.c
+endif
+FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
+
+.PHONY: firmware all-boards size sim unit test bench demo clean setup
+.DEFAULT_GOAL := firmware
+
+firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
+
+$(BUILD)/%.o: %.c $(BUILD)/flags
+	@mkdir -p $(dir $@)
+	$(CC) $(FW_CFLAGS) -MMD -MP -c $< -o $@
+
+# Rebuild when the configuration changes (DRIVERS, BAUD, ADDR).
+$(BUILD)/flags: FORCE
+	$(shell mkdir -p $(BUILD))$(file >$@.new,$(FW_CFLAGS))@cmp -s $@.new $@ || mv $@.new $@
+
+$(BUILD)/orfa.elf: $(FW_OBJ)
+	$(CC) $(FW_LDFLAGS) $^ -o $@
+
+$(BUILD)/orfa.hex: $(BUILD)/orfa.elf
+	$(OBJCOPY) -O ihex -R .eeprom $< $@
+
+all-boards:
+	@set -e; for b in $(BOARDS); do for m in $(MODES); do \
+		$(MAKE) --no-print-directory BOARD=$$b MODE=$$m firmware; done; done
+
+size:
+	@tools/size.sh build
+
+# --- simulator (host C, Debian's libsimavr) --------------------------------
+SIM_SRC := $(wildcard sim/*.c sim/parts/*.c)
+SIM_HDR := $(wildcard sim/*.h sim/parts/*.h boards/*/board.h)
+SIM_CFLAGS := -std=gnu99 -O2 -g -Wall -Wextra -Werror -I. -Isim -I/usr/include/simavr
+SIM_LIBS := -lsimavr -lelf -lutil -lpthread -lm
+
+sim: build/sim/orfa-sim
+
+build/sim/orfa-sim: $(SIM_SRC) $(SIM_HDR)
+	@mkdir -p $(dir $@)
+	gcc $(SIM_CFLAGS) $(SIM_SRC) -o $@ $(SIM_LIBS)
+
+# --- tests, benchmark, demo ------------------------------------------------
+unit:
+	@$(MAKE) --no-print-directory -C tests/unit
+
+setup:
+	@tools/setup.sh
+
+test: setup
+	@$(MAKE) --no-print-directory all-boards sim
+	@$(MAKE) --no-print-directory unit
+	python3 -m pytest -q tests
+
+bench: setup
+	@$(MAKE) --no-print-directory all-boards sim
+	python3 tools/bench.py
+
+demo: setup
+	@$(MAKE) --no-print-directory BOARD=m32d MODE=gate firmware sim
+	PYTHONPATH=host python3 -m orfa sim --board m32d --terminal
+
+clean:
+	rm -rf build
+
+FORCE:
+
+-include $(FW_OBJ:.o=.d)

@@ -1,0 +1,9 @@
+/* The front end linked into this build: the serial gateway (MODE=gate) or
+ * the I2C slave (MODE=slave). main() only knows this interface. */
+#ifndef ORFA_FRONT_H
+#define ORFA_FRONT_H
+
+void front_init(void);
+void front_poll(void);
+
+#endif

@@ -1,0 +1,19 @@
+/* ORFA firmware: drivers behind a register map, one front end before it. */
+#include <avr/interrupt.h>
+#include <avr/wdt.h>
+
+#include "firmware/front.h"
+#include "firmware/mcu.h"
+#include "firmware/regmap.h"
+
+int main(void)
+{
+	mcu_watchdog_start();
+	regmap_init();
+	front_init();
+	sei();
+	for (;;) {
+		wdt_reset();
+		front_poll();
+	}
+}

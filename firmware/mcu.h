@@ -1,0 +1,47 @@
+/*
+ * The MCU layer: the only place that knows how ATmega32 and ATmega128 name
+ * their registers. Drivers and front ends use these names, never #ifdefs.
+ */
+#ifndef ORFA_MCU_H
+#define ORFA_MCU_H
+
+#include <avr/io.h>
+#include <stdint.h>
+
+#if defined(__AVR_ATmega32__)
+#define MCU_UDR            UDR
+#define MCU_UCSRA          UCSRA
+#define MCU_UCSRB          UCSRB
+#define MCU_UBRRL          UBRRL
+#define MCU_UBRRH          UBRRH
+#define MCU_UART_RX_vect   USART_RXC_vect
+#define MCU_UART_UDRE_vect USART_UDRE_vect
+#define MCU_RESET_FLAGS    MCUCSR
+#elif defined(__AVR_ATmega128__)
+#define MCU_UDR            UDR0
+#define MCU_UCSRA          UCSR0A
+#define MCU_UCSRB          UCSR0B
+#define MCU_UBRRL          UBRR0L
+#define MCU_UBRRH          UBRR0H
+#define MCU_UART_RX_vect   USART0_RX_vect
+#define MCU_UART_UDRE_vect USART0_UDRE_vect
+#define MCU_RESET_FLAGS    MCUCSR
+#else
+#error "ORFA supports ATmega32 and ATmega128"
+#endif
+
+/* The three registers of one I/O port. */
+typedef struct {
+	volatile uint8_t *pin;
+	volatile uint8_t *ddr;
+	volatile uint8_t *port;
+} mcu_port_t;
+
+/* The port named by its letter ('A'...), or 0 if the MCU has no such port. */
+const __flash mcu_port_t *mcu_port(char letter);
+
+/* Watchdog on, reset flags cleared (simavr re-arms a fired watchdog until
+ * WDRF is cleared; harmless on silicon). */
+void mcu_watchdog_start(void);
+
+#endif

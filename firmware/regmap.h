@@ -1,0 +1,72 @@
+/*
+ * The register map: a table in flash, built at compile time from the board's
+ * driver list, that routes register reads and writes to drivers
+ * (SPEC section 3). Both front ends (serial gateway, I2C slave) use it.
+ */
+#ifndef ORFA_REGMAP_H
+#define ORFA_REGMAP_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "firmware/flash.h"
+
+/* Status register values (docs/registers.md). */
+typedef enum {
+	REG_OK = 0x00,
+	REG_BAD_LENGTH = 0x01,
+	REG_BAD_VALUE = 0x02,
+	REG_PIN_BUSY = 0x03,
+	REG_NOT_WRITABLE = 0x04,
+	REG_NOT_READABLE = 0x05,
+	REG_READ_WRAPPED = 0x06,
+	REG_NOT_BOUND = 0x07,
+} reg_status_t;
+
+#define REGMAP_INTRO_REG   0x00
+#define REGMAP_STATUS_REG  0x01
+/* Longest read a driver is asked for at once (SPEC: 64-byte buffer). */
+#define REGMAP_READ_MAX    64
+
+/*
+ * A driver. `reg` is the register's offset inside the driver's range.
+ * write: applies all of `data` or nothing; returns REG_OK or why not.
+ * read: puts up to `max` bytes of the register's data at `dst` and returns how
+ *       many; 0 means the register cannot be read. The regmap asks again when
+ *       a read frame wants more bytes than one answer gave.
+ * Either may be 0 (register never written / never read).
+ */
+typedef struct {
+	uint16_t uid;
+	uint8_t major;
+	uint8_t minor;
+	uint8_t nregs;
+	void (*init)(void);
+	reg_status_t (*write)(uint8_t reg, const uint8_t *data, uint8_t len);
+	uint8_t (*read)(uint8_t reg, uint8_t *dst, uint8_t max);
+} drv_t;
+
+/* Calls every driver's init; selects register 0x00; status OK. */
+void regmap_init(void);
+
+/* Selects a register for the following writes and reads. False, and nothing
+ * changes, if no driver maps it. */
+bool regmap_select(uint8_t reg);
+
+/* Delivers one write frame's data to the selected register. */
+reg_status_t regmap_write(const uint8_t *data, uint8_t len);
+
+/* Fills `n` bytes from the selected register, asking its driver as often as
+ * needed. REG_NOT_READABLE if it cannot be read (nothing is filled then). */
+reg_status_t regmap_read(uint8_t *dst, uint8_t n);
+
+/* For drivers: record a status that does not fail the operation. */
+void regmap_set_status(reg_status_t status);
+
+/* Number of drivers, introspection included. */
+uint8_t regmap_driver_count(void);
+
+/* Driver n (1-based) as [UID hi][UID lo][major][minor][start][count]. */
+void regmap_driver_record(uint8_t n, uint8_t rec[6]);
+
+#endif

@@ -1,0 +1,179 @@
+#include "firmware/twi_master.h"
+
+#include <avr/io.h>
+#include <avr/wdt.h>
+#include <util/delay.h>
+#include <util/twi.h>
+
+#include "board.h"
+#include "firmware/mcu.h"
+
+/* Datasheet (ATmega32/128, TWI bit rate): TWBR below 10 may give wrong
+ * SCL/SDA output in master mode. */
+#define TWI_TWBR_MIN 10
+
+static struct {
+	uint32_t timeout;  /* polling loops before a step counts as hung */
+} twi;
+
+/* SCL period in CPU cycles for a bit-rate setting. */
+static uint32_t twi_period(uint8_t twbr, uint8_t twps)
+{
+	return 16UL + ((uint32_t)twbr << (1 + 2 * twps));
+}
+
+void twi_init(void)
+{
+	TWCR = _BV(TWEN);
+	twi_set_khz(100);
+}
+
+uint16_t twi_set_khz(uint16_t khz)
+{
+	uint32_t f = (uint32_t)khz * 1000UL;
+	uint8_t twps = 3;
+	uint32_t twbr = 255;
+
+	for (uint8_t ps = 0; ps < 4; ps++) {
+		uint32_t mul_f = (2UL << (2 * ps)) * f;
+		uint32_t need = 0;
+		if (16UL * f < F_CPU) {
+			need = (F_CPU - 16UL * f + mul_f - 1) / mul_f;  /* rounded up */
+		}
+		if (need < TWI_TWBR_MIN) {
+			need = TWI_TWBR_MIN;
+		}
+		if (need <= 255) {
+			twps = ps;
+			twbr = need;
+			break;
+		}
+	}
+	TWBR = (uint8_t)twbr;
+	TWSR = twps;  /* only the prescaler bits are writable */
+	uint32_t period = twi_period((uint8_t)twbr, twps);
+	/* A polling loop takes at least 6 cycles: 3 periods of loops cover a
+	 * whole byte (9 periods) twice over. */
+	twi.timeout = 3 * period + 256;
+	return (uint16_t)(F_CPU / period / 1000UL);
+}
+
+/* Waits for TWINT; false on timeout. */
+static bool twi_wait(void)
+{
+	uint32_t n = twi.timeout;
+	while (!(TWCR & _BV(TWINT))) {
+		if (--n == 0) {
+			return false;
+		}
+	}
+	wdt_reset();  /* a slow bus makes progress: don't let the watchdog bite */
+	return true;
+}
+
+twi_result_t twi_start(uint8_t addr8)
+{
+	TWCR = _BV(TWINT) | _BV(TWSTA) | _BV(TWEN);
+	if (!twi_wait() || (TW_STATUS != TW_START && TW_STATUS != TW_REP_START)) {
+		return TWI_FAIL;
+	}
+	TWDR = addr8;
+	TWCR = _BV(TWINT) | _BV(TWEN);
+	if (!twi_wait()) {
+		return TWI_FAIL;
+	}
+	switch (TW_STATUS) {
+	case TW_MT_SLA_ACK:
+	case TW_MR_SLA_ACK:
+		return TWI_ACK;
+	case TW_MT_SLA_NACK:
+	case TW_MR_SLA_NACK:
+		return TWI_NACK;
+	default:
+		return TWI_FAIL;
+	}
+}
+
+twi_result_t twi_write(uint8_t byte)
+{
+	TWDR = byte;
+	TWCR = _BV(TWINT) | _BV(TWEN);
+	if (!twi_wait()) {
+		return TWI_FAIL;
+	}
+	switch (TW_STATUS) {
+	case TW_MT_DATA_ACK:
+		return TWI_ACK;
+	case TW_MT_DATA_NACK:
+		return TWI_NACK;
+	default:
+		return TWI_FAIL;
+	}
+}
+
+twi_result_t twi_read(uint8_t *byte, bool ack)
+{
+	TWCR = _BV(TWINT) | _BV(TWEN) | (ack ? _BV(TWEA) : 0);
+	if (!twi_wait()) {
+		return TWI_FAIL;
+	}
+	*byte = TWDR;
+	uint8_t want = ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK;
+	return TW_STATUS == want ? TWI_ACK : TWI_FAIL;
+}
+
+void twi_stop(void)
+{
+	TWCR = _BV(TWINT) | _BV(TWSTO) | _BV(TWEN);
+	uint32_t n = twi.timeout;
+	while (TWCR & _BV(TWSTO)) {
+		if (--n == 0) {
+			/* The TWI is wedged: restart it. */
+			TWCR = 0;
+			TWCR = _BV(TWEN);
+			return;
+		}
+	}
+}
+
+/* Open-drain lines by hand: low = output 0, released = input with pull-up. */
+static void line_low(const __flash mcu_port_t *p, uint8_t bit)
+{
+	*p->port &= (uint8_t)~bit;
+	*p->ddr |= bit;
+}
+
+static void line_release(const __flash mcu_port_t *p, uint8_t bit)
+{
+	*p->ddr &= (uint8_t)~bit;
+	*p->port |= bit;
+}
+
+void twi_clear_bus(void)
+{
+	const __flash mcu_port_t *p = mcu_port(BOARD_TWI_PORT);
+	const uint8_t scl = _BV(BOARD_TWI_SCL);
+	const uint8_t sda = _BV(BOARD_TWI_SDA);
+
+	TWCR = 0;  /* the pins become ordinary port pins */
+	line_release(p, scl);
+	line_release(p, sda);
+	_delay_us(5);
+	for (uint8_t i = 0; i < 9 && !(*p->pin & sda); i++) {
+		line_low(p, scl);
+		_delay_us(5);
+		line_release(p, scl);
+		_delay_us(5);
+	}
+	/* STOP: SDA rises while SCL is high. */
+	line_low(p, scl);
+	line_low(p, sda);
+	_delay_us(5);
+	line_release(p, scl);
+	_delay_us(5);
+	line_release(p, sda);
+	_delay_us(5);
+	/* Back to the TWI, pins as after reset. */
+	*p->port &= (uint8_t)~(scl | sda);
+	TWCR = _BV(TWEN);
+}

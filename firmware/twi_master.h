@@ -1,0 +1,35 @@
+/*
+ * TWI (I2C) master, polled, with a timeout on every step so that a missing or
+ * stuck device gives an error within milliseconds, never a hang.
+ */
+#ifndef ORFA_TWI_MASTER_H
+#define ORFA_TWI_MASTER_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+typedef enum {
+	TWI_ACK = 0,   /* the byte was acknowledged */
+	TWI_NACK,      /* it was not */
+	TWI_FAIL,      /* bus error, arbitration lost or timeout */
+} twi_result_t;
+
+void twi_init(void);
+
+/* Sets the fastest SCL rate the TWI can make that is not above `khz`
+ * (TWBR >= 10, as the datasheet requires in master mode) and returns that
+ * rate in kHz, rounded down. */
+uint16_t twi_set_khz(uint16_t khz);
+
+/* START (or repeated START) and the address byte (8-bit form, bit 0 = read). */
+twi_result_t twi_start(uint8_t addr8);
+twi_result_t twi_write(uint8_t byte);
+/* Reads a byte; `ack` tells the slave more bytes are wanted. */
+twi_result_t twi_read(uint8_t *byte, bool ack);
+void twi_stop(void);
+
+/* Frees a bus held by a slave: clocks SCL until SDA is released (at most 9
+ * clocks), then a STOP; the TWI is re-enabled afterwards. */
+void twi_clear_bus(void);
+
+#endif

@@ -1,0 +1,169 @@
+#include "serialgate/sg_exec.h"
+
+#include <stdbool.h>
+
+#include "firmware/flash.h"
+#include "firmware/regmap.h"
+#include "firmware/twi_master.h"
+
+static struct {
+	uint8_t local;  /* local address, bit 0 clear */
+	uint16_t khz;   /* bus clock actually set */
+} gate;
+
+static void out_hex(uint8_t b)
+{
+	static const ORFA_FLASH char digits[16] = "0123456789ABCDEF";
+	sg_out((uint8_t)digits[b >> 4]);
+	sg_out((uint8_t)digits[b & 0x0F]);
+}
+
+static void out_end(void)
+{
+	sg_out('\r');
+	sg_out('\n');
+}
+
+static void out_error(uint8_t err)
+{
+	static const ORFA_FLASH char text[] = "ERROR ";
+	for (uint8_t i = 0; i < sizeof text - 1; i++) {
+		sg_out((uint8_t)text[i]);
+	}
+	out_hex(err);
+	out_end();
+}
+
+/* A frame to the board itself: the register map, never the bus. */
+static uint8_t run_local(uint8_t addr, uint8_t *data, uint8_t n)
+{
+	if (addr & 1) {
+		return regmap_read(data, n) == REG_OK ? SG_OK : SG_ERR_ADDR_NACK;
+	}
+	if (n == 0) {
+		return SG_OK;  /* address probe */
+	}
+	if (!regmap_select(data[0])) {
+		return SG_ERR_DATA_NACK;
+	}
+	if (n > 1 && regmap_write(data + 1, (uint8_t)(n - 1)) != REG_OK) {
+		return SG_ERR_DATA_NACK;
+	}
+	return SG_OK;
+}
+
+static uint8_t run_bus(uint8_t addr, uint8_t *data, uint8_t n)
+{
+	twi_result_t r = twi_start(addr);
+	if (r != TWI_ACK) {
+		return SG_ERR_ADDR_NACK;
+	}
+	for (uint8_t i = 0; i < n; i++) {
+		if (addr & 1) {
+			r = twi_read(&data[i], (uint8_t)(i + 1) < n);
+		} else {
+			r = twi_write(data[i]);
+		}
+		if (r == TWI_NACK) {
+			return SG_ERR_DATA_NACK;
+		}
+		if (r != TWI_ACK) {
+			return SG_ERR_ADDR_NACK;  /* bus lost or stuck */
+		}
+	}
+	return SG_OK;
+}
+
+static void run_i2c(sg_parser_t *p)
+{
+	uint8_t *buf = p->buf;
+	uint8_t err = SG_OK;
+	bool on_bus = false;
+
+	for (uint8_t i = 0; i < p->nbytes && err == SG_OK;) {
+		uint8_t addr = buf[i];
+		uint8_t n = buf[i + 1];
+		if ((addr & 0xFE) == gate.local) {
+			err = run_local(addr, &buf[i + 2], n);
+		} else {
+			on_bus = true;
+			err = run_bus(addr, &buf[i + 2], n);
+		}
+		i = (uint8_t)(i + 2 + n);
+	}
+	if (on_bus) {
+		twi_stop();
+	}
+	if (err != SG_OK) {
+		out_error(err);
+		return;
+	}
+	for (uint8_t i = 0; i < p->nbytes;) {
+		uint8_t addr = buf[i];
+		uint8_t n = buf[i + 1];
+		uint8_t *data = &buf[i + 2];
+		sg_out('S');
+		if (addr & 1) {
+			sg_out('R');
+			for (uint8_t k = 0; k < n; k++) {
+				out_hex(data[k]);
+			}
+		} else {
+			sg_out('W');
+			for (uint8_t k = 0; k < n; k++) {
+				sg_out('A');
+			}
+		}
+		i = (uint8_t)(i + 2 + n);
+	}
+	sg_out('P');
+	out_end();
+}
+
+void sg_exec_init(void)
+{
+	gate.local = SG_LOCAL_DEFAULT;
+	gate.khz = twi_set_khz(SG_KHZ_DEFAULT);
+}
+
+void sg_exec(sg_parser_t *p)
+{
+	if (p->err != SG_OK) {
+		out_error(p->err);
+		return;
+	}
+	switch (p->cmd) {
+	case SG_CMD_VERSION:
+		sg_out('V');
+		sg_out('1');
+		sg_out('.');
+		sg_out('1');
+		break;
+	case SG_CMD_CLEAR:
+		twi_clear_bus();
+		sg_out('X');
+		break;
+	case SG_CMD_LOCAL:
+		if (p->nbytes) {
+			gate.local = p->buf[0] & 0xFE;
+		}
+		sg_out('L');
+		out_hex(gate.local);
+		break;
+	case SG_CMD_CLOCK:
+		if (p->nbytes) {
+			gate.khz = twi_set_khz((uint16_t)(p->buf[0] << 8 | p->buf[1]));
+		}
+		sg_out('C');
+		out_hex((uint8_t)(gate.khz >> 8));
+		out_hex((uint8_t)gate.khz);
+		break;
+	case SG_CMD_I2C:
+		run_i2c(p);
+		return;
+	default:
+		out_error(SG_ERR_INTERNAL);
+		return;
+	}
+	out_end();
+}

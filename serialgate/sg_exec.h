@@ -1,0 +1,25 @@
+/*
+ * Executes a parsed request and writes its reply line (SPEC section 2).
+ * Hardware is reached only through twi_master.h, regmap.h and sg_out(), so
+ * the executor is also compiled and tested on the host with fakes of them.
+ */
+#ifndef SG_EXEC_H
+#define SG_EXEC_H
+
+#include <stdint.h>
+
+#include "serialgate/sg_parse.h"
+
+#define SG_LOCAL_DEFAULT 0xAA
+#define SG_KHZ_DEFAULT   100
+
+/* Sends one reply character (provided by the front end or a test). */
+void sg_out(uint8_t c);
+
+/* Local address AA, bus clock as for C0064. */
+void sg_exec_init(void);
+
+/* Runs the request the parser just completed (or replies its error). */
+void sg_exec(sg_parser_t *p);
+
+#endif

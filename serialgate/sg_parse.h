@@ -1,0 +1,70 @@
+/*
+ * The serial gateway's request parser (SPEC section 2, docs/protocol.md).
+ *
+ * Pure: no hardware, so it also compiles and is tested on the host. It takes
+ * one character at a time as the UART delivers it, so that when a line's
+ * terminator arrives only the execution of the request is left.
+ */
+#ifndef SG_PARSE_H
+#define SG_PARSE_H
+
+#include <stdint.h>
+
+/* The protocol's error codes. */
+typedef enum {
+	SG_OK = 0x00,
+	SG_ERR_INTERNAL = 0x01,
+	SG_ERR_COMMAND = 0x02,
+	SG_ERR_HEX = 0x03,
+	SG_ERR_DATA = 0x04,
+	SG_ERR_NO_P = 0x05,
+	SG_ERR_ADDR_NACK = 0x06,
+	SG_ERR_DATA_NACK = 0x07,
+} sg_err_t;
+
+#define SG_LINE_MAX   128  /* characters of a request before its terminator */
+#define SG_REPLY_MAX  127  /* characters of a reply before CR LF */
+/* Parsed request: I2C frames as [addr][n][n bytes], a read frame's n bytes
+ * being room for the data it will read. Written bytes take 2 characters each
+ * and read bytes 2 reply characters each, so the limits bound this. */
+#define SG_BUF_SIZE   128
+
+/* Null marker the UART puts where it lost characters. */
+#define SG_CHAR_LOST  0x80
+
+typedef enum {
+	SG_CMD_NONE = 0,
+	SG_CMD_VERSION,
+	SG_CMD_CLEAR,
+	SG_CMD_LOCAL,    /* args: 0 bytes (read) or 1 (set) */
+	SG_CMD_CLOCK,    /* args: 0 bytes (read) or 2 (set, kHz big-endian) */
+	SG_CMD_I2C,
+} sg_cmd_t;
+
+/* What the parser says after each character. */
+typedef enum {
+	SG_MORE = 0,     /* the line goes on */
+	SG_IGNORED,      /* an empty line or a comment ended: no reply */
+	SG_REQUEST,      /* a request ended: execute it, or reply its error */
+} sg_event_t;
+
+typedef struct {
+	uint8_t state;
+	uint8_t err;        /* first error of the line, SG_OK if none */
+	uint8_t cmd;        /* sg_cmd_t */
+	uint8_t len;        /* characters of the line so far */
+	uint8_t hi;         /* first digit of a byte in progress, 0xFF if none */
+	uint8_t nbytes;     /* bytes used in buf */
+	uint8_t frame;      /* index in buf of the current frame's [addr] */
+	uint8_t reply_len;  /* length of the reply this request will have */
+	uint8_t buf[SG_BUF_SIZE];
+} sg_parser_t;
+
+void sg_parse_init(sg_parser_t *p);
+
+/* Feeds one character. After SG_REQUEST, `err` holds the error to reply (or
+ * SG_OK), `cmd`, `nbytes` and `buf` the request; the parser is ready for the
+ * next line. */
+sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c);
+
+#endif
