@@ -1,0 +1,26 @@
+/*
+ * board.c: board table.
+ */
+#include <string.h>
+
+#include "board.h"
+
+static const board_desc_t board_table[] = {
+	{ .name = "m32d", .title = "OR-AVR-M32-D", .mcu = "atmega32", .host_usart = 0 },
+	{ .name = "m128s", .title = "OR-AVR-M128-S", .mcu = "atmega128", .host_usart = 0 },
+};
+
+const board_desc_t *board_find(const char *name)
+{
+	for (unsigned i = 0; i < sizeof(board_table) / sizeof(board_table[0]); i++) {
+		if (strcmp(board_table[i].name, name) == 0) {
+			return &board_table[i];
+		}
+	}
+	return NULL;
+}
+
+const char *board_names(void)
+{
+	return "m32d|m128s";
+}

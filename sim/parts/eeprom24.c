@@ -1,0 +1,88 @@
+/*
+ * eeprom24.c: 24C02-like EEPROM device.
+ */
+#include <string.h>
+
+#include "parts/eeprom24.h"
+
+static void eeprom24_commit(eeprom24_t *e)
+{
+	for (unsigned i = 0; i < EEPROM24_PAGE; i++) {
+		if (e->page_mask & (1u << i)) {
+			e->mem[e->page_base + i] = e->page[i];
+		}
+	}
+	e->page_mask = 0;
+}
+
+static int eeprom24_start(twi_dev_t *dev, uint8_t addr8)
+{
+	eeprom24_t *e = (eeprom24_t *)dev;
+
+	/* A (repeated) START abandons a page write not ended by a STOP, as
+	 * on the real part. */
+	e->page_mask = 0;
+	e->selected = (addr8 & 0xfe) == e->addr8;
+	e->want_word_addr = e->selected && !(addr8 & 1);
+	return e->selected;
+}
+
+static int eeprom24_write(twi_dev_t *dev, uint8_t byte)
+{
+	eeprom24_t *e = (eeprom24_t *)dev;
+	unsigned off;
+
+	if (!e->selected) {
+		return 0;
+	}
+	if (e->want_word_addr) {
+		e->want_word_addr = 0;
+		e->ptr = byte;
+		return 1;
+	}
+	if (!e->page_mask) {
+		e->page_base = e->ptr & (uint8_t)~(EEPROM24_PAGE - 1);
+	}
+	off = e->ptr & (EEPROM24_PAGE - 1);
+	e->page[off] = byte;
+	e->page_mask |= (uint8_t)(1u << off);
+	e->ptr = (uint8_t)(e->page_base | ((off + 1) & (EEPROM24_PAGE - 1)));
+	return 1;
+}
+
+static uint8_t eeprom24_read(twi_dev_t *dev, int master_acks)
+{
+	eeprom24_t *e = (eeprom24_t *)dev;
+	uint8_t v = e->mem[e->ptr];
+
+	(void)master_acks;
+	e->ptr++;		/* uint8_t: wraps at 256 */
+	return v;
+}
+
+static void eeprom24_stop(twi_dev_t *dev)
+{
+	eeprom24_t *e = (eeprom24_t *)dev;
+
+	if (e->selected) {
+		eeprom24_commit(e);
+	}
+	e->selected = 0;
+	e->want_word_addr = 0;
+}
+
+static const twi_dev_ops_t eeprom24_ops = {
+	.start = eeprom24_start,
+	.write = eeprom24_write,
+	.read = eeprom24_read,
+	.stop = eeprom24_stop,
+};
+
+void eeprom24_init(eeprom24_t *e, uint8_t addr8)
+{
+	memset(e, 0, sizeof(*e));
+	memset(e->mem, 0xff, sizeof(e->mem));
+	e->dev.ops = &eeprom24_ops;
+	e->dev.name = "eeprom24";
+	e->addr8 = addr8 & 0xfe;
+}

@@ -1,0 +1,32 @@
+/*
+ * eeprom24.h: a 256-byte serial EEPROM like a 24C02 on the simulated I2C
+ * bus. One word-address byte; reads auto-increment and wrap at 256; writes
+ * wrap inside their 8-byte page and are committed at the STOP; ready again
+ * at once (no write cycle time).
+ */
+#ifndef SIM_PARTS_EEPROM24_H
+#define SIM_PARTS_EEPROM24_H
+
+#include <stdint.h>
+
+#include "twi_bus.h"
+
+#define EEPROM24_SIZE 256
+#define EEPROM24_PAGE 8
+
+typedef struct eeprom24_t {
+	twi_dev_t dev;			/* first: the bus's view */
+	uint8_t addr8;			/* 8-bit bus address, R/W bit clear */
+	uint8_t mem[EEPROM24_SIZE];
+	uint8_t ptr;			/* word address counter */
+	uint8_t selected;		/* addressed since the last START */
+	uint8_t want_word_addr;		/* next written byte is the word address */
+	uint8_t page[EEPROM24_PAGE];	/* written bytes waiting for the STOP */
+	uint8_t page_mask;		/* which of page[] are valid */
+	uint8_t page_base;
+} eeprom24_t;
+
+/* Erased (FF) EEPROM answering at ADDR8 (0xA0). */
+void eeprom24_init(eeprom24_t *e, uint8_t addr8);
+
+#endif

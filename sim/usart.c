@@ -1,0 +1,455 @@
+/*
+ * usart.c: USART model. Flags are level conditions recomputed by
+ * usart_sync() after every change; simavr's vector table only sees the
+ * result (see the note on interrupts there).
+ */
+#include <string.h>
+
+#include "sim_regbit.h"
+
+#include "usart.h"
+
+/* Register bits (datasheet names; the same on ATmega32 and ATmega128). */
+enum {
+	UCSRA_RXC = 7, UCSRA_TXC = 6, UCSRA_UDRE = 5, UCSRA_FE = 4,
+	UCSRA_DOR = 3, UCSRA_PE = 2, UCSRA_U2X = 1, UCSRA_MPCM = 0,
+	UCSRB_RXCIE = 7, UCSRB_TXCIE = 6, UCSRB_UDRIE = 5, UCSRB_RXEN = 4,
+	UCSRB_TXEN = 3, UCSRB_UCSZ2 = 2, UCSRB_RXB8 = 1, UCSRB_TXB8 = 0,
+	UCSRC_URSEL = 7, UCSRC_UMSEL = 6, UCSRC_UPM1 = 5, UCSRC_UPM0 = 4,
+	UCSRC_USBS = 3, UCSRC_UCSZ1 = 2, UCSRC_UCSZ0 = 1, UCSRC_UCPOL = 0,
+};
+
+#define BIT(b) (1u << (b))
+
+static inline uint8_t usart_ucsrb(const usart_t *u)
+{
+	return u->avr->data[u->regs->ucsrb];
+}
+
+avr_cycle_count_t usart_byte_cycles(const usart_t *u)
+{
+	static const uint8_t data_bits[8] = { 5, 6, 7, 8, 8, 8, 8, 9 };
+	unsigned ucsz = ((u->ucsrc >> UCSRC_UCSZ0) & 3) |
+			((usart_ucsrb(u) & BIT(UCSRB_UCSZ2)) ? 4 : 0);
+	unsigned bits = 1 + data_bits[ucsz] +
+			((u->ucsrc & BIT(UCSRC_UPM1)) ? 1 : 0) +
+			((u->ucsrc & BIT(UCSRC_USBS)) ? 2 : 1);
+	unsigned per_bit = (u->ucsra & BIT(UCSRA_U2X)) ? 8 : 16;
+
+	return (avr_cycle_count_t)bits * per_bit * (u->ubrr + 1u);
+}
+
+static uint8_t usart_ucsra(const usart_t *u)
+{
+	uint8_t v = u->ucsra & (BIT(UCSRA_TXC) | BIT(UCSRA_UDRE) |
+				BIT(UCSRA_U2X) | BIT(UCSRA_MPCM));
+
+	if (u->rx_fifo_len) {
+		v |= BIT(UCSRA_RXC);
+		if (u->rx_fifo[0].dor) {
+			v |= BIT(UCSRA_DOR);
+		}
+	}
+	return v;
+}
+
+/*
+ * Interrupts. simavr latches a vector only if it is enabled when raised,
+ * and forgets it once the ISR is entered; the USART's flags are levels
+ * (RXC until UDR is emptied, UDRE while the buffer is free). So after every
+ * change, on enable bit changes and on RETI, a vector is raised again while
+ * its flag and enable bit are both set, and withdrawn when its flag drops.
+ */
+static void usart_sync_vector(usart_t *u, avr_int_vector_t *v, int flag)
+{
+	avr_t *avr = u->avr;
+
+	if (flag) {
+		if (!v->pending && avr_regbit_get(avr, v->enable)) {
+			avr_raise_interrupt(avr, v);
+		}
+	} else if (v->pending) {
+		avr_clear_interrupt(avr, v);
+	}
+}
+
+static void usart_sync(usart_t *u)
+{
+	uint8_t a = usart_ucsra(u);
+
+	u->avr->data[u->regs->ucsra] = a;
+	usart_sync_vector(u, &u->vect_rxc, a & BIT(UCSRA_RXC));
+	usart_sync_vector(u, &u->vect_udre, a & BIT(UCSRA_UDRE));
+	usart_sync_vector(u, &u->vect_txc, a & BIT(UCSRA_TXC));
+}
+
+/* --- receiver ------------------------------------------------------------ */
+
+static void usart_rx_flush(usart_t *u)
+{
+	u->rx_fifo_len = 0;
+	u->rx_shift_full = 0;
+}
+
+static void usart_rx_deliver(usart_t *u, uint8_t byte)
+{
+	if (u->rx_fifo_len < 2) {
+		u->rx_fifo[u->rx_fifo_len].data = byte;
+		u->rx_fifo[u->rx_fifo_len].dor = 0;
+		u->rx_fifo_len++;
+	} else if (!u->rx_shift_full) {
+		u->rx_shift_full = 1;
+		u->rx_shift_byte = byte;
+	} else {
+		/* Overrun: the frame waiting in the shifter is overwritten. The
+		 * newest frame in the FIFO carries DOR until UDR is read. */
+		u->rx_shift_byte = byte;
+		u->rx_fifo[1].dor = 1;
+	}
+}
+
+static int usart_rx_start(usart_t *u)
+{
+	if (!u->host_len) {
+		u->rx_wire_busy = 0;
+		return 0;
+	}
+	u->rx_wire_byte = u->host_q[u->host_head];
+	u->host_head = (u->host_head + 1) % USART_HOST_QUEUE;
+	u->host_len--;
+	u->rx_wire_busy = 1;
+	u->rx_wire_valid = !!(usart_ucsrb(u) & BIT(UCSRB_RXEN));
+	return 1;
+}
+
+static avr_cycle_count_t usart_rx_timer(avr_t *avr, avr_cycle_count_t when,
+					void *param)
+{
+	usart_t *u = param;
+
+	(void)avr;
+	if (u->rx_wire_valid && (usart_ucsrb(u) & BIT(UCSRB_RXEN))) {
+		trace_event(u->trace, when, "uart rx %02X", u->rx_wire_byte);
+		usart_rx_deliver(u, u->rx_wire_byte);
+		usart_sync(u);
+	}
+	u->activity++;
+	if (usart_rx_start(u)) {
+		return when + usart_byte_cycles(u);
+	}
+	return 0;
+}
+
+size_t usart_host_room(const usart_t *u)
+{
+	return USART_HOST_QUEUE - u->host_len;
+}
+
+void usart_host_send(usart_t *u, const uint8_t *buf, size_t n)
+{
+	for (size_t i = 0; i < n && u->host_len < USART_HOST_QUEUE; i++) {
+		u->host_q[(u->host_head + u->host_len) % USART_HOST_QUEUE] = buf[i];
+		u->host_len++;
+	}
+	if (!u->rx_wire_busy && usart_rx_start(u)) {
+		avr_cycle_timer_register(u->avr, usart_byte_cycles(u),
+					 usart_rx_timer, u);
+	}
+}
+
+/* --- transmitter --------------------------------------------------------- */
+
+/* Move the buffer into the idle shifter: the start bit begins at WHEN. */
+static int usart_tx_load(usart_t *u, avr_cycle_count_t when)
+{
+	if (u->tx_shift_busy || !u->tx_buf_full) {
+		return 0;
+	}
+	u->tx_shift_byte = u->tx_buf;
+	u->tx_shift_busy = 1;
+	u->tx_buf_full = 0;
+	u->ucsra |= BIT(UCSRA_UDRE);
+	trace_event(u->trace, when, "uart tx %02X", u->tx_shift_byte);
+	return 1;
+}
+
+static avr_cycle_count_t usart_tx_timer(avr_t *avr, avr_cycle_count_t when,
+					void *param)
+{
+	usart_t *u = param;
+
+	(void)avr;
+	u->tx_shift_busy = 0;
+	u->activity++;
+	if (u->to_host) {
+		u->to_host(u->to_host_param, u->tx_shift_byte);
+	}
+	/* A byte already in the buffer goes out even if TXEN was cleared
+	 * meanwhile: the datasheet lets pending transmissions complete. */
+	if (usart_tx_load(u, when)) {
+		usart_sync(u);
+		return when + usart_byte_cycles(u);
+	}
+	u->ucsra |= BIT(UCSRA_TXC);
+	usart_sync(u);
+	return 0;
+}
+
+static void usart_tx_kick(usart_t *u)
+{
+	if ((usart_ucsrb(u) & BIT(UCSRB_TXEN)) && usart_tx_load(u, u->avr->cycle)) {
+		avr_cycle_timer_register(u->avr, usart_byte_cycles(u),
+					 usart_tx_timer, u);
+	}
+}
+
+/* --- registers ----------------------------------------------------------- */
+
+static uint8_t usart_read_udr(avr_t *avr, avr_io_addr_t addr, void *param)
+{
+	usart_t *u = param;
+
+	(void)avr;
+	(void)addr;
+	if (u->rx_fifo_len) {
+		u->rx_last = u->rx_fifo[0].data;
+		u->rx_fifo[0] = u->rx_fifo[1];
+		u->rx_fifo_len--;
+		if (u->rx_shift_full) {
+			u->rx_fifo[u->rx_fifo_len].data = u->rx_shift_byte;
+			u->rx_fifo[u->rx_fifo_len].dor = 0;
+			u->rx_fifo_len++;
+			u->rx_shift_full = 0;
+		}
+		usart_sync(u);
+	}
+	return u->rx_last;
+}
+
+static void usart_write_udr(avr_t *avr, avr_io_addr_t addr, uint8_t v,
+			    void *param)
+{
+	usart_t *u = param;
+
+	(void)avr;
+	(void)addr;
+	if (!(u->ucsra & BIT(UCSRA_UDRE))) {
+		return;		/* silicon ignores a write to a full buffer */
+	}
+	u->tx_buf = v;
+	u->tx_buf_full = 1;
+	u->ucsra &= ~BIT(UCSRA_UDRE);
+	usart_tx_kick(u);
+	usart_sync(u);
+}
+
+static uint8_t usart_read_ucsra(avr_t *avr, avr_io_addr_t addr, void *param)
+{
+	(void)avr;
+	(void)addr;
+	return usart_ucsra(param);
+}
+
+static void usart_write_ucsra(avr_t *avr, avr_io_addr_t addr, uint8_t v,
+			      void *param)
+{
+	usart_t *u = param;
+
+	(void)avr;
+	(void)addr;
+	if (v & BIT(UCSRA_TXC)) {
+		u->ucsra &= ~BIT(UCSRA_TXC);
+	}
+	u->ucsra = (u->ucsra & ~(BIT(UCSRA_U2X) | BIT(UCSRA_MPCM))) |
+		   (v & (BIT(UCSRA_U2X) | BIT(UCSRA_MPCM)));
+	usart_sync(u);
+}
+
+static void usart_write_ucsrb(avr_t *avr, avr_io_addr_t addr, uint8_t v,
+			      void *param)
+{
+	usart_t *u = param;
+	uint8_t old = avr->data[addr];
+
+	v = (uint8_t)((v & ~BIT(UCSRB_RXB8)) | (old & BIT(UCSRB_RXB8)));
+	avr->data[addr] = v;
+	if ((old & BIT(UCSRB_RXEN)) && !(v & BIT(UCSRB_RXEN))) {
+		usart_rx_flush(u);
+	}
+	if (v & BIT(UCSRB_TXEN)) {
+		usart_tx_kick(u);
+	}
+	usart_sync(u);
+}
+
+static void usart_write_ubrrl(avr_t *avr, avr_io_addr_t addr, uint8_t v,
+			      void *param)
+{
+	usart_t *u = param;
+
+	avr->data[addr] = v;
+	u->ubrr = (uint16_t)((u->ubrr & 0x0f00) | v);
+}
+
+static void usart_set_ubrrh(usart_t *u, uint8_t v)
+{
+	u->ubrr = (uint16_t)((u->ubrr & 0x00ff) | ((v & 0x0f) << 8));
+}
+
+/* ATmega128: UBRRH and UCSRC have addresses of their own. */
+static void usart_write_ubrrh(avr_t *avr, avr_io_addr_t addr, uint8_t v,
+			      void *param)
+{
+	avr->data[addr] = v & 0x0f;
+	usart_set_ubrrh(param, v);
+}
+
+static void usart_write_ucsrc(avr_t *avr, avr_io_addr_t addr, uint8_t v,
+			      void *param)
+{
+	usart_t *u = param;
+
+	u->ucsrc = v & 0x7f;
+	avr->data[addr] = u->ucsrc;
+}
+
+/* ATmega32: one address, URSEL (bit 7) picks UCSRC on write. On read, the
+ * first access returns UBRRH and one in the very next cycle UCSRC. */
+static void usart_write_shared(avr_t *avr, avr_io_addr_t addr, uint8_t v,
+			       void *param)
+{
+	usart_t *u = param;
+
+	(void)avr;
+	(void)addr;
+	if (v & BIT(UCSRC_URSEL)) {
+		u->ucsrc = v & 0x7f;
+	} else {
+		usart_set_ubrrh(u, v);
+	}
+}
+
+static uint8_t usart_read_shared(avr_t *avr, avr_io_addr_t addr, void *param)
+{
+	usart_t *u = param;
+	uint8_t v;
+
+	(void)addr;
+	if (avr->cycle == u->ubrrh_read_cycle + 1) {
+		v = (uint8_t)(BIT(UCSRC_URSEL) | u->ucsrc);
+	} else {
+		v = (uint8_t)(u->ubrr >> 8);
+	}
+	u->ubrrh_read_cycle = avr->cycle;
+	return v;
+}
+
+static void usart_take(avr_t *avr, uint16_t addr, avr_io_read_t r,
+		       avr_io_write_t w, void *param)
+{
+	avr_io_addr_t io = AVR_DATA_TO_IO(addr);
+
+	avr->io[io].r.c = r;
+	avr->io[io].r.param = r ? param : NULL;
+	avr->io[io].w.c = w;
+	avr->io[io].w.param = w ? param : NULL;
+}
+
+static void usart_irq_running(struct avr_irq_t *irq, uint32_t value,
+			      void *param)
+{
+	usart_t *u = param;
+
+	/* TXC is the one flag the hardware clears on entering its ISR. */
+	if (value && irq == &u->vect_txc.irq[AVR_INT_IRQ_RUNNING]) {
+		u->ucsra &= ~BIT(UCSRA_TXC);
+	}
+	usart_sync(u);
+}
+
+/* --- reset --------------------------------------------------------------- */
+
+static void usart_reset(avr_io_t *io)
+{
+	usart_t *u = (usart_t *)io;
+	avr_t *avr = u->avr;
+	const mcu_usart_regs_t *r = u->regs;
+
+	/* avr_reset has wiped the cycle timers: the byte on the wire is lost
+	 * in both directions; the host queue keeps flowing (into a receiver
+	 * that is off until the firmware enables it). */
+	u->ucsra = BIT(UCSRA_UDRE);
+	u->ucsrc = BIT(UCSRC_UCSZ1) | BIT(UCSRC_UCSZ0);
+	u->ubrr = 0;
+	u->rx_fifo_len = 0;
+	u->rx_shift_full = 0;
+	u->rx_wire_busy = 0;
+	u->tx_buf_full = 0;
+	u->tx_shift_busy = 0;
+	avr->data[r->ucsrb] = 0;
+	avr->data[r->ubrrl] = 0;
+	avr->data[r->ubrrh] = 0;
+	if (!mcu_usart_shared_ucsrc(r)) {
+		avr->data[r->ucsrc] = u->ucsrc;
+	}
+	usart_sync(u);
+	if (usart_rx_start(u)) {
+		avr_cycle_timer_register(avr, usart_byte_cycles(u),
+					 usart_rx_timer, u);
+	}
+}
+
+void usart_init(usart_t *u, avr_t *avr, const mcu_usart_regs_t *regs,
+		trace_t *trace, usart_to_host_t to_host, void *param)
+{
+	memset(u, 0, sizeof(*u));
+	u->avr = avr;
+	u->regs = regs;
+	u->trace = trace;
+	u->to_host = to_host;
+	u->to_host_param = param;
+	u->io.kind = "orfa-usart";
+	u->io.reset = usart_reset;
+
+	u->vect_rxc = (avr_int_vector_t) {
+		.vector = regs->vect_rxc,
+		.enable = AVR_IO_REGBIT(regs->ucsrb, UCSRB_RXCIE),
+		.raised = AVR_IO_REGBIT(regs->ucsra, UCSRA_RXC),
+		.raise_sticky = 1,
+	};
+	u->vect_udre = (avr_int_vector_t) {
+		.vector = regs->vect_udre,
+		.enable = AVR_IO_REGBIT(regs->ucsrb, UCSRB_UDRIE),
+		.raised = AVR_IO_REGBIT(regs->ucsra, UCSRA_UDRE),
+		.raise_sticky = 1,
+	};
+	u->vect_txc = (avr_int_vector_t) {
+		.vector = regs->vect_txc,
+		.enable = AVR_IO_REGBIT(regs->ucsrb, UCSRB_TXCIE),
+		.raised = AVR_IO_REGBIT(regs->ucsra, UCSRA_TXC),
+	};
+	avr_register_vector(avr, &u->vect_rxc);
+	avr_register_vector(avr, &u->vect_udre);
+	avr_register_vector(avr, &u->vect_txc);
+	avr_irq_register_notify(&u->vect_rxc.irq[AVR_INT_IRQ_RUNNING],
+				usart_irq_running, u);
+	avr_irq_register_notify(&u->vect_udre.irq[AVR_INT_IRQ_RUNNING],
+				usart_irq_running, u);
+	avr_irq_register_notify(&u->vect_txc.irq[AVR_INT_IRQ_RUNNING],
+				usart_irq_running, u);
+
+	usart_take(avr, regs->udr, usart_read_udr, usart_write_udr, u);
+	usart_take(avr, regs->ucsra, usart_read_ucsra, usart_write_ucsra, u);
+	usart_take(avr, regs->ucsrb, NULL, usart_write_ucsrb, u);
+	usart_take(avr, regs->ubrrl, NULL, usart_write_ubrrl, u);
+	if (mcu_usart_shared_ucsrc(regs)) {
+		usart_take(avr, regs->ubrrh, usart_read_shared,
+			   usart_write_shared, u);
+	} else {
+		usart_take(avr, regs->ubrrh, NULL, usart_write_ubrrh, u);
+		usart_take(avr, regs->ucsrc, NULL, usart_write_ucsrc, u);
+	}
+
+	mcu_register_io_last(avr, &u->io);
+	usart_reset(&u->io);
+}

@@ -1,0 +1,91 @@
+/*
+ * usart.h: the simulator's own model of one AVR USART (asynchronous mode),
+ * replacing simavr 1.6's (wrong byte times, no URSEL, UDRE bug, no overrun:
+ * see SIMAVR-NOTES.md). It takes over the USART's registers after avr_init
+ * and paces both directions of the wire in CPU cycles:
+ *
+ *   byte time = bit time * (1 start + data + parity + stop bits),
+ *   bit time  = 16 * (UBRR + 1) cycles, 8 * (UBRR + 1) with U2X.
+ *
+ * Receive: bytes from the host are queued and put on the wire back to back;
+ * 2-byte FIFO plus the shift register, DOR and a lost byte on overflow.
+ * Transmit: UDR buffer plus shift register; a byte reaches the host at the
+ * end of its stop bit.
+ */
+#ifndef SIM_USART_H
+#define SIM_USART_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sim_avr.h"
+#include "sim_io.h"
+#include "sim_interrupts.h"
+
+#include "mcu.h"
+#include "trace.h"
+
+/* Bytes from the host waiting for the wire; the pty is read only while
+ * there is room, so a fast host is slowed by the kernel's pty buffer. */
+#define USART_HOST_QUEUE 4096
+
+typedef void (*usart_to_host_t)(void *param, uint8_t byte);
+
+typedef struct usart_rx_slot_t {
+	uint8_t data;
+	uint8_t dor;
+} usart_rx_slot_t;
+
+typedef struct usart_t {
+	avr_io_t io;			/* first: reset hook via avr_register_io */
+	avr_t *avr;
+	const mcu_usart_regs_t *regs;
+	trace_t *trace;
+	usart_to_host_t to_host;
+	void *to_host_param;
+
+	avr_int_vector_t vect_rxc, vect_udre, vect_txc;
+
+	/* registers the model keeps itself (UCSRB lives in avr->data) */
+	uint8_t ucsra;			/* TXC, UDRE, U2X, MPCM */
+	uint8_t ucsrc;
+	uint16_t ubrr;
+	avr_cycle_count_t ubrrh_read_cycle;
+
+	/* host -> wire -> receiver */
+	uint8_t host_q[USART_HOST_QUEUE];
+	size_t host_head, host_len;
+	int rx_wire_busy;		/* a byte is on the wire now */
+	uint8_t rx_wire_byte;
+	int rx_wire_valid;		/* the receiver was on at its start bit */
+	usart_rx_slot_t rx_fifo[2];
+	uint8_t rx_fifo_len;
+	int rx_shift_full;		/* complete frame waiting in the shifter */
+	uint8_t rx_shift_byte;
+	int rx_dor;			/* an overrun lost a frame since UDR was read */
+	uint8_t rx_last;
+
+	/* transmitter */
+	int tx_buf_full;
+	uint8_t tx_buf;
+	int tx_shift_busy;
+	uint8_t tx_shift_byte;
+
+	uint32_t activity;		/* bumps on every byte on the wire */
+} usart_t;
+
+/* Take over the USART described by REGS on AVR (after avr_init). Bytes the
+ * firmware sends go to TO_HOST at the end of their stop bit. */
+void usart_init(usart_t *u, avr_t *avr, const mcu_usart_regs_t *regs,
+		trace_t *trace, usart_to_host_t to_host, void *param);
+
+/* Room left in the host queue. */
+size_t usart_host_room(const usart_t *u);
+
+/* Queue N bytes from the host (at most usart_host_room). */
+void usart_host_send(usart_t *u, const uint8_t *buf, size_t n);
+
+/* Cycles one frame takes with the current UBRR/U2X/UCSRC settings. */
+avr_cycle_count_t usart_byte_cycles(const usart_t *u);
+
+#endif
