@@ -1,0 +1,69 @@
+"""`python3 -m orfa sim` and `python3 -m orfa request` against simulated boards."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from orfa.sim import SimBoard
+
+from conftest import require_builds
+
+HOST = str(Path(__file__).resolve().parents[2] / "host")
+ENV = dict(os.environ, PYTHONPATH=HOST)
+
+
+def orfa(*args, **kw):
+    return subprocess.run([sys.executable, "-m", "orfa"] + list(args), env=ENV,
+                          capture_output=True, text=True, timeout=60, **kw)
+
+
+@pytest.mark.parametrize("board_name", ["m32d", "m128s"])
+def test_request_command(board_name):
+    require_builds([board_name])
+    with SimBoard(board_name, eeproms=(0xA0,), trace=False) as sim:
+        result = orfa("request", "--port", sim.port, "V", "S A0 P", "S A2 P")
+        assert result.returncode == 0, result.stderr
+        assert result.stdout == "V1.1\nSWP\nERROR 06\n"
+
+
+def test_request_refused_on_the_host():
+    result = orfa("request", "--port", "loop://", "V" * 129)
+    assert result.returncode == 1
+    assert "limit is 128" in result.stderr
+
+
+def test_terminal_through_a_pipe():
+    require_builds(["m32d"])
+    result = orfa("sim", "--board", "m32d", "--eeprom", "0xA0", "--terminal",
+                  input="V\nl\n# comment\n\nS A0 P\nS A2 P\nQ\n")
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[1:] == ["V1.1", "LAA", "SWP", "ERROR 06", "ERROR 02"]
+    assert lines[0].endswith("/tty")
+    assert not os.path.exists(lines[0])          # the simulator has stopped
+
+
+def test_sim_runs_until_interrupted():
+    require_builds(["m32d"])
+    proc = subprocess.Popen([sys.executable, "-m", "orfa", "sim", "--board", "m32d"],
+                            env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        port = proc.stdout.readline().strip()
+        assert os.path.exists(port), proc.stderr.read() if proc.poll() is not None else port
+        result = orfa("request", "--port", port, "C")
+        assert result.stdout == "C0063\n"
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=10) == 0
+        deadline = time.monotonic() + 5
+        while os.path.exists(port) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not os.path.exists(port)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()

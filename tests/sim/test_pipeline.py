@@ -1,0 +1,81 @@
+"""Requests back to back at the full line rate, without waiting for replies."""
+
+import random
+
+AREA = 0xA0               # this module's bytes of the simulated EEPROM: 0xA0-0xBF
+
+
+def test_pipelined_requests_in_one_write(board):
+    """240 requests in one write; each reply is no longer than its request, so
+    the host never has 256 characters of requests unanswered (SPEC: Flow)."""
+    rng = random.Random(1)
+    n = board.driver_count()
+    rec1 = board.record(1).hex().upper().encode()
+    board.eeprom_write(AREA, bytes(8))
+    board.eeprom_write(AREA + 8, bytes(8))
+    mem = bytearray(16)
+    requests, replies = [], []
+    for i in range(240):
+        kind = i % 8
+        if kind == 0:
+            requests.append(b"V    ")
+            replies.append(b"V1.1\r\n")
+        elif kind == 1:
+            requests.append(b"L   ")
+            replies.append(b"LAA\r\n")
+        elif kind == 2:
+            requests.append(b"S AA 00 00 S AB 01 P")
+            replies.append(b"SWAASR%02XP\r\n" % n)
+        elif kind == 3:
+            requests.append(b"S AA 00 01 S AB 06 P")
+            replies.append(b"SWAASR" + rec1 + b"P\r\n")
+        elif kind == 4:
+            off, value = rng.randrange(16), rng.randrange(256)
+            mem[off] = value
+            requests.append(b"S A0 %02X %02X P" % (AREA + off, value))
+            replies.append(b"SWAAP\r\n")
+        elif kind == 5:
+            off = rng.randrange(16)
+            requests.append(b"S A0 %02X S A1 01 P" % (AREA + off))
+            replies.append(b"SWASR%02XP\r\n" % mem[off])
+        elif kind == 6:
+            requests.append(b"C      ")
+            replies.append(b"C0063\r\n")
+        else:
+            requests.append(b"Q 1 2 3 4")
+            replies.append(b"ERROR 02\r\n")
+    data = b"".join(r + b"\n" for r in requests)
+    got = board.exchange(data, len(requests))
+    got_lines = got.split(b"\r\n")[:-1]
+    want_lines = b"".join(replies).split(b"\r\n")[:-1]
+    for i, (g, w) in enumerate(zip(got_lines, want_lines)):
+        assert g == w, "request %d %r: got %r, want %r" % (i, requests[i], g, w)
+    assert got == b"".join(replies)
+    board.assert_silent()
+    assert board.eeprom_read(AREA, 16) == bytes(mem)
+
+
+def test_pipelined_short_requests(board):
+    """Under 256 characters unanswered: 60 `V` requests (120 characters)."""
+    assert board.exchange(b"V\n" * 60, 60) == b"V1.1\r\n" * 60
+    board.assert_silent()
+
+
+def test_receive_overflow_is_error_04_never_garbage(board):
+    """Replies 6x longer than requests overflow the 256-character buffer; a
+    line that lost characters is ERROR 04, every other reply is exact."""
+    board.record(1)
+    request = b"S AA 00 01 S AB 3C P\n"               # 21 characters, 129 back
+    want = board.ask(request[:-1].decode())
+    assert len(want) == 129
+    board.gw.send(request * 100)
+    got = board.gw.read_available(1.0)
+    lines = got.split(b"\r\n")
+    assert lines[-1] == b"", got[-200:]
+    lines = lines[:-1]
+    assert 1 <= len(lines) <= 100
+    bad = [line for line in lines if line + b"\r\n" != want and line != b"ERROR 04"]
+    assert bad == []
+    assert b"ERROR 04" in lines                       # the buffer did overflow
+    assert board.ask("V") == b"V1.1\r\n"
+    assert board.ask(request[:-1].decode()) == want
