@@ -34,6 +34,8 @@
 #define SIM_MAX_EEPROMS 8
 #define SIM_BATCH_CYCLES (SIM_FREQUENCY / 1000)	/* 1 ms simulated */
 #define SIM_IDLE_AFTER_S 0.5
+#define SIM_BOOT_MAX_CYCLES (SIM_FREQUENCY / 10)	/* 100 ms simulated */
+#define SIM_UCSRB_RXEN 0x10
 
 typedef struct sim_t {
 	const board_desc_t *board;
@@ -113,6 +115,29 @@ static int sim_parse_addr(const char *s, uint8_t *out)
 		return -1;
 	}
 	*out = (uint8_t)v;
+	return 0;
+}
+
+/* Run about a millisecond of simulated time and hand the firmware's output
+ * to the pty. 0, or 1 when the firmware crashed or stopped for good. */
+static int sim_batch(sim_t *sim)
+{
+	avr_cycle_count_t target = sim->avr->cycle + SIM_BATCH_CYCLES;
+	int state = cpu_Running;
+
+	while (sim->avr->cycle < target) {
+		state = avr_run(sim->avr);
+		if (state == cpu_Done || state == cpu_Crashed) {
+			break;
+		}
+	}
+	pty_flush(&sim->pty);
+	if (state == cpu_Done || state == cpu_Crashed) {
+		fprintf(stderr, "orfa-sim: firmware %s at pc 0x%04x, cycle %" PRIu64 "\n",
+			state == cpu_Crashed ? "crashed" : "stopped (sleep with interrupts off)",
+			sim->avr->pc, (uint64_t)sim->avr->cycle);
+		return 1;
+	}
 	return 0;
 }
 
@@ -232,14 +257,30 @@ int main(int argc, char **argv)
 	sigaction(SIGINT, &sa, NULL);
 	signal(SIGPIPE, SIG_IGN);
 
-	if (pty_open(&sim.pty, link) < 0) {
-		fprintf(stderr, "orfa-sim: cannot create pty link '%s': %s\n",
-			link, strerror(errno));
+	if (pty_open(&sim.pty) < 0) {
+		fprintf(stderr, "orfa-sim: cannot open a pty: %s\n", strerror(errno));
 		return 2;
 	}
-	printf("orfa-sim: %s %s @ %u Hz, serial %s -> %s\n", sim.board->name,
-	       sim.board->mcu, SIM_FREQUENCY, sim.pty.slave_name, link);
-	fflush(stdout);
+	/* Power-up: let the firmware boot until it enables its receiver (at
+	 * most SIM_BOOT_MAX_CYCLES) before the PC can reach the port, so a
+	 * first byte sent right after the link appears is not lost to a
+	 * board that is still initialising. */
+	int rc = 0;
+	while (!sim_stop && rc == 0 && sim.avr->cycle < SIM_BOOT_MAX_CYCLES &&
+	       !(sim.avr->data[sim.usart.regs->ucsrb] & SIM_UCSRB_RXEN)) {
+		rc = sim_batch(&sim);
+	}
+	if (rc == 0 && !sim_stop) {
+		if (pty_link(&sim.pty, link) < 0) {
+			fprintf(stderr, "orfa-sim: cannot create link '%s': %s\n",
+				link, strerror(errno));
+			pty_close(&sim.pty);
+			return 2;
+		}
+		printf("orfa-sim: %s %s @ %u Hz, serial %s -> %s\n", sim.board->name,
+		       sim.board->mcu, SIM_FREQUENCY, sim.pty.slave_name, link);
+		fflush(stdout);
+	}
 
 	/* Speed bookkeeping: only time spent running free counts. */
 	double t_start = sim_now(), t_free = 0;
@@ -250,9 +291,8 @@ int main(int argc, char **argv)
 	int throttled = 0;
 	double th_wall0 = 0;
 	avr_cycle_count_t th_cycle0 = 0;
-	int rc = 0;
 
-	while (!sim_stop) {
+	while (!sim_stop && rc == 0) {
 		uint8_t buf[512];
 		size_t room = usart_host_room(&sim.usart);
 		size_t n = pty_read(&sim.pty, buf, room < sizeof(buf) ? room : sizeof(buf));
@@ -263,22 +303,7 @@ int main(int argc, char **argv)
 
 		double t0 = sim_now();
 		avr_cycle_count_t c0 = sim.avr->cycle;
-		avr_cycle_count_t target = c0 + SIM_BATCH_CYCLES;
-		int state = cpu_Running;
-		while (sim.avr->cycle < target) {
-			state = avr_run(sim.avr);
-			if (state == cpu_Done || state == cpu_Crashed) {
-				break;
-			}
-		}
-		pty_flush(&sim.pty);
-		if (state == cpu_Done || state == cpu_Crashed) {
-			fprintf(stderr, "orfa-sim: firmware %s at pc 0x%04x, cycle %" PRIu64 "\n",
-				state == cpu_Crashed ? "crashed" : "stopped (sleep with interrupts off)",
-				sim.avr->pc, (uint64_t)sim.avr->cycle);
-			rc = 1;
-			break;
-		}
+		rc = sim_batch(&sim);
 
 		double now = sim_now();
 		uint32_t act = sim_activity(&sim);

@@ -19,7 +19,7 @@
  * a wire with nothing plugged in. */
 #define PTY_OUT_MAX (1u << 20)
 
-int pty_open(pty_t *p, const char *link)
+int pty_open(pty_t *p)
 {
 	struct termios tio;
 
@@ -43,17 +43,18 @@ int pty_open(pty_t *p, const char *link)
 	fcntl(p->master, F_SETFL, fcntl(p->master, F_GETFL) | O_NONBLOCK);
 	fcntl(p->master, F_SETFD, FD_CLOEXEC);
 	fcntl(p->slave, F_SETFD, FD_CLOEXEC);
+	return 0;
+}
+
+int pty_link(pty_t *p, const char *link)
+{
+	struct stat st;
 
 	/* Replace a stale link left by a killed run, but never a real file. */
-	struct stat st;
 	if (lstat(link, &st) == 0 && S_ISLNK(st.st_mode)) {
 		unlink(link);
 	}
 	if (symlink(p->slave_name, link) < 0) {
-		int e = errno;
-		close(p->master);
-		close(p->slave);
-		errno = e;
 		return -1;
 	}
 	p->link = strdup(link);

@@ -18,8 +18,11 @@ typedef struct pty_t {
 	size_t out_len, out_cap;
 } pty_t;
 
-/* Open a raw pty and point LINK at it (replacing an old link). 0 or -1. */
-int pty_open(pty_t *p, const char *link);
+/* Open a raw pty. 0, or -1 with errno set. */
+int pty_open(pty_t *p);
+
+/* Point LINK at the pty (replacing a stale link). 0, or -1 with errno. */
+int pty_link(pty_t *p, const char *link);
 
 /* Read up to N bytes from the PC; returns the count (0 when none). */
 size_t pty_read(pty_t *p, uint8_t *buf, size_t n);
