@@ -36,7 +36,7 @@ FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) -DORFA_BAUD=$(BAUD) \
 FW_LDFLAGS := -mmcu=$(BOARD_MCU) -Wl,--gc-sections
 
 FW_SRC := firmware/main.c firmware/regmap.c firmware/intro.c firmware/uart.c \
-	firmware/twi_master.c firmware/mcu.c \
+	firmware/twi_master.c firmware/twi_rate.c firmware/mcu.c \
 	$(foreach d,$(DRIVERS),drivers/drv_$(d).c)
 ifeq ($(MODE),gate)
 FW_SRC += serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c

@@ -8,6 +8,10 @@
 
 #include "firmware/intro.h"
 
+#ifdef ORFA_UNIT_TEST
+#include "fakes.h"
+#endif
+
 #ifndef ORFA_DRIVER_LIST
 #define ORFA_DRIVER_LIST
 #endif

@@ -7,20 +7,11 @@
 
 #include "board.h"
 #include "firmware/mcu.h"
-
-/* Datasheet (ATmega32/128, TWI bit rate): TWBR below 10 may give wrong
- * SCL/SDA output in master mode. */
-#define TWI_TWBR_MIN 10
+#include "firmware/twi_rate.h"
 
 static struct {
 	uint32_t timeout;  /* polling loops before a step counts as hung */
 } twi;
-
-/* SCL period in CPU cycles for a bit-rate setting. */
-static uint32_t twi_period(uint8_t twbr, uint8_t twps)
-{
-	return 16UL + ((uint32_t)twbr << (1 + 2 * twps));
-}
 
 void twi_init(void)
 {
@@ -30,32 +21,13 @@ void twi_init(void)
 
 uint16_t twi_set_khz(uint16_t khz)
 {
-	uint32_t f = (uint32_t)khz * 1000UL;
-	uint8_t twps = 3;
-	uint32_t twbr = 255;
-
-	for (uint8_t ps = 0; ps < 4; ps++) {
-		uint32_t mul_f = (2UL << (2 * ps)) * f;
-		uint32_t need = 0;
-		if (16UL * f < F_CPU) {
-			need = (F_CPU - 16UL * f + mul_f - 1) / mul_f;  /* rounded up */
-		}
-		if (need < TWI_TWBR_MIN) {
-			need = TWI_TWBR_MIN;
-		}
-		if (need <= 255) {
-			twps = ps;
-			twbr = need;
-			break;
-		}
-	}
-	TWBR = (uint8_t)twbr;
-	TWSR = twps;  /* only the prescaler bits are writable */
-	uint32_t period = twi_period((uint8_t)twbr, twps);
+	twi_rate_t r = twi_rate_for_khz(F_CPU, khz);
+	TWBR = r.twbr;
+	TWSR = r.twps;  /* only the prescaler bits are writable */
 	/* A polling loop takes at least 6 cycles: 3 periods of loops cover a
 	 * whole byte (9 periods) twice over. */
-	twi.timeout = 3 * period + 256;
-	return (uint16_t)(F_CPU / period / 1000UL);
+	twi.timeout = 3 * r.period + 256;
+	return r.khz;
 }
 
 /* Waits for TWINT; false on timeout. */

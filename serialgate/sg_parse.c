@@ -153,14 +153,12 @@ static sg_event_t end_line(sg_parser_t *p)
 {
 	uint8_t state = p->state;
 	p->state = ST_BEGIN;
-	if (p->err != SG_OK) {
-		return SG_REQUEST;
-	}
 	switch (state) {
 	case ST_BEGIN:
 	case ST_LEAD:
 	case ST_COMMENT:
 		return SG_IGNORED;
+	case ST_ERROR:
 	case ST_DONE:
 		break;
 	case ST_ARGS:

@@ -1,0 +1,159 @@
+#include "fakes.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "firmware/twi_master.h"
+#include "firmware/twi_rate.h"
+#include "serialgate/sg_exec.h"
+
+char bus_log[4096];
+uint8_t eeprom[256];
+char out_buf[4096];
+unsigned out_len;
+
+static struct {
+	int device;      /* addressed device, -1 none */
+	int first_write; /* next written byte is the EEPROM word address */
+	uint8_t ptr;
+} bus;
+
+static void logf_(const char *fmt, unsigned v)
+{
+	size_t n = strlen(bus_log);
+	snprintf(bus_log + n, sizeof bus_log - n, fmt, v);
+}
+
+void fakes_reset(void)
+{
+	bus_log[0] = 0;
+	out_len = 0;
+	out_buf[0] = 0;
+	memset(eeprom, 0xFF, sizeof eeprom);
+	bus.device = -1;
+}
+
+void sg_out(uint8_t c)
+{
+	if (out_len + 1 < sizeof out_buf) {
+		out_buf[out_len++] = (char)c;
+		out_buf[out_len] = 0;
+	}
+}
+
+/* Devices: 0xA0 EEPROM; 0x50 acknowledges its address, refuses data;
+ * 0x60 hangs the bus (every step fails). */
+twi_result_t twi_start(uint8_t addr8)
+{
+	logf_("S %02X", addr8);
+	uint8_t dev = addr8 & 0xFE;
+	if (dev == 0x60) {
+		logf_("! ", 0);
+		return TWI_FAIL;
+	}
+	if (dev != 0xA0 && dev != 0x50) {
+		logf_("- ", 0);
+		bus.device = -1;
+		return TWI_NACK;
+	}
+	logf_("+ ", 0);
+	bus.device = dev;
+	bus.first_write = !(addr8 & 1);
+	return TWI_ACK;
+}
+
+twi_result_t twi_write(uint8_t byte)
+{
+	logf_("W%02X", byte);
+	if (bus.device != 0xA0) {
+		logf_("- ", 0);
+		return TWI_NACK;
+	}
+	logf_("+ ", 0);
+	if (bus.first_write) {
+		bus.ptr = byte;
+		bus.first_write = 0;
+	} else {
+		eeprom[bus.ptr] = byte;
+		bus.ptr = (uint8_t)((bus.ptr & 0xF8) | ((bus.ptr + 1) & 7));
+	}
+	return TWI_ACK;
+}
+
+twi_result_t twi_read(uint8_t *byte, bool ack)
+{
+	*byte = bus.device == 0xA0 ? eeprom[bus.ptr++] : 0xFF;
+	logf_("R%02X", *byte);
+	logf_(ack ? "+ " : "- ", 0);
+	return TWI_ACK;
+}
+
+void twi_stop(void)
+{
+	logf_("P ", 0);
+	bus.device = -1;
+}
+
+void twi_clear_bus(void)
+{
+	logf_("X ", 0);
+}
+
+uint16_t twi_set_khz(uint16_t khz)
+{
+	return twi_rate_for_khz(7372800UL, khz).khz;
+}
+
+/* --- the test driver ---------------------------------------------------- */
+
+static struct {
+	uint8_t data[4];
+	uint8_t len;
+} fake;
+
+static void fake_init(void)
+{
+	fake.len = 1;
+	fake.data[0] = 0x5A;
+}
+
+static reg_status_t fake_write(uint8_t reg, const uint8_t *data, uint8_t len)
+{
+	if (reg == 1) {
+		return REG_NOT_WRITABLE;
+	}
+	if (reg == 2) {
+		return REG_OK;
+	}
+	if (len == 0 || len > 4) {
+		return REG_BAD_LENGTH;
+	}
+	memcpy(fake.data, data, len);
+	fake.len = len;
+	return REG_OK;
+}
+
+static uint8_t fake_read(uint8_t reg, uint8_t *dst, uint8_t max)
+{
+	static const uint8_t ro[3] = { 0x11, 0x22, 0x33 };
+	const uint8_t *src = reg == 0 ? fake.data : ro;
+	uint8_t n = reg == 0 ? fake.len : 3;
+	if (reg == 2) {
+		return 0;
+	}
+	if (n > max) {
+		n = max;
+	}
+	memcpy(dst, src, n);
+	return n;
+}
+
+const drv_t drv_fake = {
+	.uid = 0x0F0F,
+	.major = 2,
+	.minor = 3,
+	.nregs = DRV_fake_NREGS,
+	.init = fake_init,
+	.write = fake_write,
+	.read = fake_read,
+};

@@ -1,0 +1,411 @@
+/*
+ * Unit tests of the serial gateway (parser + executor) and the register map,
+ * compiled for the host with fakes of the bus and a test driver.
+ * Prints "N passed, N failed".
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fakes.h"
+#include "firmware/twi_rate.h"
+#include "serialgate/sg_exec.h"
+#include "serialgate/sg_parse.h"
+
+static int passed, failed;
+static sg_parser_t parser;
+
+static void check(int ok, const char *what, const char *detail)
+{
+	if (ok) {
+		passed++;
+	} else {
+		failed++;
+		printf("FAIL %s %s\n", what, detail ? detail : "");
+	}
+}
+
+/* A fresh board: reset state, then feed `in`. */
+static void boot(void)
+{
+	fakes_reset();
+	regmap_init();
+	sg_parse_init(&parser);
+	sg_exec_init();
+}
+
+static void feed(const char *in, size_t n)
+{
+	for (size_t i = 0; i < n; i++) {
+		if (sg_parse_char(&parser, (uint8_t)in[i]) == SG_REQUEST) {
+			sg_exec(&parser);
+		}
+	}
+}
+
+static void escape(char *dst, size_t cap, const char *s)
+{
+	size_t k = 0;
+	for (; *s && k + 5 < cap; s++) {
+		if (*s == '\r') {
+			k += (size_t)snprintf(dst + k, cap - k, "\\r");
+		} else if (*s == '\n') {
+			k += (size_t)snprintf(dst + k, cap - k, "\\n");
+		} else {
+			dst[k++] = *s;
+		}
+	}
+	dst[k] = 0;
+}
+
+/* Feeds `in` (on the state left by earlier calls) and compares the replies
+ * and the bus traffic. bus == NULL: don't care. */
+static void expect(const char *in, const char *reply, const char *bus)
+{
+	out_len = 0;
+	out_buf[0] = 0;
+	bus_log[0] = 0;
+	feed(in, strlen(in));
+	char a[600], b[600], c[900];
+	escape(a, sizeof a, in);
+	escape(b, sizeof b, out_buf);
+	escape(c, sizeof c, reply ? reply : "");
+	char detail[8192];
+	if (reply) {
+		snprintf(detail, sizeof detail, "in=\"%s\" got=\"%s\" want=\"%s\"", a, b, c);
+		check(strcmp(out_buf, reply) == 0, "reply", detail);
+	}
+	if (bus) {
+		snprintf(detail, sizeof detail, "in=\"%s\" bus=\"%s\" want=\"%s\"", a, bus_log, bus);
+		check(strcmp(bus_log, bus) == 0, "bus", detail);
+	}
+}
+
+static void test_simple_commands(void)
+{
+	boot();
+	expect("V\r", "V1.1\r\n", "");
+	expect("v\n", "V1.1\r\n", "");
+	expect("V\r\n", "V1.1\r\n", "");
+	expect("  V  \r", "V1.1\r\n", "");
+	expect("\r\n\r\r\r\r\r\r\r\r", "", "");
+	expect("# a comment S A0 00 P\r", "", "");
+	expect("     \r", "", "");
+	expect("  # not a comment\r", "ERROR 02\r\n", "");
+	expect("Q\r", "ERROR 02\r\n", "");
+	expect("P\r", "ERROR 02\r\n", "");
+	expect("1\r", "ERROR 02\r\n", "");
+	expect("\tV\r", "ERROR 02\r\n", "");
+	expect("V1\r", "ERROR 04\r\n", "");
+	expect("V V\r", "ERROR 04\r\n", "");
+	expect("X\r", "X\r\n", "X ");
+	expect("x\r", "X\r\n", "X ");
+	expect("X X\r", "ERROR 04\r\n", "");
+}
+
+static void test_local_address(void)
+{
+	boot();
+	expect("L\r", "LAA\r\n", "");
+	expect("L21\r", "L20\r\n", "");
+	expect("L\r", "L20\r\n", "");
+	expect("l ab\r", "LAA\r\n", "");
+	expect("L00\r", "ERROR 04\r\n", "");
+	expect("L01\r", "ERROR 04\r\n", "");
+	expect("LA\r", "ERROR 03\r\n", "");
+	expect("L A A\r", "ERROR 03\r\n", "");
+	expect("LZZ\r", "ERROR 03\r\n", "");
+	expect("LAA BB\r", "ERROR 04\r\n", "");
+	expect("LAAB\r", "ERROR 04\r\n", "");
+	expect("L\r", "LAA\r\n", "");
+	/* The local address moves: requests to the old one go to the bus. */
+	expect("L A0\r", "LA0\r\n", "");
+	expect("S A0 00 S A1 01 P\r", "SWASR02P\r\n", "");
+	expect("S AA P\r", "ERROR 06\r\n", "S AA- P ");
+}
+
+static void test_clock(void)
+{
+	boot();
+	expect("C\r", "C0063\r\n", "");
+	expect("C0064\r", "C0063\r\n", "");
+	expect("C0190\r", "C00CC\r\n", "");
+	expect("C\r", "C00CC\r\n", "");
+	expect("CFFFF\r", "C00CC\r\n", "");
+	expect("c 00 0a\r", "C0009\r\n", "");
+	expect("C0001\r", "C0000\r\n", "");
+	expect("C0000\r", "ERROR 04\r\n", "");
+	expect("C64\r", "ERROR 04\r\n", "");
+	expect("C006\r", "ERROR 03\r\n", "");
+	expect("C006400\r", "ERROR 04\r\n", "");
+	expect("C00 64 1\r", "ERROR 04\r\n", "");
+	expect("C0Z\r", "ERROR 03\r\n", "");
+}
+
+static void test_rates(void)
+{
+	/* SCL = F_CPU / (16 + 2 TWBR 4^TWPS), TWBR >= 10, fastest not above. */
+	struct { uint16_t khz; uint8_t twbr, twps; uint16_t got; } t[] = {
+		{ 100, 29, 0, 99 }, { 400, 10, 0, 204 }, { 204, 11, 0, 194 },
+		{ 205, 10, 0, 204 }, { 50, 66, 0, 49 }, { 14, 64, 1, 13 },
+		{ 13, 69, 1, 12 }, { 1, 230, 2, 0 }, { 0xFFFF, 10, 0, 204 },
+	};
+	for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
+		twi_rate_t r = twi_rate_for_khz(7372800UL, t[i].khz);
+		char d[120];
+		snprintf(d, sizeof d, "khz=%u twbr=%u twps=%u got=%u", t[i].khz, r.twbr, r.twps, r.khz);
+		check(r.twbr == t[i].twbr && r.twps == t[i].twps && r.khz == t[i].got, "rate", d);
+		/* never above the rate asked */
+		check(7372800UL / r.period <= t[i].khz * 1000UL || t[i].khz == 0, "rate<=asked", d);
+	}
+}
+
+static void test_i2c(void)
+{
+	boot();
+	expect("S A0 00 11 22 P\r", "SWAAAP\r\n", "S A0+ W00+ W11+ W22+ P ");
+	check(eeprom[0] == 0x11 && eeprom[1] == 0x22, "eeprom written", NULL);
+	expect("S A0 00 S A1 02 P\r", "SWASR1122P\r\n", "S A0+ W00+ S A1+ R11+ R22- P ");
+	expect("sa000sa102p\r", "SWASR1122P\r\n", NULL);
+	expect("S A0 P\r", "SWP\r\n", "S A0+ P ");
+	expect("S A1 01 P\r", "SRFFP\r\n", NULL);  /* address counter went on to 2 */
+	expect("S A2 P\r", "ERROR 06\r\n", "S A2- P ");
+	expect("S A2 00 S A1 01 P\r", "ERROR 06\r\n", "S A2- P ");
+	expect("S 50 01 02 P\r", "ERROR 07\r\n", "S 50+ W01- P ");
+	expect("S 60 01 P\r", "ERROR 06\r\n", "S 60! P ");
+	expect("S A0 10 S A1 04 P\r", "SWASRFFFFFFFFP\r\n", NULL);
+	/* execution error: only the error, and STOP after the earlier frames */
+	expect("S A0 05 77 S A2 P\r", "ERROR 06\r\n", "S A0+ W05+ W77+ S A2- P ");
+	check(eeprom[5] == 0x77, "earlier frame took effect", NULL);
+}
+
+static void test_i2c_parse_errors(void)
+{
+	boot();
+	expect("S 10 20\r", "ERROR 05\r\n", "");
+	expect("S\r", "ERROR 05\r\n", "");
+	expect("S A1 01\r", "ERROR 05\r\n", "");
+	expect("S A0 00 S\r", "ERROR 05\r\n", "");
+	expect("S P\r", "ERROR 03\r\n", "");
+	expect("S S\r", "ERROR 03\r\n", "");
+	expect("S 1 P\r", "ERROR 03\r\n", "");
+	expect("S 1 0 P\r", "ERROR 03\r\n", "");
+	expect("S 1G P\r", "ERROR 03\r\n", "");
+	expect("S 10 2\r", "ERROR 03\r\n", "");
+	expect("S A0 00 Q P\r", "ERROR 03\r\n", "");
+	expect("S A1 01 Q\r", "ERROR 03\r\n", "");
+	expect("S A1 P\r", "ERROR 04\r\n", "");
+	expect("S A1 S A1 01 P\r", "ERROR 04\r\n", "");
+	expect("S A1 00 P\r", "ERROR 04\r\n", "");
+	expect("S A1 01 02 P\r", "ERROR 04\r\n", "");
+	expect("S A0 00 P Q\r", "ERROR 04\r\n", "");
+	expect("S A0 00 P 1\r", "ERROR 04\r\n", "");
+	expect("S A0 00 P P\r", "ERROR 04\r\n", "");
+	expect("S A0 00 P  \r", "SWAP\r\n", NULL);
+	/* the first error decides */
+	expect("S A1 00 G\r", "ERROR 04\r\n", "");
+	expect("S 1G 00\r", "ERROR 03\r\n", "");
+	/* nothing of an erroneous request runs */
+	expect("S A0 00 55 S A1 0G P\r", "ERROR 03\r\n", "");
+	check(eeprom[0] == 0xFF, "erroneous request left the EEPROM alone", NULL);
+	/* and the next line is parsed normally */
+	expect("S A0 00 55 P garbage\rV\r", "ERROR 04\r\nV1.1\r\n", "");
+}
+
+static void test_limits(void)
+{
+	boot();
+	/* 128 characters: "S A0 00" + 40 data bytes " 00" = 7 + 120 = 127, + "P" */
+	char line[300];
+	strcpy(line, "S A0 00");
+	for (int i = 0; i < 40; i++) {
+		strcat(line, " 5A");
+	}
+	strcat(line, "P");
+	check(strlen(line) == 128, "line is 128", NULL);
+	strcat(line, "\r");
+	char want[200] = "SW";
+	for (int i = 0; i < 41; i++) {
+		strcat(want, "A");
+	}
+	strcat(want, "P\r\n");
+	expect(line, want, NULL);
+	/* 129 characters: refused, nothing on the bus */
+	strcpy(line, " S A0 00");
+	for (int i = 0; i < 40; i++) {
+		strcat(line, " 5A");
+	}
+	strcat(line, "P\r");
+	check(strlen(line) == 130, "line is 129", NULL);
+	fakes_reset();
+	expect(line, "ERROR 04\r\n", "");
+	check(eeprom[0] == 0xFF, "129-character request did nothing", NULL);
+	/* a 129-character comment is still a comment */
+	memset(line, 'c', 200);
+	line[0] = '#';
+	line[200] = '\r';
+	line[201] = 0;
+	expect(line, "", "");
+	/* replies: SR + 2*62 + P = 127 accepted, 63 bytes refused */
+	expect("S A1 3E P\r", NULL, NULL);
+	check(out_len == 127 + 2, "127-character reply", out_buf);
+	expect("S A1 3F P\r", "ERROR 04\r\n", "");
+	expect("S A1 FF P\r", "ERROR 04\r\n", "");
+	expect("S AA 00 01 S AB 3C P\r", NULL, NULL);
+	check(out_len == 127 + 2, "10 introspection records fill the reply", out_buf);
+	expect("S AA 00 01 S AB 3D P\r", "ERROR 04\r\n", "");
+	/* a long line of spaces before V is over the limit */
+	memset(line, ' ', 128);
+	strcpy(line + 128, "V\r");
+	expect(line, "ERROR 04\r\n", "");
+	memset(line, ' ', 127);
+	strcpy(line + 127, "V\r");
+	expect(line, "V1.1\r\n", "");
+}
+
+static void test_lost_characters(void)
+{
+	boot();
+	char in[] = "S A0 00 12 \x80 P\rV\r";
+	expect(in, "ERROR 04\r\nV1.1\r\n", "");
+	char in2[] = "#comment\x80V\rV\r";
+	expect(in2, "ERROR 04\r\nV1.1\r\n", "");
+}
+
+static void test_registers(void)
+{
+	boot();
+	/* introspection: intro + the fake driver */
+	expect("S AA 00 00 S AB 01 P\r", "SWAASR02P\r\n", "");
+	expect("S AA 00 01 S AB 06 P\r", "SWAASR000001000002P\r\n", "");
+	expect("S AA 00 02 S AB 06 P\r", "SWAASR0F0F02030203P\r\n", "");
+	expect("S AA 00 01 S AB 0C P\r", "SWAASR0000010000020F0F02030203P\r\n", "");
+	/* status after a clean read */
+	expect("S AA 01 S AB 01 P\r", "SWASR00P\r\n", "");
+	/* count, then driver 1 */
+	expect("S AA 00 00 S AB 07 P\r", "SWAASR02000001000002P\r\n", "");
+	/* reading past the last driver goes on with driver 1, status 06 */
+	expect("S AA 00 02 S AB 0C P\r", "SWAASR0F0F02030203000001000002P\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR06P\r\n", "");
+	/* N above the count: ERROR 07, status 02, next read gives driver 1 */
+	expect("S AA 00 03 P\r", "ERROR 07\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR02P\r\n", "");
+	expect("S AA 00 S AB 06 P\r", "SWASR000001000002P\r\n", "");
+	/* each read frame asks afresh; a short frame drops the rest */
+	expect("S AA 00 01 S AB 02 S AB 06 P\r", "SWAASR0000SR0F0F02030203P\r\n", "");
+	/* unmapped registers */
+	expect("S AA 05 P\r", "ERROR 07\r\n", "");
+	expect("S AA FF 00 P\r", "ERROR 07\r\n", "");
+	/* the fake driver: +0 at 0x02 read/write, +1 at 0x03 read-only,
+	 * +2 at 0x04 write-only */
+	expect("S AA 02 S AB 01 P\r", "SWASR5AP\r\n", "");
+	expect("S AA 02 01 02 03 S AB 03 P\r", "SWAAAASR010203P\r\n", "");
+	/* asked again when its data run out */
+	expect("S AA 02 S AB 05 P\r", "SWASR0102030102P\r\n", "");
+	/* rejected write changes nothing */
+	expect("S AA 02 01 02 03 04 05 P\r", "ERROR 07\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR01P\r\n", "");
+	expect("S AA 02 S AB 03 P\r", "SWASR010203P\r\n", "");
+	expect("S AA 03 S AB 03 P\r", "SWASR112233P\r\n", "");
+	expect("S AA 03 09 P\r", "ERROR 07\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR04P\r\n", "");
+	expect("S AA 04 09 09 P\r", "SWAAAP\r\n", "");
+	expect("S AA 04 S AB 01 P\r", "ERROR 06\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR05P\r\n", "");
+	/* status register: not writable, reading it keeps it */
+	expect("S AA 01 00 P\r", "ERROR 07\r\n", "");
+	expect("S AA 01 S AB 02 P\r", "SWASR0404P\r\n", "");
+	/* selecting a register is not an operation: status stays */
+	expect("S AA 02 P\r", "SWAP\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR04P\r\n", "");
+	/* local and bus frames mixed: STOP only for the bus part */
+	expect("S AA 00 00 S A0 00 S AB 01 P\r", "SWAASWASR02P\r\n", "S A0+ W00+ P ");
+	/* local probe */
+	expect("S AA P\r", "SWP\r\n", "");
+	expect("S AB 01 P\r", "SR00P\r\n", "");  /* the count read moved on to driver 1 */
+}
+
+/* Random input must never crash, hang or break the one-reply-per-line rule. */
+static void test_fuzz(void)
+{
+	static const char alphabet[] = "VXLCSPvxlcsp0123456789ABCDEFabcdefGz #\r\n\t\x80\xff";
+	uint32_t seed = 12345;
+	int bad = 0;
+	for (int round = 0; round < 3000 && bad < 5; round++) {
+		boot();
+		char in[400];
+		size_t n = 0, len = 1 + (round % 350);
+		for (; n < len; n++) {
+			seed ^= seed << 13;
+			seed ^= seed >> 17;
+			seed ^= seed << 5;
+			in[n] = alphabet[seed % (sizeof alphabet - 1)];
+		}
+		/* expected replies: lines with a non-space character, not starting
+		 * with '#', or with lost characters */
+		int lines = 0, content = 0, comment = 0, first = 1, lost = 0;
+		for (size_t i = 0; i < n; i++) {
+			char c = in[i];
+			if (c == '\r' || c == '\n') {
+				if (lost || (content && !comment)) {
+					lines++;
+				}
+				content = comment = lost = 0;
+				first = 1;
+				continue;
+			}
+			if ((unsigned char)c == 0x80) {
+				lost = 1;
+			} else if (first && c == '#') {
+				comment = 1;
+			} else if (c != ' ') {
+				content = 1;
+			}
+			first = 0;
+		}
+		out_len = 0;
+		feed(in, n);
+		int replies = 0;
+		for (unsigned i = 0; i + 1 < out_len + 1 && i < out_len; i++) {
+			if (out_buf[i] == '\n') {
+				replies++;
+			}
+		}
+		if (replies != lines) {
+			bad++;
+			char a[1600], b[8192];
+			in[n] = 0;
+			escape(a, sizeof a, in);
+			escape(b, sizeof b, out_buf);
+			printf("fuzz round %d: %d replies for %d lines: in=\"%s\" out=\"%s\"\n", round, replies, lines, a, b);
+		}
+		/* every reply line is at most 127 characters */
+		unsigned start = 0;
+		for (unsigned i = 0; i < out_len; i++) {
+			if (out_buf[i] == '\n') {
+				if (i - start - 1 > 127) {
+					bad++;
+					printf("fuzz round %d: reply of %u characters\n", round, i - start - 1);
+				}
+				start = i + 1;
+			}
+		}
+	}
+	check(bad == 0, "fuzz", NULL);
+}
+
+int main(void)
+{
+	test_simple_commands();
+	test_local_address();
+	test_clock();
+	test_rates();
+	test_i2c();
+	test_i2c_parse_errors();
+	test_limits();
+	test_lost_characters();
+	test_registers();
+	test_fuzz();
+	printf("%d passed, %d failed\n", passed, failed);
+	return failed ? 1 : 0;
+}
