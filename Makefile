@@ -24,16 +24,17 @@ include boards/$(BOARD)/board.mk
 DRIVERS ?= $(BOARD_DRIVERS)
 
 BUILD := build/$(BOARD)-$(MODE)
+FW_OPT ?= -Os
 CC := avr-gcc
 OBJCOPY := avr-objcopy
 AVR_SIZE := avr-size
 
 FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) -DORFA_BAUD=$(BAUD) \
 	-DORFA_ADDR=$(ADDR) -DORFA_MODE_$(MODE) \
-	-std=gnu99 -Os -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
-	-fshort-enums -mcall-prologues -I. -Iboards/$(BOARD) \
+	-std=gnu99 $(FW_OPT) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
+	-fshort-enums -I. -Iboards/$(BOARD) \
 	'-DORFA_DRIVER_LIST=$(foreach d,$(DRIVERS),X($(d)))'
-FW_LDFLAGS := -mmcu=$(BOARD_MCU) -Wl,--gc-sections
+FW_LDFLAGS := -mmcu=$(BOARD_MCU) $(FW_OPT) -flto -Wl,--gc-sections
 
 FW_SRC := firmware/main.c firmware/regmap.c firmware/intro.c firmware/uart.c \
 	firmware/twi_master.c firmware/twi_rate.c firmware/mcu.c \

@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""ORFA benchmark: cycle-exact figures from the simulator's trace.
+
+For each board: latency from the last request byte (end of its stop bit) to
+the first reply byte (start of its start bit) for a few requests, sustained
+throughput of back-to-back introspection reads against the wire limit, flash
+and static RAM. Everything is counted in simulated CPU cycles, so every figure
+is exact and repeatable; wall time enters only the simulator-speed line.
+
+    python3 tools/bench.py [--boards m32d m128s] [--requests 1000]
+"""
+
+import argparse
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "host"))
+
+import serial  # noqa: E402
+
+from orfa.sim import SimBoard, firmware_path, parse_trace  # noqa: E402
+
+F_CPU = 7372800
+CYCLES_PER_BYTE = 640  # 10 bit times at 115200 baud
+
+LATENCY_REQUESTS = [
+    ("V", "V\r", 250),
+    ("introspection count", "S AA 00 00 S AB 01 P\r", 640),
+    ("driver info", "S AA 00 01 S AB 06 P\r", 640),
+]
+PIPELINE_REQUEST = "S AA 00 00 S AB 01 P\r"
+
+# ORFA 0.7.5, measured the same way (issue 2).
+ORIGINAL = {"V": 1084, "introspection count": 2702, "driver info": 3966}
+BUDGET_FLASH = 11152
+BUDGET_RAM = 992
+
+
+def footprint(board):
+    out = subprocess.run(["avr-size", str(firmware_path(board))], check=True,
+                         capture_output=True, text=True).stdout.splitlines()[1].split()
+    text, data, bss = int(out[0]), int(out[1]), int(out[2])
+    return text + data, data + bss
+
+
+def read_trace(sim, settle=0.3):
+    time.sleep(settle)  # let the simulator flush the last trace lines
+    return parse_trace(sim.trace_path.read_text())
+
+
+def latency(sim, port, request):
+    """Cycles from the request's terminator to the first reply byte."""
+    before = len(read_trace(sim, 0))
+    port.write(request.encode())
+    reply = port.readline()
+    events = read_trace(sim)[before:]
+    rx = [e for e in events if e.kind == "uart rx"]
+    end = rx[-1].cycle
+    first_tx = next(e for e in events if e.kind == "uart tx" and e.cycle > end)
+    return first_tx.cycle - end, reply
+
+
+def pipeline(sim, port, count):
+    """Sends `count` requests in one write; returns (correct, cycles, replies)."""
+    expected = port_request_reply(port, PIPELINE_REQUEST)
+    before = len(read_trace(sim, 0))
+    port.write((PIPELINE_REQUEST * count).encode())
+    replies = [port.readline() for _ in range(count)]
+    events = read_trace(sim, 0.5)[before:]
+    rx = [e for e in events if e.kind == "uart rx"]
+    tx = [e for e in events if e.kind == "uart tx"]
+    start = rx[0].cycle - CYCLES_PER_BYTE        # start bit of the first request byte
+    end = tx[-1].cycle + CYCLES_PER_BYTE          # stop bit of the last reply byte
+    correct = sum(1 for r in replies if r == expected)
+    return correct, end - start, len(rx)
+
+
+def port_request_reply(port, request):
+    port.write(request.encode())
+    return port.readline()
+
+
+def bench_board(board, count):
+    rows = {}
+    wall0 = time.monotonic()
+    with SimBoard(board) as sim:
+        with serial.Serial(sim.port, 115200, timeout=10) as port:
+            for name, request, _ in LATENCY_REQUESTS:
+                rows[name] = latency(sim, port, request)
+            correct, cycles, rx_bytes = pipeline(sim, port, count)
+        cycles_total = read_trace(sim, 0)[-1].cycle
+    wall = time.monotonic() - wall0
+    wire = rx_bytes * CYCLES_PER_BYTE
+    rows["pipeline"] = (correct, cycles, wire)
+    rows["speed"] = cycles_total / wall / 1e6
+    rows["footprint"] = footprint(board)
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--boards", nargs="+", default=["m32d", "m128s"])
+    ap.add_argument("--requests", type=int, default=1000)
+    args = ap.parse_args()
+
+    results = {b: bench_board(b, args.requests) for b in args.boards}
+    width = 34
+    print("ORFA benchmark (simulated CPU cycles at 7.3728 MHz; 115200 baud = 640 cycles/byte)")
+    print()
+    print("%-*s" % (width, "figure") + "".join("%14s" % b for b in args.boards)
+          + "%10s%12s" % ("target", "ORFA 0.7.5"))
+    for name, request, target in LATENCY_REQUESTS:
+        label = "latency %s (cycles)" % name
+        print("%-*s" % (width, label)
+              + "".join("%14d" % results[b][name][0] for b in args.boards)
+              + "%10s%12d" % ("<= %d" % target, ORIGINAL[name]))
+    n = args.requests
+    label = "pipelined %d: correct replies" % n
+    print("%-*s" % (width, label) + "".join("%14s" % ("%d/%d" % (results[b]["pipeline"][0], n))
+                                            for b in args.boards) + "%10s%12s" % ("%d/%d" % (n, n), "fails"))
+    print("%-*s" % (width, "pipelined: requests/s") + "".join(
+        "%14.1f" % (n * F_CPU / results[b]["pipeline"][1]) for b in args.boards)
+        + "%10.1f" % (F_CPU / (len(PIPELINE_REQUEST) * CYCLES_PER_BYTE)))
+    print("%-*s" % (width, "pipelined: % of wire") + "".join(
+        "%14.2f" % (100.0 * results[b]["pipeline"][2] / results[b]["pipeline"][1]) for b in args.boards)
+        + "%10s" % ">= 99")
+    print("%-*s" % (width, "flash (B)") + "".join("%14d" % results[b]["footprint"][0] for b in args.boards)
+          + "%10s%12d" % ("<= %d" % BUDGET_FLASH, BUDGET_FLASH))
+    print("%-*s" % (width, "static RAM (B)") + "".join("%14d" % results[b]["footprint"][1] for b in args.boards)
+          + "%10s%12d" % ("<= %d" % BUDGET_RAM, BUDGET_RAM))
+    print("%-*s" % (width, "simulator speed (sim MHz / wall s)") + "".join(
+        "%14.1f" % results[b]["speed"] for b in args.boards))
+    print()
+    print("Targets are the M32-D's (issue 2); flash/RAM budget = ORFA 0.7.5's own M32-D figures.")
+    ok = all(results[b]["pipeline"][0] == n for b in args.boards)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
