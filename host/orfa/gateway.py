@@ -128,7 +128,8 @@ class Gateway:
 
     def drivers(self) -> List[p.DriverRecord]:
         """The gateway's own introspection records, driver 1 first."""
-        (count,) = self.read_register(None, 0x00, 1)
+        (count,) = self.transaction([p.Write(self.local, b"\x00\x00"),
+                                     p.Read(self.local, 1)])[-1].data
         records: List[p.DriverRecord] = []
         per_read = 10
         for first in range(1, count + 1, per_read):

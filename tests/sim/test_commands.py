@@ -80,9 +80,9 @@ def test_clock_examples(board, request_, reply):
     ("C 006", b"ERROR 03\r\n"),
 ])
 def test_clock_refused_keeps_clock(board, request_, reply):
-    assert board.ask("C0190") == b"C0170\r\n"
+    assert board.ask("C0032") == b"C0031\r\n"         # 49.816 kHz
     assert board.ask(request_) == reply
-    assert board.ask("C") == b"C0170\r\n"
+    assert board.ask("C") == b"C0031\r\n"
 
 
 @pytest.mark.parametrize("request_, reply", [

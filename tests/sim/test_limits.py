@@ -70,9 +70,9 @@ def test_reply_of_127_characters_is_accepted(board):
 
 def test_eeprom_read_of_127_characters(board):
     mark = board.mark()
-    reply = board.ask("S A0 %02X S A1 3D P" % EEPROM_AREA)   # SWA SR 122 digits P
-    assert len(reply) == 127 + 2 and reply.startswith(b"SWASR") and reply.endswith(b"P\r\n")
-    assert len([e for e in board.bus(mark) if e[0] == "read"]) == 61
+    reply = board.ask("S A0 %02X S A1 3C P" % EEPROM_AREA)   # SWA SR 120 digits P
+    assert len(reply) == 126 + 2 and reply.startswith(b"SWASR") and reply.endswith(b"P\r\n")
+    assert len([e for e in board.bus(mark) if e[0] == "read"]) == 60
     reply = board.ask("S A1 3E P")                            # SR 124 digits P
     assert len(reply) == 127 + 2 and reply.startswith(b"SR") and reply.endswith(b"P\r\n")
 
@@ -81,7 +81,7 @@ def test_eeprom_read_of_127_characters(board):
     "S AA 00 01 S AB 3D P",
     "S A1 3F P",
     "S A1 FF P",
-    "S A0 %02X S A1 3E P" % EEPROM_AREA,
+    "S A0 %02X S A1 3D P" % EEPROM_AREA,     # 128 characters
     "S A1 1F S A1 1F P",                 # two frames of 64 characters
 ])
 def test_reply_over_127_characters_is_refused(board, request_):
