@@ -5,23 +5,10 @@
 
 #include "parts/eeprom24.h"
 
-static void eeprom24_commit(eeprom24_t *e)
-{
-	for (unsigned i = 0; i < EEPROM24_PAGE; i++) {
-		if (e->page_mask & (1u << i)) {
-			e->mem[e->page_base + i] = e->page[i];
-		}
-	}
-	e->page_mask = 0;
-}
-
 static int eeprom24_start(twi_dev_t *dev, uint8_t addr8)
 {
 	eeprom24_t *e = (eeprom24_t *)dev;
 
-	/* A (repeated) START abandons a page write not ended by a STOP, as
-	 * on the real part. */
-	e->page_mask = 0;
 	e->selected = (addr8 & 0xfe) == e->addr8;
 	e->want_word_addr = e->selected && !(addr8 & 1);
 	return e->selected;
@@ -30,7 +17,6 @@ static int eeprom24_start(twi_dev_t *dev, uint8_t addr8)
 static int eeprom24_write(twi_dev_t *dev, uint8_t byte)
 {
 	eeprom24_t *e = (eeprom24_t *)dev;
-	unsigned off;
 
 	if (!e->selected) {
 		return 0;
@@ -40,13 +26,10 @@ static int eeprom24_write(twi_dev_t *dev, uint8_t byte)
 		e->ptr = byte;
 		return 1;
 	}
-	if (!e->page_mask) {
-		e->page_base = e->ptr & (uint8_t)~(EEPROM24_PAGE - 1);
-	}
-	off = e->ptr & (EEPROM24_PAGE - 1);
-	e->page[off] = byte;
-	e->page_mask |= (uint8_t)(1u << off);
-	e->ptr = (uint8_t)(e->page_base | ((off + 1) & (EEPROM24_PAGE - 1)));
+	e->mem[e->ptr] = byte;
+	/* The counter's low bits roll over inside the page while writing. */
+	e->ptr = (uint8_t)((e->ptr & ~(EEPROM24_PAGE - 1)) |
+			   ((e->ptr + 1) & (EEPROM24_PAGE - 1)));
 	return 1;
 }
 
@@ -64,9 +47,6 @@ static void eeprom24_stop(twi_dev_t *dev)
 {
 	eeprom24_t *e = (eeprom24_t *)dev;
 
-	if (e->selected) {
-		eeprom24_commit(e);
-	}
 	e->selected = 0;
 	e->want_word_addr = 0;
 }

@@ -21,9 +21,6 @@ typedef struct eeprom24_t {
 	uint8_t ptr;			/* word address counter */
 	uint8_t selected;		/* addressed since the last START */
 	uint8_t want_word_addr;		/* next written byte is the word address */
-	uint8_t page[EEPROM24_PAGE];	/* written bytes waiting for the STOP */
-	uint8_t page_mask;		/* which of page[] are valid */
-	uint8_t page_base;
 } eeprom24_t;
 
 /* Erased (FF) EEPROM answering at ADDR8 (0xA0). */
