@@ -89,6 +89,7 @@ static void usart_rx_flush(usart_t *u)
 {
 	u->rx_fifo_len = 0;
 	u->rx_shift_full = 0;
+	u->rx_dor = 0;
 }
 
 static void usart_rx_deliver(usart_t *u, uint8_t byte)
@@ -101,10 +102,11 @@ static void usart_rx_deliver(usart_t *u, uint8_t byte)
 		u->rx_shift_full = 1;
 		u->rx_shift_byte = byte;
 	} else {
-		/* Overrun: the frame waiting in the shifter is overwritten. The
-		 * newest frame in the FIFO carries DOR until UDR is read. */
+		/* Overrun: the frame waiting in the shifter is overwritten.
+		 * The next frame to enter the FIFO carries DOR ("frames lost
+		 * between the last frame read and the next one"). */
 		u->rx_shift_byte = byte;
-		u->rx_fifo[1].dor = 1;
+		u->rx_dor = 1;
 	}
 }
 
@@ -217,9 +219,10 @@ static uint8_t usart_read_udr(avr_t *avr, avr_io_addr_t addr, void *param)
 		u->rx_fifo_len--;
 		if (u->rx_shift_full) {
 			u->rx_fifo[u->rx_fifo_len].data = u->rx_shift_byte;
-			u->rx_fifo[u->rx_fifo_len].dor = 0;
+			u->rx_fifo[u->rx_fifo_len].dor = (uint8_t)u->rx_dor;
 			u->rx_fifo_len++;
 			u->rx_shift_full = 0;
+			u->rx_dor = 0;
 		}
 		usart_sync(u);
 	}
@@ -381,8 +384,7 @@ static void usart_reset(avr_io_t *io)
 	u->ucsra = BIT(UCSRA_UDRE);
 	u->ucsrc = BIT(UCSRC_UCSZ1) | BIT(UCSRC_UCSZ0);
 	u->ubrr = 0;
-	u->rx_fifo_len = 0;
-	u->rx_shift_full = 0;
+	usart_rx_flush(u);
 	u->rx_wire_busy = 0;
 	u->tx_buf_full = 0;
 	u->tx_shift_busy = 0;

@@ -62,7 +62,7 @@ typedef struct usart_t {
 	uint8_t rx_fifo_len;
 	int rx_shift_full;		/* complete frame waiting in the shifter */
 	uint8_t rx_shift_byte;
-	int rx_dor;			/* an overrun lost a frame since UDR was read */
+	int rx_dor;			/* a frame was lost: DOR for the shifter's frame */
 	uint8_t rx_last;
 
 	/* transmitter */
