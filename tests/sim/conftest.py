@@ -109,11 +109,19 @@ class Bench:
         assert self.gw.write(EEPROM, bytes([addr]) + data) == 1 + len(data)
 
     def restore(self):
-        """Put back what tests change; fails if the board does not answer."""
-        self.gw.send(b"\n")                     # ends a line a test left open
-        self.gw.read_available(0.2)
-        assert self.ask("L AA") == b"LAA\r\n"
-        assert self.ask("C 00 64") == b"C0063\r\n"
+        """Put back what tests change; fails if the board does not answer.
+
+        The leading LF ends any line a test left open (its reply, if any, is
+        skipped); the three requests after it must then answer in order.
+        """
+        want = [b"LAA\r\n", b"C0063\r\n", b"V1.1\r\n"]
+        self.gw.send(b"\nL AA\nC 00 64\nV\n")
+        lines = []
+        for _ in range(5):
+            lines.append(self.read_lines(1))
+            if lines[-3:] == want:
+                break
+        assert lines[-3:] == want, "the board did not come back: %r" % lines
         assert self.sim.running, self.sim.stderr
 
 
