@@ -144,5 +144,8 @@ def board(bench):
     """The module's board, idle and in its default state."""
     assert bench.sim.running, "the simulator died: %s" % bench.sim.stderr
     bench.gw.serial.reset_input_buffer()
+    mark = bench.mark()
     yield bench
     bench.restore()
+    resets = bench.events(mark, ["reset"])
+    assert resets == [], "the MCU reset during the test: %r" % resets
