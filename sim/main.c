@@ -48,7 +48,6 @@ typedef struct sim_t {
 	twi_bus_t bus;
 	twi_t twi;
 	eeprom24_t eeprom[SIM_MAX_EEPROMS];
-	int eeprom_count;
 	int idle_throttle;
 } sim_t;
 
@@ -146,9 +145,16 @@ static uint32_t sim_activity(const sim_t *sim)
 	return sim->usart.activity + sim->bus.activity;
 }
 
-int main(int argc, char **argv)
+typedef struct sim_args_t {
+	const char *link, *trace, *firmware;
+	uint8_t eeprom_addr[SIM_MAX_EEPROMS];
+	int eeprom_count;
+} sim_args_t;
+
+/* Parse the command line into ARGS and SIM's board/throttle. 0, or the
+ * exit status to leave with. */
+static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 {
-	static sim_t sim;
 	static const struct option opts[] = {
 		{ "board", required_argument, NULL, 'b' },
 		{ "link", required_argument, NULL, 'l' },
@@ -158,99 +164,190 @@ int main(int argc, char **argv)
 		{ "help", no_argument, NULL, 'h' },
 		{ NULL, 0, NULL, 0 },
 	};
-	const char *link = NULL, *trace_path = NULL;
-	uint8_t eeprom_addr[SIM_MAX_EEPROMS];
-	elf_firmware_t fw;
 	int c;
 
-	sim.idle_throttle = 1;
+	sim->idle_throttle = 1;
 	while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
 		switch (c) {
 		case 'b':
-			sim.board = board_find(optarg);
-			if (!sim.board) {
+			sim->board = board_find(optarg);
+			if (!sim->board) {
 				fprintf(stderr, "orfa-sim: unknown board '%s' (%s)\n",
 					optarg, board_names());
 				return 2;
 			}
 			break;
 		case 'l':
-			link = optarg;
+			args->link = optarg;
 			break;
 		case 'e':
-			if (sim.eeprom_count == SIM_MAX_EEPROMS ||
-			    sim_parse_addr(optarg, &eeprom_addr[sim.eeprom_count]) < 0) {
+			if (args->eeprom_count == SIM_MAX_EEPROMS ||
+			    sim_parse_addr(optarg, &args->eeprom_addr[args->eeprom_count]) < 0) {
 				fprintf(stderr, "orfa-sim: bad or too many --eeprom '%s'"
 					" (an even 8-bit address like 0xA0)\n", optarg);
 				return 2;
 			}
-			for (int i = 0; i < sim.eeprom_count; i++) {
-				if (eeprom_addr[i] == eeprom_addr[sim.eeprom_count]) {
+			for (int i = 0; i < args->eeprom_count; i++) {
+				if (args->eeprom_addr[i] == args->eeprom_addr[args->eeprom_count]) {
 					fprintf(stderr, "orfa-sim: two EEPROMs at %s\n", optarg);
 					return 2;
 				}
 			}
-			sim.eeprom_count++;
+			args->eeprom_count++;
 			break;
 		case 't':
-			trace_path = optarg;
+			args->trace = optarg;
 			break;
 		case 'n':
-			sim.idle_throttle = 0;
+			sim->idle_throttle = 0;
 			break;
 		case 'h':
 			sim_usage();
-			return 0;
+			exit(0);
 		default:
 			sim_usage();
 			return 2;
 		}
 	}
-	if (!sim.board || !link || optind != argc - 1) {
+	if (!sim->board || !args->link || optind != argc - 1) {
 		sim_usage();
 		return 2;
 	}
+	args->firmware = argv[optind];
+	return 0;
+}
+
+/* Load the firmware into a fresh MCU and wire up the board's parts. 0, or
+ * the exit status. */
+static int sim_build(sim_t *sim, const sim_args_t *args)
+{
+	elf_firmware_t fw;
 
 	avr_global_logger_set(sim_logger);
 	memset(&fw, 0, sizeof(fw));
-	if (elf_read_firmware(argv[optind], &fw) != 0 || !fw.flash || !fw.flashsize) {
-		fprintf(stderr, "orfa-sim: cannot load firmware '%s'\n", argv[optind]);
+	if (elf_read_firmware(args->firmware, &fw) != 0 || !fw.flash || !fw.flashsize) {
+		fprintf(stderr, "orfa-sim: cannot load firmware '%s'\n", args->firmware);
 		return 2;
 	}
-	sim.mcu = mcu_find(sim.board->mcu);
-	sim.avr = avr_make_mcu_by_name(sim.board->mcu);
-	if (!sim.mcu || !sim.avr) {
-		fprintf(stderr, "orfa-sim: simavr lacks MCU '%s'\n", sim.board->mcu);
+	sim->mcu = mcu_find(sim->board->mcu);
+	sim->avr = avr_make_mcu_by_name(sim->board->mcu);
+	if (!sim->mcu || !sim->avr) {
+		fprintf(stderr, "orfa-sim: simavr lacks MCU '%s'\n", sim->board->mcu);
 		return 2;
 	}
-	avr_init(sim.avr);
-	if (fw.flashsize > sim.avr->flashend + 1u) {
+	avr_init(sim->avr);
+	if (fw.flashsize > sim->avr->flashend + 1u) {
 		fprintf(stderr, "orfa-sim: '%s' does not fit the %s's flash\n",
-			argv[optind], sim.board->mcu);
+			args->firmware, sim->board->mcu);
 		return 2;
 	}
-	avr_load_firmware(sim.avr, &fw);
-	sim.avr->frequency = SIM_FREQUENCY;	/* our ELFs carry no .mmcu */
-	sim.avr->sleep = sim_sleep;
+	avr_load_firmware(sim->avr, &fw);
+	sim->avr->frequency = SIM_FREQUENCY;	/* our ELFs carry no .mmcu */
+	sim->avr->sleep = sim_sleep;
 
-	if (trace_path && trace_open(&sim.trace, trace_path) < 0) {
+	if (args->trace && trace_open(&sim->trace, args->trace) < 0) {
 		fprintf(stderr, "orfa-sim: cannot write trace '%s': %s\n",
-			trace_path, strerror(errno));
+			args->trace, strerror(errno));
 		return 2;
 	}
-	twi_bus_init(&sim.bus, &sim.trace);
-	for (int i = 0; i < sim.eeprom_count; i++) {
-		eeprom24_init(&sim.eeprom[i], eeprom_addr[i]);
-		twi_bus_attach(&sim.bus, &sim.eeprom[i].dev);
+	twi_bus_init(&sim->bus, &sim->trace);
+	for (int i = 0; i < args->eeprom_count; i++) {
+		eeprom24_init(&sim->eeprom[i], args->eeprom_addr[i]);
+		twi_bus_attach(&sim->bus, &sim->eeprom[i].dev);
 	}
-	usart_init(&sim.usart, sim.avr, &sim.mcu->usart[sim.board->host_usart],
-		   &sim.trace, sim_to_host, &sim.pty);
-	twi_init(&sim.twi, sim.avr, &sim.mcu->twi, &sim.bus);
-	sim.reset_watch.kind = "orfa-reset";
-	sim.reset_watch.reset = sim_reset_hook;
-	mcu_register_io_last(sim.avr, &sim.reset_watch);
+	usart_init(&sim->usart, sim->avr, &sim->mcu->usart[sim->board->host_usart],
+		   &sim->trace, sim_to_host, &sim->pty);
+	twi_init(&sim->twi, sim->avr, &sim->mcu->twi, &sim->bus);
+	sim->reset_watch.kind = "orfa-reset";
+	sim->reset_watch.reset = sim_reset_hook;
+	mcu_register_io_last(sim->avr, &sim->reset_watch);
+	return 0;
+}
 
+/* Idle throttle: after SIM_IDLE_AFTER_S of wall time with nothing on the
+ * serial line or the bus, simulated time is held to wall time. */
+typedef struct sim_throttle_t {
+	uint32_t last_activity;
+	double t_last_activity;
+	int on;
+	double wall0;
+	avr_cycle_count_t cycle0;
+} sim_throttle_t;
+
+static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double now)
+{
+	uint32_t act = sim_activity(sim);
+
+	if (host_bytes || act != th->last_activity) {
+		th->last_activity = act;
+		th->t_last_activity = now;
+		th->on = 0;
+	} else if (sim->idle_throttle && !th->on &&
+		   now - th->t_last_activity > SIM_IDLE_AFTER_S) {
+		th->on = 1;
+		th->wall0 = now;
+		th->cycle0 = sim->avr->cycle;
+	}
+	if (th->on) {
+		double ahead = (double)(sim->avr->cycle - th->cycle0) / SIM_FREQUENCY -
+			       (now - th->wall0);
+		if (ahead > 0.0005) {
+			/* Wait for wall time, or for the PC to send. */
+			struct pollfd pfd = { .fd = sim->pty.master, .events = POLLIN };
+			poll(&pfd, 1, (int)(ahead * 1000));
+		}
+	}
+}
+
+/* Run until a signal (0) or a dead firmware (1); report the speed. */
+static int sim_run(sim_t *sim)
+{
+	sim_throttle_t th = { .last_activity = sim_activity(sim) };
+	double t_start = sim_now(), t_free = 0;
+	avr_cycle_count_t cyc_free = 0;	/* only time running free counts */
+	int rc = 0;
+
+	th.t_last_activity = t_start;
+	while (!sim_stop && rc == 0) {
+		uint8_t buf[512];
+		size_t room = usart_host_room(&sim->usart);
+		size_t n = pty_read(&sim->pty, buf, room < sizeof(buf) ? room : sizeof(buf));
+
+		if (n) {
+			usart_host_send(&sim->usart, buf, n);
+		}
+		double t0 = sim_now();
+		avr_cycle_count_t c0 = sim->avr->cycle;
+		rc = sim_batch(sim);
+		double now = sim_now();
+		if (!th.on) {
+			t_free += now - t0;
+			cyc_free += sim->avr->cycle - c0;
+		}
+		sim_throttle(sim, &th, n != 0, now);
+	}
+	fprintf(stderr, "orfa-sim: %" PRIu64 " cycles in %.2f s wall;"
+		" running free %.1f simulated MHz per wall second (%.1fx real time)\n",
+		(uint64_t)sim->avr->cycle, sim_now() - t_start,
+		t_free > 0 ? cyc_free / t_free / 1e6 : 0.0,
+		t_free > 0 ? cyc_free / t_free / SIM_FREQUENCY : 0.0);
+	return rc;
+}
+
+int main(int argc, char **argv)
+{
+	static sim_t sim;
+	sim_args_t args = { 0 };
 	struct sigaction sa;
+	int rc;
+
+	rc = sim_parse_args(&sim, &args, argc, argv);
+	if (rc == 0) {
+		rc = sim_build(&sim, &args);
+	}
+	if (rc) {
+		return rc;
+	}
 	memset(&sa, 0, sizeof(sa));
 	sa.sa_handler = sim_on_signal;
 	sigaction(SIGTERM, &sa, NULL);
@@ -265,79 +362,22 @@ int main(int argc, char **argv)
 	 * most SIM_BOOT_MAX_CYCLES) before the PC can reach the port, so a
 	 * first byte sent right after the link appears is not lost to a
 	 * board that is still initialising. */
-	int rc = 0;
 	while (!sim_stop && rc == 0 && sim.avr->cycle < SIM_BOOT_MAX_CYCLES &&
 	       !(sim.avr->data[sim.usart.regs->ucsrb] & SIM_UCSRB_RXEN)) {
 		rc = sim_batch(&sim);
 	}
 	if (rc == 0 && !sim_stop) {
-		if (pty_link(&sim.pty, link) < 0) {
+		if (pty_link(&sim.pty, args.link) < 0) {
 			fprintf(stderr, "orfa-sim: cannot create link '%s': %s\n",
-				link, strerror(errno));
+				args.link, strerror(errno));
 			pty_close(&sim.pty);
 			return 2;
 		}
 		printf("orfa-sim: %s %s @ %u Hz, serial %s -> %s\n", sim.board->name,
-		       sim.board->mcu, SIM_FREQUENCY, sim.pty.slave_name, link);
+		       sim.board->mcu, SIM_FREQUENCY, sim.pty.slave_name, args.link);
 		fflush(stdout);
+		rc = sim_run(&sim);
 	}
-
-	/* Speed bookkeeping: only time spent running free counts. */
-	double t_start = sim_now(), t_free = 0;
-	avr_cycle_count_t cyc_free = 0;
-	/* Idle throttle state. */
-	uint32_t last_activity = sim_activity(&sim);
-	double t_last_activity = t_start;
-	int throttled = 0;
-	double th_wall0 = 0;
-	avr_cycle_count_t th_cycle0 = 0;
-
-	while (!sim_stop && rc == 0) {
-		uint8_t buf[512];
-		size_t room = usart_host_room(&sim.usart);
-		size_t n = pty_read(&sim.pty, buf, room < sizeof(buf) ? room : sizeof(buf));
-
-		if (n) {
-			usart_host_send(&sim.usart, buf, n);
-		}
-
-		double t0 = sim_now();
-		avr_cycle_count_t c0 = sim.avr->cycle;
-		rc = sim_batch(&sim);
-
-		double now = sim_now();
-		uint32_t act = sim_activity(&sim);
-		if (!throttled) {
-			t_free += now - t0;
-			cyc_free += sim.avr->cycle - c0;
-		}
-		if (n || act != last_activity) {
-			last_activity = act;
-			t_last_activity = now;
-			throttled = 0;
-		} else if (sim.idle_throttle && !throttled &&
-			   now - t_last_activity > SIM_IDLE_AFTER_S) {
-			throttled = 1;
-			th_wall0 = now;
-			th_cycle0 = sim.avr->cycle;
-		}
-		if (throttled) {
-			double ahead = (double)(sim.avr->cycle - th_cycle0) / SIM_FREQUENCY -
-				       (now - th_wall0);
-			if (ahead > 0.0005) {
-				/* Wait for wall time, or for the PC to send. */
-				struct pollfd pfd = { .fd = sim.pty.master, .events = POLLIN };
-				poll(&pfd, 1, (int)(ahead * 1000));
-			}
-		}
-	}
-
-	double t_total = sim_now() - t_start;
-	fprintf(stderr, "orfa-sim: %" PRIu64 " cycles in %.2f s wall;"
-		" running free %.1f simulated MHz per wall second (%.1fx real time)\n",
-		(uint64_t)sim.avr->cycle, t_total,
-		t_free > 0 ? cyc_free / t_free / 1e6 : 0.0,
-		t_free > 0 ? cyc_free / t_free / SIM_FREQUENCY : 0.0);
 	pty_close(&sim.pty);
 	trace_close(&sim.trace);
 	return rc;
