@@ -9,12 +9,17 @@ from pathlib import Path
 
 import pytest
 
-from orfa.sim import SimBoard
-
-from conftest import require_builds
+from orfa.sim import BUILD_HINT, SimBoard, SimError, missing_builds
 
 HOST = str(Path(__file__).resolve().parents[2] / "host")
 ENV = dict(os.environ, PYTHONPATH=HOST)
+
+
+def require_builds(boards):
+    missing = missing_builds(boards)
+    if missing:
+        pytest.fail("missing %s: %s" % (", ".join(map(str, missing)), BUILD_HINT),
+                    pytrace=False)
 
 
 def orfa(*args, **kw):
@@ -67,3 +72,13 @@ def test_sim_runs_until_interrupted():
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def test_bad_firmware_shows_the_simulators_stderr(tmp_path):
+    require_builds([])
+    elf = tmp_path / "bad.elf"
+    elf.write_bytes(b"not an elf")
+    with pytest.raises(SimError) as exc:
+        SimBoard("m32d", firmware=elf, start_timeout=10).start()
+    assert "exited with 2" in str(exc.value)
+    assert "stderr: (empty)" not in str(exc.value)

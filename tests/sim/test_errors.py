@@ -57,7 +57,7 @@ def test_error_07_local_unmapped_register(board):
     assert board.bus(mark) == []
 
 
-def test_error_07_on_the_bus(board):
+def test_eeprom_acknowledges_every_data_byte(board):
     """A NACKed data byte needs a device that refuses data; the simulated
     24C02 acknowledges every byte, so the bus path of 07 is unreachable here
     (see the report). The local path is tested in test_registers.py."""

@@ -1,0 +1,43 @@
+"""sim.py parts that need no simulator: trace parsing, paths, errors."""
+
+import pytest
+
+from orfa import sim
+
+
+def test_parse_trace_lines():
+    text = ("841139 uart rx 56\n841997 uart tx 0A\n904293 twi start\n"
+            "904980 twi addr A0 ack\n905000 twi read FF nack\n905121 twi stop\n"
+            "999999 reset\n")
+    assert sim.parse_trace(text) == [
+        (841139, "uart rx", ("56",)), (841997, "uart tx", ("0A",)),
+        (904293, "twi start", ()), (904980, "twi addr", ("A0", "ack")),
+        (905000, "twi read", ("FF", "nack")), (905121, "twi stop", ()),
+        (999999, "reset", ()),
+    ]
+    assert sim.parse_trace_line("1 twi stop").cycle == 1
+
+
+@pytest.mark.parametrize("bad", ["", "uart rx 56", "x1 twi stop", "12"])
+def test_bad_trace_lines(bad):
+    with pytest.raises(ValueError):
+        sim.parse_trace_line(bad)
+
+
+def test_paths_are_relative_to_the_repository():
+    assert (sim.REPO_ROOT / "host" / "orfa" / "sim.py").is_file()
+    assert sim.sim_path() == sim.REPO_ROOT / "build" / "sim" / "orfa-sim"
+    assert sim.firmware_path("m128s") == sim.REPO_ROOT / "build" / "m128s-gate" / "orfa.elf"
+
+
+def test_missing_firmware_says_how_to_build(tmp_path):
+    board = sim.SimBoard("m32d", firmware=tmp_path / "none.elf")
+    with pytest.raises(sim.SimError) as exc:
+        board.start()
+    assert "make all-boards sim" in str(exc.value)
+    assert board.proc is None
+
+
+def test_unknown_board():
+    with pytest.raises(ValueError):
+        sim.SimBoard("m8")
