@@ -16,9 +16,8 @@ typedef enum {
 
 void twi_init(void);
 
-/* Sets the fastest SCL rate the TWI can make that is not above `khz`
- * (TWBR >= 10, as the datasheet requires in master mode) and returns that
- * rate in kHz, rounded down. */
+/* Sets the fastest SCL rate the TWI can make that is not above `khz` and
+ * returns that rate in kHz, rounded down. */
 uint16_t twi_set_khz(uint16_t khz);
 
 /* START (or repeated START) and the address byte (8-bit form, bit 0 = read). */

@@ -11,9 +11,6 @@ twi_rate_t twi_rate_for_khz(uint32_t f_cpu, uint16_t khz)
 		if (16UL * f < f_cpu) {
 			need = (f_cpu - 16UL * f + mul_f - 1) / mul_f;  /* rounded up */
 		}
-		if (need < TWI_TWBR_MIN) {
-			need = TWI_TWBR_MIN;
-		}
 		if (need <= 255) {
 			r.twbr = (uint8_t)need;
 			r.twps = ps;

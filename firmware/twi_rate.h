@@ -4,10 +4,6 @@
 
 #include <stdint.h>
 
-/* Datasheet (ATmega32/128, TWI bit rate): TWBR below 10 may give wrong
- * SCL/SDA output in master mode. */
-#define TWI_TWBR_MIN 10
-
 typedef struct {
 	uint8_t twbr;
 	uint8_t twps;      /* prescaler bits: 4^twps */
