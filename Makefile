@@ -103,7 +103,7 @@ bench: setup
 
 demo: setup
 	@$(MAKE) --no-print-directory BOARD=m32d MODE=gate firmware sim
-	PYTHONPATH=host python3 -m orfa sim --board m32d --terminal
+	PYTHONPATH=host python3 -m orfa sim --board m32d --eeprom 0xA0 --terminal
 
 clean:
 	rm -rf build
