@@ -36,9 +36,16 @@ FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) -DORFA_BAUD=$(BAUD) \
 	'-DORFA_DRIVER_LIST=$(foreach d,$(DRIVERS),X($(d)))'
 FW_LDFLAGS := -mmcu=$(BOARD_MCU) $(FW_OPT) -flto -Wl,--gc-sections
 
+# Each driver's hardware part, where it has one.
+DRV_HW_spi := drivers/spi_hw.c
+DRV_HW_adc := drivers/adc_hw.c
+DRV_HW_motor := drivers/motor_hw.c
+DRV_HW_servo := drivers/$(BOARD_SERVO_HW).c
+
 FW_SRC := firmware/main.c firmware/regmap.c firmware/intro.c firmware/uart.c \
-	firmware/twi_master.c firmware/twi_rate.c firmware/mcu.c \
-	$(foreach d,$(DRIVERS),drivers/drv_$(d).c)
+	firmware/twi_master.c firmware/twi_rate.c firmware/mcu.c firmware/pins.c \
+	firmware/board_pins.c firmware/port_io_avr.c \
+	$(foreach d,$(DRIVERS),drivers/drv_$(d).c $(DRV_HW_$(d)))
 ifeq ($(MODE),gate)
 FW_SRC += serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
 endif

@@ -6,6 +6,11 @@
 #ifndef ORFA_DRIVERS_H
 #define ORFA_DRIVERS_H
 
+#include "drivers/drv_adc.h"
+#include "drivers/drv_gpio.h"
+#include "drivers/drv_motor.h"
+#include "drivers/drv_servo.h"
+#include "drivers/drv_spi.h"
 #include "firmware/intro.h"
 
 #ifdef ORFA_UNIT_TEST

@@ -4,11 +4,14 @@
 
 #include "firmware/front.h"
 #include "firmware/mcu.h"
+#include "firmware/pins.h"
 #include "firmware/regmap.h"
 
 int main(void)
 {
 	mcu_watchdog_start();
+	mcu_jtag_off();
+	pins_init();
 	regmap_init();
 	front_init();
 	sei();

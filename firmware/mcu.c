@@ -29,3 +29,11 @@ void mcu_watchdog_start(void)
 	MCU_RESET_FLAGS = 0;
 	wdt_enable(WDTO_250MS);
 }
+
+void mcu_jtag_off(void)
+{
+	/* JTD must be written twice within four cycles. */
+	uint8_t v = MCUCSR | _BV(JTD);
+	MCUCSR = v;
+	MCUCSR = v;
+}

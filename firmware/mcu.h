@@ -28,6 +28,10 @@
 #define MCU_RESET_FLAGS    MCUCSR
 #else
 #error "ORFA supports ATmega32 and ATmega128"
+/* Frees the JTAG pins (M32-D PC2-PC5, M128-S PF4-PF7) for their board
+ * functions even when the JTAGEN fuse is programmed. */
+void mcu_jtag_off(void);
+
 #endif
 
 /* The three registers of one I/O port. */
@@ -43,5 +47,9 @@ const __flash mcu_port_t *mcu_port(char letter);
 /* Watchdog on, reset flags cleared (simavr re-arms a fired watchdog until
  * WDRF is cleared; harmless on silicon). */
 void mcu_watchdog_start(void);
+
+/* Frees the JTAG pins (M32-D PC2-PC5, M128-S PF4-PF7) for their board
+ * functions even when the JTAGEN fuse is programmed. */
+void mcu_jtag_off(void);
 
 #endif

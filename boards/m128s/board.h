@@ -24,6 +24,7 @@
 #define BOARD_ID        "m128s"
 #define BOARD_MCU_NAME  "atmega128"
 #define BOARD_CLOCK_HZ  7372800UL
+#define BOARD_NPORTS    7   /* A..G */
 
 /* The gateway's serial port (USART0) and the TWI pins. */
 #define BOARD_UART      0

@@ -24,6 +24,7 @@
 #define BOARD_ID        "m32d"
 #define BOARD_MCU_NAME  "atmega32"
 #define BOARD_CLOCK_HZ  7372800UL
+#define BOARD_NPORTS    4   /* A..D */
 
 /* The gateway's serial port and the TWI pins. */
 #define BOARD_UART      0

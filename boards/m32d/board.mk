@@ -2,4 +2,6 @@
 BOARD_MCU := atmega32
 BOARD_F_CPU := 7372800UL
 # Drivers after introspection, in register order (SPEC section 1).
-BOARD_DRIVERS :=
+BOARD_DRIVERS := gpio spi adc motor servo
+# Servo pulse hardware: one MCU pin per channel.
+BOARD_SERVO_HW := servo_pins

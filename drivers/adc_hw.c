@@ -1,0 +1,76 @@
+#include "drivers/adc_hw.h"
+
+#include <avr/interrupt.h>
+#include <avr/io.h>
+#include <util/atomic.h>
+
+/* F_CPU / 64 = 115.2 kHz ADC clock (datasheet: 50-200 kHz for 10 bits):
+ * 13 ADC clocks = 832 CPU cycles a conversion, all 8 channels in < 1 ms. */
+#define ADC_PRESCALE (_BV(ADPS2) | _BV(ADPS1))
+
+static struct {
+	volatile uint16_t value[8];
+	uint8_t mask;
+	uint8_t refs;
+	uint8_t ch;        /* channel being converted */
+	uint8_t discard;   /* conversions to drop after a reference change */
+} adc;
+
+static uint8_t adc_next(uint8_t ch)
+{
+	do {
+		ch = (uint8_t)((ch + 1) & 7);
+	} while (!(adc.mask & (1u << ch)));
+	return ch;
+}
+
+static void adc_start(uint8_t ch)
+{
+	adc.ch = ch;
+	ADMUX = (uint8_t)(adc.refs << REFS0 | ch);
+	ADCSRA = _BV(ADEN) | _BV(ADSC) | _BV(ADIE) | ADC_PRESCALE;
+}
+
+ISR(ADC_vect)
+{
+	uint8_t lo = ADCL;
+	uint8_t hi = ADCH;
+	if (adc.discard) {
+		adc.discard--;
+	} else {
+		adc.value[adc.ch] = (uint16_t)(hi << 8 | lo);
+	}
+	adc_start(adc_next(adc.ch));
+}
+
+void adc_hw_config(uint8_t refs, uint8_t mask)
+{
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		ADCSRA = 0;  /* stop; a conversion under way is dropped */
+	}
+	for (uint8_t ch = 0; ch < 8; ch++) {
+		if (!(mask & (1u << ch))) {
+			adc.value[ch] = 0;
+		}
+	}
+	/* The reference needs a moment after a change: one conversion. */
+	adc.discard = (refs != adc.refs) ? 1 : 0;
+	adc.refs = refs;
+	adc.mask = mask;
+	if (mask) {
+		ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+			adc_start(adc_next(7));
+		}
+	} else {
+		ADMUX = 0;
+	}
+}
+
+uint16_t adc_hw_value(uint8_t ch)
+{
+	uint16_t v;
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		v = adc.value[ch];
+	}
+	return v;
+}

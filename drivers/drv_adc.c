@@ -1,0 +1,100 @@
+#include "drivers/drv_adc.h"
+
+#include "board.h"
+#include "drivers/adc_hw.h"
+#include "firmware/pins.h"
+#include "firmware/port_io.h"
+
+#define ADC_REG_RC 0
+#define ADC_REG_RD 1
+#define ADC_PORT ((uint8_t)(BOARD_ADC_PORT - 'A'))
+
+static struct {
+	uint8_t settings;
+	uint8_t mask;
+} adc_cfg;
+
+/* RC: [settings][mask], always both. Enabled channels take their pins
+ * (input, no pull-up); all of the write or none of it. */
+static reg_status_t adc_write(uint8_t reg, const uint8_t *data, uint8_t len)
+{
+	if (reg != ADC_REG_RC) {
+		return REG_NOT_WRITABLE;
+	}
+	if (len != 2) {
+		return REG_BAD_LENGTH;
+	}
+	uint8_t settings = data[0];
+	uint8_t mask = data[1];
+	if (settings & (uint8_t)~(ADC_SET_REF_MASK | ADC_SET_10BIT)) {
+		return REG_BAD_VALUE;
+	}
+	uint8_t taking = mask & (uint8_t)~adc_cfg.mask;
+	for (uint8_t ch = 0; ch < 8; ch++) {
+		if ((taking & (1u << ch)) && !pins_claim((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC)) {
+			while (ch--) {
+				if (taking & (1u << ch)) {
+					pins_release((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC);
+				}
+			}
+			return REG_PIN_BUSY;
+		}
+	}
+	port_io_dir(ADC_PORT, taking, 0);
+	port_io_write(ADC_PORT, taking, 0);
+	uint8_t giving = adc_cfg.mask & (uint8_t)~mask;
+	for (uint8_t ch = 0; ch < 8; ch++) {
+		if (giving & (1u << ch)) {
+			pins_release((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC);
+		}
+	}
+	uint8_t ref = settings & ADC_SET_REF_MASK;
+	adc_hw_config(ref >= 2 ? 3 : ref, mask);
+	adc_cfg.settings = settings;
+	adc_cfg.mask = mask;
+	return REG_OK;
+}
+
+/* RC reads back [settings][mask]; RD gives channels 0..7, one byte each
+ * (8-bit) or two, big-endian (10-bit); channels off read 0. */
+static uint8_t adc_read(uint8_t reg, uint8_t *dst, uint8_t max)
+{
+	uint8_t n = 0;
+	if (reg == ADC_REG_RC) {
+		dst[n++] = adc_cfg.settings;
+		if (n < max) {
+			dst[n++] = adc_cfg.mask;
+		}
+		return n;
+	}
+	for (uint8_t ch = 0; ch < 8 && n < max; ch++) {
+		uint16_t v = adc_hw_value(ch);
+		if (adc_cfg.settings & ADC_SET_10BIT) {
+			dst[n++] = (uint8_t)(v >> 8);
+			if (n == max) {
+				break;
+			}
+			dst[n++] = (uint8_t)v;
+		} else {
+			dst[n++] = (uint8_t)(v >> 2);
+		}
+	}
+	return n;
+}
+
+static void adc_init(void)
+{
+	adc_cfg.settings = 0;
+	adc_cfg.mask = 0;
+	adc_hw_config(0, 0);
+}
+
+const ORFA_FLASH drv_t drv_adc = {
+	.uid = 0x0040,
+	.major = 1,
+	.minor = 1,
+	.nregs = DRV_adc_NREGS,
+	.init = adc_init,
+	.write = adc_write,
+	.read = adc_read,
+};

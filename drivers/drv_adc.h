@@ -1,0 +1,15 @@
+/* ADC driver (UID 0x0040): RC (settings, channel mask), RD (results). */
+#ifndef DRV_ADC_H
+#define DRV_ADC_H
+
+#include "firmware/regmap.h"
+
+#define DRV_adc_NREGS 2
+
+/* Settings byte of RC. */
+#define ADC_SET_REF_MASK 0x03  /* 00 AREF, 01 AVCC, 10/11 internal 2.56 V */
+#define ADC_SET_10BIT    0x04  /* else 8-bit results */
+
+extern const ORFA_FLASH drv_t drv_adc;
+
+#endif

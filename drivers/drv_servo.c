@@ -1,0 +1,124 @@
+#include "drivers/drv_servo.h"
+
+#include "drivers/servo_hw.h"
+
+#define SERVO_REG_RS 0
+#define SERVO_REG_SP 1
+
+static struct {
+	uint16_t width[SERVO_CHANNELS];  /* us; 0 = off */
+	uint8_t first;                   /* first channel a read of SP gives */
+} servo;
+
+static void servo_init(void)
+{
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		servo.width[ch] = 0;
+	}
+	servo.first = 0;
+	servo_hw_init();
+}
+
+static uint16_t servo_clamp(uint16_t us)
+{
+	if (us == 0) {
+		return 0;
+	}
+	if (us < SERVO_MIN_US) {
+		return SERVO_MIN_US;
+	}
+	return us > SERVO_MAX_US ? SERVO_MAX_US : us;
+}
+
+/* SP: [channel] selects the first channel for reads; [channel][hi][lo]...
+ * (up to 16) sets widths. The whole write applies or none of it. */
+static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
+{
+	if (len == 1) {
+		if (data[0] >= SERVO_CHANNELS) {
+			return REG_BAD_VALUE;
+		}
+		servo.first = data[0];
+		return REG_OK;
+	}
+	if (len % 3 != 0 || len > 3 * SERVO_MAX_TRIPLES) {
+		return REG_BAD_LENGTH;
+	}
+	for (uint8_t i = 0; i < len; i += 3) {
+		if (data[i] >= SERVO_CHANNELS) {
+			return REG_BAD_VALUE;
+		}
+	}
+	uint16_t next[SERVO_CHANNELS];
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		next[ch] = servo.width[ch];
+	}
+	for (uint8_t i = 0; i < len; i += 3) {
+		next[data[i]] = servo_clamp((uint16_t)(data[i + 1] << 8 | data[i + 2]));
+	}
+	/* Channels turned on take their pins; any refusal undoes the others. */
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		if (next[ch] && !servo.width[ch] && !servo_hw_claim(ch)) {
+			while (ch--) {
+				if (next[ch] && !servo.width[ch]) {
+					servo_hw_release(ch);
+				}
+			}
+			return REG_PIN_BUSY;
+		}
+	}
+	servo_hw_apply(next);
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		if (!next[ch] && servo.width[ch]) {
+			servo_hw_release(ch);
+		}
+		servo.width[ch] = next[ch];
+	}
+	return REG_OK;
+}
+
+static reg_status_t servo_write(uint8_t reg, const uint8_t *data, uint8_t len)
+{
+	if (reg == SERVO_REG_RS) {
+		return REG_OK;  /* driver 1.0's channel mask: accepted, not needed */
+	}
+	return servo_write_sp(data, len);
+}
+
+/* RS: the mask of pulsing channels, channel 0 in the last byte's bit 0.
+ * SP: the widths from the first channel on, 2 bytes each. */
+static uint8_t servo_read(uint8_t reg, uint8_t *dst, uint8_t max)
+{
+	uint8_t n = 0;
+	if (reg == SERVO_REG_RS) {
+		for (uint8_t i = 0; i < SERVO_CHANNELS / 8 && n < max; i++, n++) {
+			uint8_t bits = 0;
+			uint8_t base = (uint8_t)(SERVO_CHANNELS - 8 * (i + 1));
+			for (uint8_t b = 0; b < 8; b++) {
+				if (servo.width[base + b]) {
+					bits |= (uint8_t)(1u << b);
+				}
+			}
+			dst[n] = bits;
+		}
+		return n;
+	}
+	for (uint8_t ch = servo.first; ch < SERVO_CHANNELS && n < max; ch++) {
+		dst[n++] = (uint8_t)(servo.width[ch] >> 8);
+		if (n == max) {
+			break;
+		}
+		dst[n++] = (uint8_t)servo.width[ch];
+	}
+	return n;
+}
+
+const ORFA_FLASH drv_t drv_servo = {
+	.uid = BOARD_SERVO_UID,
+	.major = 2,
+	.minor = 0,
+	.nregs = DRV_servo_NREGS,
+	.init = servo_init,
+	.write = servo_write,
+	.read = servo_read,
+};

@@ -1,0 +1,20 @@
+/* SPI driver (UID 0x0001): DATA (R) and CONFIG (R+1). */
+#ifndef DRV_SPI_H
+#define DRV_SPI_H
+
+#include "firmware/regmap.h"
+
+#define DRV_spi_NREGS 2
+#define SPI_CHANNELS 4
+#define SPI_BUF 64
+
+/* CONFIG [FF][x][settings]: bits 0-2 clock divider (F_CPU/2 << n, n = 0..6),
+ * bits 3-4 SPI mode (bit 4 CPOL, bit 3 CPHA), bit 5 LSB first. */
+#define SPI_SET_DIV_MASK  0x07
+#define SPI_SET_MODE_SHIFT 3
+#define SPI_SET_LSB_FIRST 0x20
+#define SPI_SET_DEFAULT   0x02  /* F_CPU/8 = 921.6 kHz, mode 0, MSB first */
+
+extern const ORFA_FLASH drv_t drv_spi;
+
+#endif

@@ -1,0 +1,69 @@
+/*
+ * Motor PWM: Timer1 fast PWM (mode 14, TOP = ICR1) at F_CPU / 368 =
+ * 20.035 kHz: above hearing (the original's 3.6 kHz whined) and well inside
+ * what common H-bridges (L298, TB6612, DRV88xx) switch cleanly.
+ */
+#include "drivers/motor_hw.h"
+
+#include <avr/io.h>
+#include <util/atomic.h>
+
+#include "firmware/board_pins.h"
+#include "firmware/pins.h"
+#include "firmware/port_io.h"
+
+#define MOTOR_TOP 367  /* 368 timer cycles per PWM period */
+
+void motor_hw_init(void)
+{
+	static const uint8_t zero[MOTOR_COUNT] = { 0, 0 };
+	ICR1 = MOTOR_TOP;
+	TCCR1A = _BV(WGM11);
+	TCCR1B = _BV(WGM13) | _BV(WGM12) | _BV(CS10);
+	motor_hw_apply(zero, zero, 0x03);
+}
+
+/* High for OCR+1 of 368 cycles: OCR = round(pwm * 368 / 255) - 1; 255 gives
+ * TOP, a steady high. */
+static uint16_t motor_ocr(uint8_t pwm)
+{
+	return (uint16_t)(((uint32_t)pwm * (MOTOR_TOP + 1) + 127) / 255 - 1);
+}
+
+void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
+{
+	uint16_t ocr[MOTOR_COUNT];
+	uint8_t com_on = 0;
+	uint8_t com_off = 0;
+	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
+		uint8_t com = m ? _BV(COM1B1) : _BV(COM1A1);
+		ocr[m] = pwm[m] ? motor_ocr(pwm[m]) : 0;
+		if (lines & (1u << m)) {
+			if (pwm[m]) {
+				com_on |= com;
+			} else {
+				com_off |= com;
+			}
+		}
+	}
+	/* OCR1A/B are double-buffered up to the next PWM period: written
+	 * together, both motors change in the same period. Short: the servo
+	 * interrupt waits while interrupts are off. */
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		OCR1A = ocr[0];
+		OCR1B = ocr[1];
+		TCCR1A = (uint8_t)((TCCR1A & ~com_off) | com_on);
+	}
+	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
+		uint8_t d = board_pin(BF_MOTOR_DIR, m);
+		port_io_write(PIN_PORT(d), PIN_MASK(d), dir[m] ? PIN_MASK(d) : 0);
+		port_io_dir(PIN_PORT(d), PIN_MASK(d), PIN_MASK(d));
+		if (lines & (1u << m)) {
+			/* A disconnected output (PWM 0) holds the line low: at OCR 0
+			 * the compare output would still spike once a period. */
+			uint8_t p = board_pin(BF_MOTOR_PWM, m);
+			port_io_write(PIN_PORT(p), PIN_MASK(p), 0);
+			port_io_dir(PIN_PORT(p), PIN_MASK(p), PIN_MASK(p));
+		}
+	}
+}

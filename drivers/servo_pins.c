@@ -1,0 +1,233 @@
+/*
+ * Servo pulses on ordinary port pins (M32-D: one pin per channel).
+ *
+ * Channel n's pulse starts SERVO_SLOT * n cycles into each 20 ms frame, so
+ * at most a few pulses overlap and their edges rarely meet. Every edge is
+ * written by the Timer2 compare interrupt at an exact CPU cycle: Timer2
+ * (clk/8) wakes the interrupt about SERVO_LEAD cycles early, and the
+ * interrupt then waits on Timer0 (clk/1, free running) for the edge's cycle.
+ * The edges' error is the few cycles of that last loop, whatever else the
+ * firmware is doing (UART interrupts are short and lower priority).
+ *
+ * The schedule (edges sorted by time) is built in the main loop when widths
+ * change, into the buffer the interrupt is not using, and taken over at the
+ * next frame boundary: a frame never mixes old and new widths.
+ */
+#include "drivers/servo_hw.h"
+
+#include <avr/interrupt.h>
+#include <avr/io.h>
+#include <util/atomic.h>
+
+#include "board.h"
+#include "drivers/drv_servo.h"
+#include "firmware/board_pins.h"
+#include "firmware/pins.h"
+#include "firmware/port_io.h"
+
+#define SERVO_FRAME  147456UL  /* 20 ms at 7.3728 MHz */
+#define SERVO_SLOT   8191UL    /* between channel starts: 1.111 ms */
+#define SERVO_LEAD   96        /* wake-up before an edge, cycles */
+#define SERVO_NEAR   (SERVO_LEAD + 32)  /* closer than this: wait in place */
+#define SERVO_EDGES  (2 * SERVO_CHANNELS)
+#define SERVO_FALL   0x80      /* edge code: channel | SERVO_FALL */
+
+_Static_assert(SERVO_SLOT * (SERVO_CHANNELS - 1) + 18432UL + 1000UL < SERVO_FRAME,
+	       "the last channel's longest pulse ends inside the frame");
+
+typedef struct {
+	uint8_t n;                        /* edges in this frame */
+	uint8_t edge[SERVO_EDGES];        /* sorted by time */
+	uint16_t width[SERVO_CHANNELS];   /* cycles */
+} servo_sched_t;
+
+static struct {
+	servo_sched_t sched[2];
+	volatile uint8_t active;     /* sched[] the interrupt runs */
+	volatile uint8_t pending;    /* the other one is newer */
+	volatile uint8_t running;
+	uint8_t next;                /* next edge of the active schedule */
+	uint32_t frame;              /* Timer0 cycle of the frame's start */
+	uint32_t target;             /* Timer0 cycle of the next edge */
+	volatile uint16_t wraps;     /* Timer2 overflows */
+} sv;
+
+/* Each channel's pin (PIN_ID), from the board's pin map. */
+static uint8_t servo_pin[SERVO_CHANNELS];
+
+static const __flash uint8_t port_addr[] = {
+	_SFR_MEM_ADDR(PORTA), _SFR_MEM_ADDR(PORTB), _SFR_MEM_ADDR(PORTC), _SFR_MEM_ADDR(PORTD),
+};
+static const __flash uint8_t line_mask[8] = { 1, 2, 4, 8, 16, 32, 64, 128 };
+
+/* Frame offset of each channel's pulse start. */
+static const __flash uint32_t slot_start[SERVO_CHANNELS] = {
+#define S(n) SERVO_SLOT * (n)
+	S(0), S(1), S(2), S(3), S(4), S(5), S(6), S(7),
+	S(8), S(9), S(10), S(11), S(12), S(13), S(14), S(15),
+#undef S
+};
+_Static_assert(SERVO_CHANNELS == 16, "slot_start lists 16 channels");
+
+static uint32_t edge_time(const servo_sched_t *s, uint8_t e)
+{
+	uint8_t ch = e & (uint8_t)~SERVO_FALL;
+	uint32_t t = slot_start[ch];
+	if (e & SERVO_FALL) {
+		t += s->width[ch];
+	}
+	return t;
+}
+
+/* Timer0 cycles as a 32-bit count, good to a few cycles (for planning). */
+static uint32_t servo_now(void)
+{
+	uint16_t w = sv.wraps;
+	uint8_t t = TCNT2;
+	if ((TIFR & _BV(TOV2)) && t < 128) {
+		w++;
+	}
+	return ((uint32_t)w << 11) | ((uint32_t)t << 3);
+}
+
+/* Arms Timer2 to wake SERVO_LEAD cycles before sv.target; false if that is
+ * too close: the caller then waits for the edge in place. The compare fires
+ * once per Timer2 wrap; the interrupt ignores the wraps before the edge's. */
+static bool servo_arm(void)
+{
+	if ((int32_t)(sv.target - servo_now()) < SERVO_NEAR) {
+		return false;
+	}
+	OCR2 = (uint8_t)((sv.target - SERVO_LEAD) >> 3);
+	return true;
+}
+
+ISR(TIMER2_OVF_vect)
+{
+	sv.wraps++;
+}
+
+ISR(TIMER2_COMP_vect)
+{
+	if (!sv.running || (int32_t)(sv.target - servo_now()) > SERVO_NEAR) {
+		return;  /* an earlier wrap, or a stale flag */
+	}
+	for (;;) {
+		const servo_sched_t *s = &sv.sched[sv.active];
+		uint8_t e = s->edge[sv.next];
+		uint8_t pin = servo_pin[e & (uint8_t)~SERVO_FALL];
+		volatile uint8_t *reg = (volatile uint8_t *)(uint16_t)port_addr[PIN_PORT(pin)];
+		uint8_t mask = line_mask[pin & 7];
+		uint8_t lo = (uint8_t)sv.target;
+
+		while ((int8_t)(TCNT0 - lo) < 0) {
+		}
+		if (e & SERVO_FALL) {
+			*reg &= (uint8_t)~mask;
+		} else {
+			*reg |= mask;
+		}
+
+		if (++sv.next == s->n) {
+			/* Frame done: take a newer schedule over, start the next. */
+			sv.next = 0;
+			sv.frame += SERVO_FRAME;
+			if (sv.pending) {
+				sv.active ^= 1;
+				sv.pending = 0;
+				s = &sv.sched[sv.active];
+				if (s->n == 0) {
+					sv.running = 0;
+					TIMSK &= (uint8_t)~_BV(OCIE2);
+					return;
+				}
+			}
+		}
+		sv.target = sv.frame + edge_time(s, s->edge[sv.next]);
+		if (servo_arm()) {
+			return;
+		}
+	}
+}
+
+void servo_hw_init(void)
+{
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		servo_pin[ch] = board_pin(BF_SERVO, ch);
+	}
+	sv.running = 0;
+	sv.pending = 0;
+	sv.active = 0;
+	sv.sched[0].n = 0;
+	/* Timer0 counts every cycle, Timer2 every 8th; both run free. */
+	TCCR0 = _BV(CS00);
+	TCCR2 = _BV(CS21);
+	TIMSK |= _BV(TOIE2);
+}
+
+bool servo_hw_claim(uint8_t ch)
+{
+	uint8_t pin = board_pin(BF_SERVO, ch);
+	if (!pins_claim(pin, PIN_SERVO)) {
+		return false;
+	}
+	port_io_write(PIN_PORT(pin), PIN_MASK(pin), 0);
+	port_io_dir(PIN_PORT(pin), PIN_MASK(pin), PIN_MASK(pin));
+	return true;
+}
+
+void servo_hw_release(uint8_t ch)
+{
+	pins_release(board_pin(BF_SERVO, ch), PIN_SERVO);
+}
+
+/* Cycles for a width in microseconds, rounded to the nearest. */
+static uint16_t servo_cycles(uint16_t us)
+{
+	return (uint16_t)(((uint32_t)us * (F_CPU / 1000UL) + 500UL) / 1000UL);
+}
+
+void servo_hw_apply(const uint16_t *widths_us)
+{
+	sv.pending = 0;  /* the interrupt must not take the buffer half written */
+	servo_sched_t *s = &sv.sched[sv.active ^ 1];
+	uint8_t n = 0;
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		s->width[ch] = servo_cycles(widths_us[ch]);
+		if (widths_us[ch]) {
+			s->edge[n++] = ch;
+			s->edge[n++] = ch | SERVO_FALL;
+		}
+	}
+	/* Insertion sort by time: at most 32 edges, run only on a change. */
+	uint32_t when[SERVO_EDGES];
+	for (uint8_t i = 0; i < n; i++) {
+		uint8_t e = s->edge[i];
+		uint32_t t = edge_time(s, e);
+		uint8_t j = i;
+		while (j > 0 && when[j - 1] > t) {
+			s->edge[j] = s->edge[j - 1];
+			when[j] = when[j - 1];
+			j--;
+		}
+		s->edge[j] = e;
+		when[j] = t;
+	}
+	s->n = n;
+
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		if (sv.running) {
+			sv.pending = 1;
+		} else if (n) {
+			/* Start: the first frame begins a little from now. */
+			sv.active ^= 1;
+			sv.next = 0;
+			sv.frame = servo_now() + 4096;
+			sv.target = sv.frame + edge_time(s, s->edge[0]);
+			servo_arm();
+			sv.running = 1;
+			/* (No TIFR write: simavr 1.6 clears every flag on one.) */
+			TIMSK |= _BV(OCIE2);
+		}
+	}
+}

@@ -1,0 +1,17 @@
+/* SPI master on the MCU's SPI port (polled). */
+#ifndef SPI_HW_H
+#define SPI_HW_H
+
+#include <stdint.h>
+
+/* SCK, MOSI, SS outputs (SS high: master mode stays on), MISO input. */
+void spi_hw_init(void);
+
+/* divider: 0..6 for F_CPU/2, 4, 8, 16, 32, 64, 128; mode 0-3 (CPOL, CPHA);
+ * lsb_first: bit order. */
+void spi_hw_config(uint8_t divider, uint8_t mode, uint8_t lsb_first);
+
+/* Sends buf[0..n-1], stores the bytes received in their place. */
+void spi_hw_exchange(uint8_t *buf, uint8_t n);
+
+#endif

@@ -1,0 +1,67 @@
+#include "firmware/pins.h"
+
+#include "board.h"
+#include "firmware/board_pins.h"
+#include "firmware/port_io.h"
+
+static uint8_t owner[BOARD_NPORTS * 8];
+
+void pins_init(void)
+{
+	for (uint8_t i = 0; i < sizeof owner; i++) {
+		owner[i] = PIN_FREE;
+	}
+	/* UART and TWI pins never change hands. */
+	owner[board_pin(BF_UART_RX, 0)] = PIN_UART;
+	owner[board_pin(BF_UART_TX, 0)] = PIN_UART;
+	owner[board_pin(BF_TWI_SCL, 0)] = PIN_TWI;
+	owner[board_pin(BF_TWI_SDA, 0)] = PIN_TWI;
+}
+
+bool pins_claim(uint8_t pin, pin_owner_t who)
+{
+	uint8_t now = owner[pin];
+	bool motor_line = now == PIN_MOTOR || now == PIN_MOTOR_IDLE;
+	bool motor_wants = who == PIN_MOTOR || who == PIN_MOTOR_IDLE;
+	if (now == who || now == PIN_FREE || (motor_line && motor_wants)
+	    || (now == PIN_MOTOR_IDLE && who == PIN_SERVO)) {
+		owner[pin] = who;
+		return true;
+	}
+	return false;
+}
+
+void pins_release(uint8_t pin, pin_owner_t who)
+{
+	if (owner[pin] != who) {
+		return;
+	}
+	uint8_t port = PIN_PORT(pin);
+	uint8_t mask = PIN_MASK(pin);
+	if (who == PIN_SERVO && board_pin_has(pin, BF_MOTOR_PWM)) {
+		/* Lent by a stopped motor: back to it, driven low. */
+		owner[pin] = PIN_MOTOR_IDLE;
+		port_io_write(port, mask, 0);
+		port_io_dir(port, mask, mask);
+		return;
+	}
+	owner[pin] = PIN_FREE;
+	port_io_dir(port, mask, 0);
+	port_io_write(port, mask, 0);
+}
+
+pin_owner_t pins_owner(uint8_t pin)
+{
+	return (pin_owner_t)owner[pin];
+}
+
+uint8_t pins_gpio_mask(uint8_t port)
+{
+	uint8_t mask = 0;
+	for (uint8_t line = 0; line < 8; line++) {
+		if (owner[port * 8 + line] == PIN_FREE) {
+			mask |= (uint8_t)(1u << line);
+		}
+	}
+	return mask;
+}
