@@ -1,7 +1,7 @@
 /*
  * board.h: the boards the simulator knows: which MCU, which USART is the
- * serial port to the PC. (A later board model reads the pin map from
- * boards/<board>/board.h.)
+ * serial port to the PC, and the wiring read from boards/<board>/board.h
+ * (board_wiring.h) for the board model (board_model.h).
  */
 #ifndef SIM_BOARD_H
 #define SIM_BOARD_H
@@ -13,6 +13,7 @@ typedef struct board_desc_t {
 	const char *title;	/* "OR-AVR-M32-D" */
 	const char *mcu;	/* simavr MCU name */
 	uint8_t host_usart;	/* index into the MCU's USARTs */
+	const struct board_wiring_t *wiring;
 } board_desc_t;
 
 /* The board called NAME, or NULL. */

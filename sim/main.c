@@ -22,6 +22,8 @@
 #include "sim_elf.h"
 
 #include "board.h"
+#include "board_model.h"
+#include "control.h"
 #include "mcu.h"
 #include "pty.h"
 #include "trace.h"
@@ -48,6 +50,8 @@ typedef struct sim_t {
 	twi_bus_t bus;
 	twi_t twi;
 	eeprom24_t eeprom[SIM_MAX_EEPROMS];
+	board_model_t bm;
+	control_t control;
 	int idle_throttle;
 } sim_t;
 
@@ -63,7 +67,9 @@ static void sim_usage(void)
 {
 	fprintf(stderr,
 		"usage: orfa-sim --board %s --link PATH [--eeprom ADDR]...\n"
-		"                [--trace FILE] [--no-idle-throttle] FIRMWARE.elf\n",
+		"                [--trace FILE] [--no-idle-throttle] [--control PATH]\n"
+		"                [--vcd FILE] [--spi KIND@PIN[:mode=N][:lsb]]...\n"
+		"                [--adc CH=MV]... [--avcc MV] [--aref MV] FIRMWARE.elf\n",
 		board_names());
 }
 
@@ -122,7 +128,13 @@ static int sim_parse_addr(const char *s, uint8_t *out)
 static int sim_batch(sim_t *sim)
 {
 	avr_cycle_count_t target = sim->avr->cycle + SIM_BATCH_CYCLES;
+	uint64_t deadline = control_deadline(&sim->control);
 	int state = cpu_Running;
+
+	/* a control client's `wait` ends near its cycle, not a batch later */
+	if (deadline < target) {
+		target = deadline;
+	}
 
 	while (sim->avr->cycle < target) {
 		state = avr_run(sim->avr);
@@ -131,6 +143,7 @@ static int sim_batch(sim_t *sim)
 		}
 	}
 	pty_flush(&sim->pty);
+	signals_vcd_flush(&sim->bm.signals, sim->avr->cycle, 0);
 	if (state == cpu_Done || state == cpu_Crashed) {
 		fprintf(stderr, "orfa-sim: firmware %s at pc 0x%04x, cycle %" PRIu64 "\n",
 			state == cpu_Crashed ? "crashed" : "stopped (sleep with interrupts off)",
@@ -142,14 +155,35 @@ static int sim_batch(sim_t *sim)
 
 static uint32_t sim_activity(const sim_t *sim)
 {
-	return sim->usart.activity + sim->bus.activity;
+	return sim->usart.activity + sim->bus.activity + sim->bm.spi.activity +
+	       sim->bm.activity + sim->control.activity;
 }
 
+#define SIM_MAX_SPI 8
+
 typedef struct sim_args_t {
-	const char *link, *trace, *firmware;
+	const char *link, *trace, *firmware, *control, *vcd;
 	uint8_t eeprom_addr[SIM_MAX_EEPROMS];
 	int eeprom_count;
+	const char *spi[SIM_MAX_SPI];
+	int spi_count;
+	uint32_t adc_mv[8];
+	uint8_t adc_set;		/* bit per channel given */
+	uint32_t avcc, aref;		/* 0: default */
 } sim_args_t;
+
+/* "1234" millivolts, 0..100000. 0 or -1. */
+static int sim_parse_mv(const char *s, uint32_t *out)
+{
+	char *end;
+	unsigned long v = strtoul(s, &end, 10);
+
+	if (!*s || *end || *s == '-' || v > 100000) {
+		return -1;
+	}
+	*out = (uint32_t)v;
+	return 0;
+}
 
 /* Parse the command line into ARGS and SIM's board/throttle. 0, or the
  * exit status to leave with. */
@@ -161,6 +195,12 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		{ "eeprom", required_argument, NULL, 'e' },
 		{ "trace", required_argument, NULL, 't' },
 		{ "no-idle-throttle", no_argument, NULL, 'n' },
+		{ "control", required_argument, NULL, 'c' },
+		{ "vcd", required_argument, NULL, 'v' },
+		{ "spi", required_argument, NULL, 's' },
+		{ "adc", required_argument, NULL, 'a' },
+		{ "avcc", required_argument, NULL, 'V' },
+		{ "aref", required_argument, NULL, 'R' },
 		{ "help", no_argument, NULL, 'h' },
 		{ NULL, 0, NULL, 0 },
 	};
@@ -200,6 +240,39 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 			break;
 		case 'n':
 			sim->idle_throttle = 0;
+			break;
+		case 'c':
+			args->control = optarg;
+			break;
+		case 'v':
+			args->vcd = optarg;
+			break;
+		case 's':
+			if (args->spi_count == SIM_MAX_SPI) {
+				fprintf(stderr, "orfa-sim: too many --spi\n");
+				return 2;
+			}
+			args->spi[args->spi_count++] = optarg;
+			break;
+		case 'a': {
+			const char *eq = strchr(optarg, '=');
+
+			if (!eq || eq - optarg != 1 || optarg[0] < '0' || optarg[0] > '7' ||
+			    sim_parse_mv(eq + 1, &args->adc_mv[optarg[0] - '0']) < 0) {
+				fprintf(stderr, "orfa-sim: bad --adc '%s' (CH=MV, CH 0..7)\n", optarg);
+				return 2;
+			}
+			args->adc_set |= (uint8_t)(1u << (optarg[0] - '0'));
+			break;
+		}
+		case 'V':
+		case 'R':
+			if (sim_parse_mv(optarg, c == 'V' ? &args->avcc : &args->aref) < 0 ||
+			    !(c == 'V' ? args->avcc : args->aref)) {
+				fprintf(stderr, "orfa-sim: bad --%s '%s' (millivolts)\n",
+					c == 'V' ? "avcc" : "aref", optarg);
+				return 2;
+			}
 			break;
 		case 'h':
 			sim_usage();
@@ -258,6 +331,39 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	usart_init(&sim->usart, sim->avr, &sim->mcu->usart[sim->board->host_usart],
 		   &sim->trace, sim_to_host, &sim->pty);
 	twi_init(&sim->twi, sim->avr, &sim->mcu->twi, &sim->bus);
+	if (board_model_init(&sim->bm, sim->avr, sim->board, sim->mcu, &sim->trace) < 0) {
+		fprintf(stderr, "orfa-sim: cannot build the %s board model\n", sim->board->name);
+		return 2;
+	}
+	for (int i = 0; i < args->spi_count; i++) {
+		const char *err = board_model_add_spi(&sim->bm, args->spi[i]);
+
+		if (err) {
+			fprintf(stderr, "orfa-sim: bad --spi '%s': %s\n", args->spi[i], err);
+			return 2;
+		}
+	}
+	for (int ch = 0; ch < 8; ch++) {
+		if (args->adc_set & (1u << ch)) {
+			board_model_set_adc(&sim->bm, ch, args->adc_mv[ch]);
+		}
+	}
+	if (args->avcc) {
+		board_model_set_avcc(&sim->bm, args->avcc);
+	}
+	if (args->aref) {
+		board_model_set_aref(&sim->bm, args->aref);
+	}
+	if (args->vcd && signals_vcd_open(&sim->bm.signals, args->vcd, SIM_FREQUENCY) < 0) {
+		fprintf(stderr, "orfa-sim: cannot write VCD '%s': %s\n", args->vcd, strerror(errno));
+		return 2;
+	}
+	sim->control.fd = -1;
+	if (args->control && control_open(&sim->control, args->control, sim->avr, &sim->bm) < 0) {
+		fprintf(stderr, "orfa-sim: cannot listen on '%s': %s\n", args->control,
+			strerror(errno));
+		return 2;
+	}
 	sim->reset_watch.kind = "orfa-reset";
 	sim->reset_watch.reset = sim_reset_hook;
 	mcu_register_io_last(sim->avr, &sim->reset_watch);
@@ -278,7 +384,7 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 {
 	uint32_t act = sim_activity(sim);
 
-	if (host_bytes || act != th->last_activity) {
+	if (host_bytes || act != th->last_activity || control_waiting(&sim->control)) {
 		th->last_activity = act;
 		th->t_last_activity = now;
 		th->on = 0;
@@ -292,9 +398,14 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 		double ahead = (double)(sim->avr->cycle - th->cycle0) / SIM_FREQUENCY -
 			       (now - th->wall0);
 		if (ahead > 0.0005) {
-			/* Wait for wall time, or for the PC to send. */
-			struct pollfd pfd = { .fd = sim->pty.master, .events = POLLIN };
-			poll(&pfd, 1, (int)(ahead * 1000));
+			/* Wait for wall time, or for the PC or a control
+			 * client to send. */
+			struct pollfd pfd[2 + CONTROL_CLIENTS] = {
+				{ .fd = sim->pty.master, .events = POLLIN },
+			};
+			int n = 1 + control_pollfds(&sim->control, pfd + 1, CONTROL_CLIENTS + 1);
+
+			poll(pfd, (nfds_t)n, (int)(ahead * 1000));
 		}
 	}
 }
@@ -316,6 +427,7 @@ static int sim_run(sim_t *sim)
 		if (n) {
 			usart_host_send(&sim->usart, buf, n);
 		}
+		control_poll(&sim->control);
 		double t0 = sim_now();
 		avr_cycle_count_t c0 = sim->avr->cycle;
 		rc = sim_batch(sim);
@@ -324,6 +436,7 @@ static int sim_run(sim_t *sim)
 			t_free += now - t0;
 			cyc_free += sim->avr->cycle - c0;
 		}
+		control_poll(&sim->control);
 		sim_throttle(sim, &th, n != 0, now);
 	}
 	fprintf(stderr, "orfa-sim: %" PRIu64 " cycles in %.2f s wall;"
@@ -379,6 +492,8 @@ int main(int argc, char **argv)
 		rc = sim_run(&sim);
 	}
 	pty_close(&sim.pty);
+	control_close(&sim.control);
+	signals_vcd_close(&sim.bm.signals, sim.avr->cycle);
 	trace_close(&sim.trace);
 	return rc;
 }

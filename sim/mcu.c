@@ -20,6 +20,7 @@ static const mcu_desc_t mcu_table[] = {
 			.twbr = 0x20, .twsr = 0x21, .twar = 0x22, .twdr = 0x23,
 			.twcr = 0x56, .vect_twi = 19,
 		},
+		.spi = { .spcr = 0x2d, .spsr = 0x2e, .spdr = 0x2f, .vect_spi = 12 },
 	},
 	{
 		.name = "atmega128",
@@ -40,6 +41,7 @@ static const mcu_desc_t mcu_table[] = {
 			.twbr = 0x70, .twsr = 0x71, .twar = 0x72, .twdr = 0x73,
 			.twcr = 0x74, .vect_twi = 33,
 		},
+		.spi = { .spcr = 0x2d, .spsr = 0x2e, .spdr = 0x2f, .vect_spi = 17 },
 	},
 };
 

@@ -1,6 +1,6 @@
 /*
  * mcu.h: the MCU layer of the simulator. Data-space addresses of the
- * registers the simulator models itself (USART, TWI) and their vector
+ * registers the simulator models itself (USART, TWI, SPI) and their vector
  * numbers, per MCU. Checked against avr-libc's iom32.h / iom128.h
  * (data address = I/O address + 0x20 for _SFR_IO8 registers).
  */
@@ -23,11 +23,17 @@ typedef struct mcu_twi_regs_t {
 	uint8_t vect_twi;
 } mcu_twi_regs_t;
 
+typedef struct mcu_spi_regs_t {
+	uint16_t spcr, spsr, spdr;
+	uint8_t vect_spi;		/* SPI_STC */
+} mcu_spi_regs_t;
+
 typedef struct mcu_desc_t {
 	const char *name;	/* simavr's name: "atmega32" */
 	mcu_usart_regs_t usart[2];
 	uint8_t usart_count;
 	mcu_twi_regs_t twi;
+	mcu_spi_regs_t spi;
 } mcu_desc_t;
 
 /* The description of MCU NAME, or NULL if the simulator does not know it. */

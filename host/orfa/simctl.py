@@ -1,0 +1,132 @@
+"""Client of orfa-sim's control socket (--control PATH; docs/simulator.md).
+
+One request line, one reply line; a reply starting with ``ERR`` raises
+SimControlError. The board keeps running between requests.
+"""
+
+from __future__ import annotations
+
+import socket
+import time
+from typing import Dict, List, Optional, Tuple, Union
+
+
+class SimControlError(RuntimeError):
+    """The simulator refused a request (its ``ERR ...`` text)."""
+
+
+class SimControl:
+    def __init__(self, path: str, timeout: float = 60.0, connect_timeout: float = 10.0):
+        self.path = str(path)
+        self.timeout = timeout
+        deadline = time.monotonic() + connect_timeout
+        while True:
+            try:
+                self.sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+                self.sock.connect(self.path)
+                break
+            except OSError:
+                self.sock.close()
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.02)
+        self.sock.settimeout(timeout)
+        self._buf = b""
+
+    def close(self) -> None:
+        self.sock.close()
+
+    def __enter__(self) -> "SimControl":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def request(self, line: str) -> str:
+        """Send one request, return its reply line (without newline)."""
+        self.sock.sendall(line.encode() + b"\n")
+        while b"\n" not in self._buf:
+            chunk = self.sock.recv(65536)
+            if not chunk:
+                raise SimControlError("orfa-sim closed the control socket")
+            self._buf += chunk
+        reply, self._buf = self._buf.split(b"\n", 1)
+        text = reply.decode()
+        if text.startswith("ERR"):
+            raise SimControlError(text)
+        return text
+
+    # --- commands -------------------------------------------------------------
+    def time(self) -> int:
+        return int(self.request("time"))
+
+    def wait(self, cycles: int) -> int:
+        """Returns the cycle at which the wait ended (>= now + cycles)."""
+        return int(self.request("wait %d" % cycles))
+
+    def pin(self, name: str) -> Tuple[int, str]:
+        """(level, "out" | "in" | "in pullup" | "in ext" | "out oc" | "out spi")."""
+        level, how = self.request("pin %s" % name).split(" ", 1)
+        return int(level), how
+
+    def drive(self, name: str, value: Union[int, str, None]) -> None:
+        """Drive pin NAME to 0 or 1; None or "z" releases it."""
+        v = "z" if value is None or value == "z" else str(int(value))
+        self.request("drive %s %s" % (name, v))
+
+    def adc(self, ch: int, mv: int) -> None:
+        self.request("adc %d %d" % (ch, mv))
+
+    def avcc(self, mv: int) -> None:
+        self.request("avcc %d" % mv)
+
+    def aref(self, mv: int) -> None:
+        self.request("aref %d" % mv)
+
+    def level(self, sig: str) -> int:
+        return int(self.request("level %s" % sig))
+
+    def edges(self, sig: str, since: Optional[int] = None) -> List[Tuple[int, int]]:
+        """[(cycle, level), ...], oldest first."""
+        reply = self.request("edges %s" % sig if since is None else "edges %s %d" % (sig, since))
+        if reply == "-":
+            return []
+        out = []
+        for item in reply.split():
+            cycle, level = item.split(":")
+            out.append((int(cycle), int(level)))
+        return out
+
+    def measure(self, sig: str, n: Optional[int] = None, since: Optional[int] = None) -> Dict:
+        """{"steady": 0|1} or {"high": (min, max, mean), "period": (...), "duty": f, "n": k}."""
+        req = "measure %s" % sig
+        if n is not None or since is not None:
+            req += " %d" % (n if n is not None else 50)
+        if since is not None:
+            req += " %d" % since
+        words = self.request(req).split()
+        if words[0] == "steady":
+            return {"steady": int(words[1])}
+        return {
+            "high": (int(words[1]), int(words[2]), float(words[3])),
+            "period": (int(words[5]), int(words[6]), float(words[7])),
+            "duty": float(words[9]),
+            "n": int(words[11]),
+        }
+
+    def spi(self) -> List[Dict]:
+        """Exchanges since the last call: [{"cs": "C2", "mosi": bytes, "miso": bytes}]."""
+        reply = self.request("spi")
+        if reply == "-":
+            return []
+        out = []
+        for item in reply.split():
+            cs, mosi, miso = item.split(":")
+            out.append({"cs": cs, "mosi": bytes.fromhex(mosi), "miso": bytes.fromhex(miso)})
+        return out
+
+    def spidev(self, pin: str) -> str:
+        return self.request("spidev %s" % pin)
+
+    def signals(self) -> List[str]:
+        return self.request("signals").split()

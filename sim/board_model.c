@@ -1,0 +1,511 @@
+/*
+ * board_model.c: pins, compare outputs, external drive, analog inputs,
+ * servo counters and SPI devices of a board.
+ */
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "sim_regbit.h"
+#include "avr_adc.h"
+
+#include "board_model.h"
+
+_Static_assert(MAX_CYCLE_TIMERS <= 64, "the slot mask is 64 bits");
+
+/*
+ * The cycle an event really happened at. simavr runs cycle timers after
+ * the instruction that crossed their time, so avr->cycle may be a few
+ * cycles late; a compare match's pin change belongs to the timer's own
+ * cycle. While a cycle timer runs, its slot is in neither of the pool's
+ * lists and still holds that cycle: find it by the timer's param.
+ */
+static uint64_t bm_event_cycle(avr_t *avr, void *param)
+{
+	avr_cycle_timer_pool_t *pool = &avr->cycle_timers;
+	uint64_t listed = 0;
+
+	for (avr_cycle_timer_slot_p t = pool->timer; t; t = t->next) {
+		listed |= 1ull << (t - pool->timer_slots);
+	}
+	for (avr_cycle_timer_slot_p t = pool->timer_free; t; t = t->next) {
+		listed |= 1ull << (t - pool->timer_slots);
+	}
+	for (int i = 0; i < MAX_CYCLE_TIMERS; i++) {
+		avr_cycle_timer_slot_p t = &pool->timer_slots[i];
+
+		if (!(listed & (1ull << i)) && t->param == param && t->when <= avr->cycle) {
+			return t->when;
+		}
+	}
+	return avr->cycle;
+}
+
+/* --- pins ---------------------------------------------------------------- */
+
+static int bm_oc_on(const bm_oc_t *oc)
+{
+	return avr_regbit_get(oc->bm->avr, oc->timer->comp[oc->comp].com) != 0;
+}
+
+/* The compare unit driving pin BIT, or NULL. */
+static const bm_oc_t *bm_pin_oc(const bm_port_t *p, int bit)
+{
+	const bm_oc_t *best = NULL;
+
+	for (int i = 0; i < p->noc[bit]; i++) {
+		const bm_oc_t *oc = p->oc[bit][i];
+
+		if (bm_oc_on(oc) && (!best || oc->seq > best->seq)) {
+			best = oc;
+		}
+	}
+	return best;
+}
+
+static int bm_pin_level(const bm_port_t *p, int bit)
+{
+	uint8_t m = (uint8_t)(1u << bit);
+
+	if (p->ddr & m) {
+		if (p->spi_mask & m) {
+			return !!(p->spi_level & m);
+		}
+		const bm_oc_t *oc = bm_pin_oc(p, bit);
+
+		return oc ? oc->latch : !!(p->port & m);
+	}
+	if (p->ext_mask & m) {
+		return !!(p->ext_value & m);
+	}
+	return !!(p->port & m);
+}
+
+/* Recompute every pin of P at CYCLE; an input's PINx bit follows. */
+static void bm_port_update(bm_port_t *p, uint64_t cycle)
+{
+	avr_t *avr = p->bm->avr;
+
+	for (int b = 0; b < 8; b++) {
+		int level = bm_pin_level(p, b);
+		uint8_t m = (uint8_t)(1u << b);
+
+		if (!(p->ddr & m) && !(p->ext_mask & m) &&
+		    !!(avr->data[p->io->r_pin] & m) != level) {
+			avr_raise_irq(p->irq + b, (uint32_t)level);
+		}
+		signal_set(&p->pin[b], cycle, level);
+	}
+}
+
+static void bm_on_port(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+	bm_port_t *p = param;
+
+	(void)irq;
+	p->port = (uint8_t)value;
+	bm_port_update(p, p->bm->avr->cycle);
+}
+
+static void bm_on_ddr(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+	bm_port_t *p = param;
+
+	(void)irq;
+	p->ddr = (uint8_t)value;
+	bm_port_update(p, p->bm->avr->cycle);
+}
+
+static void bm_on_oc(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+	bm_oc_t *oc = param;
+
+	(void)irq;
+	oc->latch = value & 1;
+	oc->seq = ++oc->bm->oc_seq;
+	bm_port_update(oc->port, bm_event_cycle(oc->bm->avr, oc->timer));
+}
+
+static void bm_update_oc_ports(board_model_t *bm)
+{
+	for (int i = 0; i < bm->noc; i++) {
+		bm_port_update(bm->oc[i].port, bm->avr->cycle);
+	}
+}
+
+/* A register holding COM bits was written: the pin may change owner. */
+static void bm_on_com_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *param)
+{
+	bm_com_hook_t *h = param;
+
+	if (h->w) {
+		h->w(avr, addr, v, h->param);
+	} else {
+		avr->data[addr] = v;
+	}
+	bm_update_oc_ports(h->bm);
+}
+
+static void bm_hook_com(board_model_t *bm, uint16_t addr)
+{
+	avr_io_addr_t io = AVR_DATA_TO_IO(addr);
+
+	for (int i = 0; i < bm->ncom; i++) {
+		if (bm->com[i].addr == addr) {
+			return;
+		}
+	}
+	if (bm->ncom == (int)(sizeof(bm->com) / sizeof(bm->com[0]))) {
+		return;
+	}
+	bm_com_hook_t *h = &bm->com[bm->ncom++];
+
+	h->bm = bm;
+	h->addr = addr;
+	h->w = bm->avr->io[io].w.c;
+	h->param = bm->avr->io[io].w.param;
+	bm->avr->io[io].w.c = bm_on_com_write;
+	bm->avr->io[io].w.param = h;
+}
+
+bm_port_t *board_model_port(board_model_t *bm, char letter)
+{
+	letter = (char)toupper((unsigned char)letter);
+	for (int i = 0; i < bm->nports; i++) {
+		if (bm->ports[i].name == letter) {
+			return &bm->ports[i];
+		}
+	}
+	return NULL;
+}
+
+int board_model_parse_pin(board_model_t *bm, const char *s, bm_port_t **port, int *bit)
+{
+	if (!s || strlen(s) != 2 || s[1] < '0' || s[1] > '7') {
+		return -1;
+	}
+	*port = board_model_port(bm, s[0]);
+	*bit = s[1] - '0';
+	return *port ? 0 : -1;
+}
+
+void board_model_drive(board_model_t *bm, bm_port_t *p, int bit, int level)
+{
+	uint8_t m = (uint8_t)(1u << bit);
+	avr_ioport_external_t ext = { .name = (unsigned)p->name };
+
+	if (level < 0) {
+		p->ext_mask &= (uint8_t)~m;
+		p->ext_value &= (uint8_t)~m;
+	} else {
+		p->ext_mask |= m;
+		p->ext_value = (uint8_t)(level ? (p->ext_value | m) : (p->ext_value & ~m));
+	}
+	ext.mask = p->ext_mask;
+	ext.value = p->ext_value;
+	avr_ioctl(bm->avr, AVR_IOCTL_IOPORT_SET_EXTERNAL(p->name), &ext);
+	if (level >= 0) {
+		avr_raise_irq(p->irq + bit, (uint32_t)level);
+	}
+	bm_port_update(p, bm->avr->cycle);
+	bm->activity++;
+}
+
+void board_model_pin_text(board_model_t *bm, bm_port_t *p, int bit, char *buf, int size)
+{
+	uint8_t m = (uint8_t)(1u << bit);
+	const char *how;
+
+	(void)bm;
+	if (p->ddr & m) {
+		how = (p->spi_mask & m) ? "out spi" : bm_pin_oc(p, bit) ? "out oc" : "out";
+	} else if (p->ext_mask & m) {
+		how = "in ext";
+	} else if (p->port & m) {
+		how = "in pullup";
+	} else {
+		how = "in";
+	}
+	snprintf(buf, (size_t)size, "%d %s", p->pin[bit].level, how);
+}
+
+/* --- SPI pins -------------------------------------------------------------- */
+
+static void bm_spi_drive(void *param, int pin, int active, int level, uint64_t cycle)
+{
+	board_model_t *bm = param;
+	bm_port_t *p = bm->spi_port[pin];
+
+	if (!p) {
+		return;
+	}
+	uint8_t m = (uint8_t)(1u << bm->spi_bit[pin]);
+
+	p->spi_mask = (uint8_t)(active ? (p->spi_mask | m) : (p->spi_mask & ~m));
+	p->spi_level = (uint8_t)(level ? (p->spi_level | m) : (p->spi_level & ~m));
+	bm_port_update(p, cycle);
+}
+
+spi_dev_t *board_model_spi_dev(board_model_t *bm, const char *pin)
+{
+	for (int i = 0; i < bm->spi.ndev; i++) {
+		if (strcasecmp(bm->spi.dev[i]->cs->name, pin) == 0) {
+			return bm->spi.dev[i];
+		}
+	}
+	return NULL;
+}
+
+const char *board_model_add_spi(board_model_t *bm, const char *spec)
+{
+	char buf[64], *at, *opt, *save = NULL;
+	int mode = 0, lsb = 0;
+	bm_port_t *p;
+	int bit;
+	spi_dev_t *d;
+
+	if (strlen(spec) >= sizeof(buf)) {
+		return "too long";
+	}
+	strcpy(buf, spec);
+	at = strchr(buf, '@');
+	if (!at) {
+		return "expected KIND@PIN";
+	}
+	*at++ = 0;
+	char *pin = strtok_r(at, ":", &save);
+
+	if (!pin || board_model_parse_pin(bm, pin, &p, &bit) < 0) {
+		return "bad chip-select pin";
+	}
+	if (board_model_spi_dev(bm, p->pin[bit].name)) {
+		return "two devices on one chip-select pin";
+	}
+	while ((opt = strtok_r(NULL, ":", &save))) {
+		if (strncmp(opt, "mode=", 5) == 0 && opt[5] >= '0' && opt[5] <= '3' && !opt[6]) {
+			mode = opt[5] - '0';
+		} else if (strcmp(opt, "lsb") == 0) {
+			lsb = 1;
+		} else if (strcmp(opt, "msb") == 0) {
+			lsb = 0;
+		} else {
+			return "bad option (mode=0..3, lsb, msb)";
+		}
+	}
+	if (strcmp(buf, "eeprom25") == 0 && bm->nee < BM_MAX_SPI_DEV) {
+		eeprom25_init(&bm->ee[bm->nee], mode, lsb);
+		d = &bm->ee[bm->nee++].dev;
+	} else if (strcmp(buf, "mcp3008") == 0 && bm->nmcp < BM_MAX_SPI_DEV) {
+		mcp3008_init(&bm->mcp[bm->nmcp], mode, lsb, bm->adc_mv, &bm->avcc);
+		d = &bm->mcp[bm->nmcp++].dev;
+	} else {
+		return "unknown kind (eeprom25, mcp3008) or too many";
+	}
+	if (spi_attach(&bm->spi, d, &p->pin[bit]) < 0) {
+		return "too many SPI devices";
+	}
+	return NULL;
+}
+
+/* --- analog ---------------------------------------------------------------- */
+
+void board_model_set_adc(board_model_t *bm, int ch, uint32_t mv)
+{
+	bm->adc_mv[ch] = mv;
+	if (bm->adc_irq) {
+		avr_raise_irq(bm->adc_irq + ADC_IRQ_ADC0 + ch, mv);
+	}
+	bm->activity++;
+}
+
+void board_model_set_avcc(board_model_t *bm, uint32_t mv)
+{
+	bm->avcc = mv;
+	bm->avr->avcc = mv;
+	bm->avr->vcc = mv;
+	bm->activity++;
+}
+
+void board_model_set_aref(board_model_t *bm, uint32_t mv)
+{
+	bm->aref = mv;
+	bm->avr->aref = mv;
+	bm->activity++;
+}
+
+/* --- servo counters -------------------------------------------------------- */
+
+static void bm_servo_mirror(void *param, signal_t *s, uint64_t cycle, int level)
+{
+	(void)s;
+	signal_set(param, cycle, level);
+}
+
+static int bm_counters(board_model_t *bm)
+{
+	const board_wiring_t *w = bm->wiring;
+	const board_pin_t *rst = board_wiring_pin(w, BW_SERVO_RST, 0);
+	char name[16];
+
+	for (int c = 0; c < w->servo_counters && c < 4; c++) {
+		const board_pin_t *clk = board_wiring_pin(w, BW_SERVO_CLK, c);
+		bm_port_t *cp = clk ? board_model_port(bm, clk->port) : NULL;
+
+		snprintf(name, sizeof(name), "cnt%d", c);
+		if (!cp || cd4017_init(&bm->cnt[c], &bm->signals, name) < 0) {
+			return -1;
+		}
+		signal_listen(&cp->pin[clk->bit], cd4017_on_clock, &bm->cnt[c]);
+		if (rst) {
+			bm_port_t *rp = board_model_port(bm, rst->port);
+
+			if (rp) {
+				signal_listen(&rp->pin[rst->bit], cd4017_on_reset, &bm->cnt[c]);
+			}
+		}
+		bm->ncnt++;
+	}
+	for (int n = 0; n < bm->ncnt * w->servo_per_counter && n < 32; n++) {
+		int c = n / w->servo_per_counter, k = 1 + n % w->servo_per_counter;
+
+		snprintf(name, sizeof(name), "servo%d", n);
+		if (signal_add(&bm->signals, &bm->servo[n], name, 0) < 0) {
+			return -1;
+		}
+		signal_listen(&bm->cnt[c].q[k], bm_servo_mirror, &bm->servo[n]);
+		bm->nservo++;
+	}
+	return 0;
+}
+
+/* --- setup ----------------------------------------------------------------- */
+
+static void bm_reset(avr_io_t *io)
+{
+	board_model_t *bm = (board_model_t *)io;
+	avr_t *avr = bm->avr;
+
+	/* avr_reset cleared the port registers without telling the IRQs. */
+	for (int i = 0; i < bm->nports; i++) {
+		bm_port_t *p = &bm->ports[i];
+
+		p->ddr = avr->data[p->io->r_ddr];
+		p->port = avr->data[p->io->r_port];
+		bm_port_update(p, avr->cycle);
+	}
+	avr->avcc = bm->avcc;
+	avr->vcc = bm->avcc;
+	avr->aref = bm->aref;
+}
+
+static int bm_find_ports(board_model_t *bm)
+{
+	char name[4];
+
+	for (avr_io_t *io = bm->avr->io_port; io; io = io->next) {
+		if (!io->kind || strcmp(io->kind, "port") != 0 || bm->nports == BM_MAX_PORTS) {
+			continue;
+		}
+		avr_ioport_t *ap = (avr_ioport_t *)io;
+		bm_port_t *p = &bm->ports[bm->nports++];
+
+		p->bm = bm;
+		p->name = ap->name;
+		p->io = ap;
+		p->irq = avr_io_getirq(bm->avr, AVR_IOCTL_IOPORT_GETIRQ(ap->name), 0);
+		if (!p->irq) {
+			return -1;
+		}
+	}
+	/* signals in port order, A0..G7 */
+	for (char c = 'A'; c <= 'Z'; c++) {
+		bm_port_t *p = board_model_port(bm, c);
+
+		for (int b = 0; p && b < 8; b++) {
+			snprintf(name, sizeof(name), "%c%d", c, b);
+			if (signal_add(&bm->signals, &p->pin[b], name, 0) < 0) {
+				return -1;
+			}
+		}
+		if (p) {
+			avr_irq_register_notify(p->irq + IOPORT_IRQ_REG_PORT, bm_on_port, p);
+			avr_irq_register_notify(p->irq + IOPORT_IRQ_DIRECTION_ALL, bm_on_ddr, p);
+		}
+	}
+	return 0;
+}
+
+static void bm_find_ocs(board_model_t *bm)
+{
+	for (avr_io_t *io = bm->avr->io_port; io; io = io->next) {
+		if (!io->kind || strcmp(io->kind, "timer") != 0) {
+			continue;
+		}
+		avr_timer_t *t = (avr_timer_t *)io;
+
+		for (int c = 0; c < AVR_TIMER_COMP_COUNT; c++) {
+			avr_regbit_t pin = t->comp[c].com_pin;
+
+			if (!pin.reg || !t->comp[c].com.reg || bm->noc == BM_MAX_OC) {
+				continue;
+			}
+			for (int i = 0; i < bm->nports; i++) {
+				bm_port_t *p = &bm->ports[i];
+
+				if (p->io->r_port != pin.reg || p->noc[pin.bit] == 2) {
+					continue;
+				}
+				bm_oc_t *oc = &bm->oc[bm->noc++];
+
+				oc->bm = bm;
+				oc->timer = t;
+				oc->comp = c;
+				oc->port = p;
+				oc->bit = pin.bit;
+				p->oc[pin.bit][p->noc[pin.bit]++] = oc;
+				avr_irq_register_notify(t->io.irq + TIMER_IRQ_OUT_COMP + c,
+							bm_on_oc, oc);
+				bm_hook_com(bm, t->comp[c].com.reg);
+			}
+		}
+	}
+}
+
+int board_model_init(board_model_t *bm, avr_t *avr, const board_desc_t *board,
+		     const mcu_desc_t *mcu, trace_t *trace)
+{
+	const board_wiring_t *w = board->wiring;
+
+	memset(bm, 0, sizeof(*bm));
+	bm->avr = avr;
+	bm->board = board;
+	bm->wiring = w;
+	bm->trace = trace;
+	if (bm_find_ports(bm) < 0) {
+		return -1;
+	}
+	bm_find_ocs(bm);
+	if (bm_counters(bm) < 0) {
+		return -1;
+	}
+	bm->adc_irq = avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0);
+	board_model_set_avcc(bm, 5000);
+	board_model_set_aref(bm, 5000);
+
+	for (int k = 0; k < 2; k++) {
+		const board_pin_t *bp = board_wiring_pin(w, k ? BW_SPI_MOSI : BW_SPI_SCK, 0);
+
+		bm->spi_port[k] = bp ? board_model_port(bm, bp->port) : NULL;
+		bm->spi_bit[k] = bp ? bp->bit : 0;
+	}
+	spi_init(&bm->spi, avr, mcu->spi.spcr, mcu->spi.spsr, mcu->spi.spdr,
+		 mcu->spi.vect_spi, trace, bm_spi_drive, bm);
+
+	bm->io.kind = "orfa-board";
+	bm->io.reset = bm_reset;
+	mcu_register_io_last(avr, &bm->io);
+	bm->activity = 0;
+	return 0;
+}

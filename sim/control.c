@@ -1,0 +1,571 @@
+/*
+ * control.c: the control socket and its line protocol.
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <inttypes.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include "control.h"
+
+#define CONTROL_OUT_MAX (4u << 20)
+#define CONTROL_MEASURE_DEFAULT 50
+#define CONTROL_MAX_ARGS 8
+
+/* --- reply buffer ---------------------------------------------------------- */
+
+typedef struct reply_t {
+	char **buf;
+	size_t *len, *cap;
+} reply_t;
+
+static void rp(reply_t *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static void rp(reply_t *r, const char *fmt, ...)
+{
+	va_list ap;
+	int n;
+
+	for (;;) {
+		size_t room = *r->cap - *r->len;
+
+		va_start(ap, fmt);
+		n = vsnprintf(*r->buf + *r->len, room, fmt, ap);
+		va_end(ap);
+		if (n < 0) {
+			return;
+		}
+		if ((size_t)n < room) {
+			*r->len += (size_t)n;
+			return;
+		}
+		size_t cap = (*r->cap ? *r->cap : 256) * 2 + (size_t)n;
+		char *p = realloc(*r->buf, cap);
+
+		if (!p) {
+			return;
+		}
+		*r->buf = p;
+		*r->cap = cap;
+	}
+}
+
+/* --- argument helpers ------------------------------------------------------ */
+
+static int parse_u64(const char *s, uint64_t *out)
+{
+	char *end;
+
+	if (!s || !*s || *s == '-') {
+		return -1;
+	}
+	errno = 0;
+	unsigned long long v = strtoull(s, &end, 10);
+
+	if (errno || *end) {
+		return -1;
+	}
+	*out = v;
+	return 0;
+}
+
+static int parse_mv(const char *s, uint32_t *out)
+{
+	uint64_t v;
+
+	if (parse_u64(s, &v) < 0 || v > 100000) {
+		return -1;
+	}
+	*out = (uint32_t)v;
+	return 0;
+}
+
+/* --- commands -------------------------------------------------------------- */
+
+static void cmd_edges(control_t *c, reply_t *r, signal_t *s, int have_since, uint64_t since)
+{
+	int any = 0;
+
+	(void)c;
+	for (int i = (int)s->count - 1; i >= 0; i--) {
+		const signal_edge_t *e = signal_edge(s, (unsigned)i);
+
+		if (have_since && e->cycle < since) {
+			continue;
+		}
+		rp(r, "%s%" PRIu64 ":%d", any ? " " : "", e->cycle, e->level);
+		any = 1;
+	}
+	if (!any) {
+		rp(r, "-");
+	}
+}
+
+static void cmd_measure(control_t *c, reply_t *r, signal_t *s, unsigned nmax,
+			int have_since, uint64_t since)
+{
+	/* edges oldest first */
+	unsigned n = s->count, first = 0;
+	uint64_t hmin = UINT64_MAX, hmax = 0, hsum = 0, pmin = UINT64_MAX, pmax = 0, psum = 0;
+	unsigned periods = 0;
+	uint64_t now = c->avr->cycle;
+
+	/* Walk rising edges from the newest backwards: a complete period is
+	 * rise -> fall -> next rise. */
+	int rise_next = -1;	/* index (age) of the later rising edge */
+
+	for (unsigned age = 0; age < n && periods < nmax; age++) {
+		const signal_edge_t *e = signal_edge(s, age);
+
+		if (have_since && e->cycle < since) {
+			break;
+		}
+		if (!e->level) {
+			continue;
+		}
+		if (rise_next >= 0 && (int)age == rise_next + 2) {
+			const signal_edge_t *fall = signal_edge(s, age - 1);
+			const signal_edge_t *next = signal_edge(s, (unsigned)rise_next);
+			uint64_t high = fall->cycle - e->cycle, period = next->cycle - e->cycle;
+
+			hmin = high < hmin ? high : hmin;
+			hmax = high > hmax ? high : hmax;
+			hsum += high;
+			pmin = period < pmin ? period : pmin;
+			pmax = period > pmax ? period : pmax;
+			psum += period;
+			periods++;
+		}
+		rise_next = (int)age;
+	}
+	(void)first;
+	/* No complete period, or the signal stopped (no edge for more than
+	 * two of its longest periods): steady. */
+	if (!periods || (s->count && now - s->last_cycle > 2 * pmax)) {
+		rp(r, "steady %d", s->level);
+		return;
+	}
+	rp(r, "high %" PRIu64 " %" PRIu64 " %.1f period %" PRIu64 " %" PRIu64 " %.1f duty %.4f n %u",
+	   hmin, hmax, (double)hsum / periods, pmin, pmax, (double)psum / periods,
+	   (double)hsum / (double)psum, periods);
+}
+
+static void cmd_spi(control_t *c, reply_t *r)
+{
+	spi_log_t e;
+	int any = 0, open = 0;
+	const char *cs = NULL;
+	uint32_t txn = 0;
+	char mosi[2 * SPI_LOG + 1], miso[2 * SPI_LOG + 1];
+	size_t nm = 0;
+
+	while (spi_log_pop(&c->bm->spi, &e)) {
+		if (open && (e.cs != cs || e.txn != txn)) {
+			mosi[nm] = miso[nm] = 0;
+			rp(r, "%s%s:%s:%s", any ? " " : "", cs, mosi, miso);
+			any = 1;
+			open = 0;
+		}
+		if (!open) {
+			cs = e.cs;
+			txn = e.txn;
+			nm = 0;
+			open = 1;
+		}
+		if (nm + 2 < sizeof(mosi)) {
+			snprintf(mosi + nm, 3, "%02X", e.mosi);
+			snprintf(miso + nm, 3, "%02X", e.miso);
+			nm += 2;
+		}
+	}
+	if (open) {
+		mosi[nm] = miso[nm] = 0;
+		rp(r, "%s%s:%s:%s", any ? " " : "", cs, mosi, miso);
+		any = 1;
+	}
+	if (!any) {
+		rp(r, "-");
+	}
+}
+
+static const char control_help[] =
+	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
+	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
+	"signals | help";
+
+int control_request(control_t *c, const char *line, char **out, size_t *len,
+		    size_t *cap, uint64_t *wait_until)
+{
+	reply_t r = { out, len, cap };
+	char buf[CONTROL_LINE];
+	char *argv[CONTROL_MAX_ARGS + 1], *save = NULL, *tok;
+	int argc = 0;
+	board_model_t *bm = c->bm;
+	avr_t *avr = c->avr;
+	uint64_t u;
+	uint32_t mv;
+
+	snprintf(buf, sizeof(buf), "%s", line);
+	for (tok = strtok_r(buf, " \t\r", &save); tok && argc <= CONTROL_MAX_ARGS;
+	     tok = strtok_r(NULL, " \t\r", &save)) {
+		argv[argc++] = tok;
+	}
+	c->activity++;
+	if (argc == 0) {
+		rp(&r, "ERR empty request");
+		return 0;
+	}
+	if (argc > CONTROL_MAX_ARGS) {
+		rp(&r, "ERR too many arguments");
+		return 0;
+	}
+	const char *cmd = argv[0];
+
+	if (!strcasecmp(cmd, "time") && argc == 1) {
+		rp(&r, "%" PRIu64, (uint64_t)avr->cycle);
+	} else if (!strcasecmp(cmd, "wait") && argc == 2) {
+		if (parse_u64(argv[1], &u) < 0 || u > (1ull << 40)) {
+			rp(&r, "ERR wait N: N cycles, decimal");
+			return 0;
+		}
+		*wait_until = avr->cycle + u;
+		return 1;
+	} else if ((!strcasecmp(cmd, "pin") && argc == 2) ||
+		   (!strcasecmp(cmd, "drive") && argc == 3)) {
+		bm_port_t *p;
+		int bit;
+
+		if (board_model_parse_pin(bm, argv[1], &p, &bit) < 0) {
+			rp(&r, "ERR no pin '%s'", argv[1]);
+			return 0;
+		}
+		if (argc == 3) {
+			const char *v = argv[2];
+			int level = !strcmp(v, "0") ? 0 : !strcmp(v, "1") ? 1 :
+				    !strcasecmp(v, "z") ? -1 : -2;
+
+			if (level == -2) {
+				rp(&r, "ERR drive P 0|1|z");
+				return 0;
+			}
+			board_model_drive(bm, p, bit, level);
+			rp(&r, "OK");
+		} else {
+			char text[32];
+
+			board_model_pin_text(bm, p, bit, text, sizeof(text));
+			rp(&r, "%s", text);
+		}
+	} else if (!strcasecmp(cmd, "adc") && (argc == 2 || argc == 3)) {
+		uint64_t ch;
+
+		if (parse_u64(argv[1], &ch) < 0 || ch > 7) {
+			rp(&r, "ERR adc CH [MV]: CH 0..7");
+			return 0;
+		}
+		if (argc == 2) {
+			rp(&r, "%" PRIu32, bm->adc_mv[ch]);
+		} else if (parse_mv(argv[2], &mv) < 0) {
+			rp(&r, "ERR millivolts 0..100000");
+		} else {
+			board_model_set_adc(bm, (int)ch, mv);
+			rp(&r, "OK");
+		}
+	} else if ((!strcasecmp(cmd, "avcc") || !strcasecmp(cmd, "aref")) &&
+		   (argc == 1 || argc == 2)) {
+		int avcc = !strcasecmp(cmd, "avcc");
+
+		if (argc == 1) {
+			rp(&r, "%" PRIu32, avcc ? bm->avcc : bm->aref);
+		} else if (parse_mv(argv[1], &mv) < 0 || mv == 0) {
+			rp(&r, "ERR millivolts 1..100000");
+		} else {
+			if (avcc) {
+				board_model_set_avcc(bm, mv);
+			} else {
+				board_model_set_aref(bm, mv);
+			}
+			rp(&r, "OK");
+		}
+	} else if ((!strcasecmp(cmd, "edges") && (argc == 2 || argc == 3)) ||
+		   (!strcasecmp(cmd, "measure") && argc >= 2 && argc <= 4) ||
+		   (!strcasecmp(cmd, "level") && argc == 2)) {
+		signal_t *s = signal_find(&bm->signals, argv[1]);
+		uint64_t since = 0, nmax = CONTROL_MEASURE_DEFAULT;
+		int edges = !strcasecmp(cmd, "edges"), level = !strcasecmp(cmd, "level");
+
+		if (!s) {
+			rp(&r, "ERR no signal '%s' (see: signals)", argv[1]);
+			return 0;
+		}
+		if (level) {
+			rp(&r, "%d", s->level);
+		} else if (edges) {
+			if (argc == 3 && parse_u64(argv[2], &since) < 0) {
+				rp(&r, "ERR edges SIG [SINCE_CYCLE]");
+				return 0;
+			}
+			cmd_edges(c, &r, s, argc == 3, since);
+		} else {
+			if ((argc >= 3 && (parse_u64(argv[2], &nmax) < 0 || nmax == 0)) ||
+			    (argc == 4 && parse_u64(argv[3], &since) < 0)) {
+				rp(&r, "ERR measure SIG [N [SINCE_CYCLE]]");
+				return 0;
+			}
+			cmd_measure(c, &r, s, nmax > SIGNAL_RING ? SIGNAL_RING : (unsigned)nmax,
+				    argc == 4, since);
+		}
+	} else if (!strcasecmp(cmd, "spi") && argc == 1) {
+		cmd_spi(c, &r);
+	} else if (!strcasecmp(cmd, "spidev") && argc == 2) {
+		spi_dev_t *d = board_model_spi_dev(bm, argv[1]);
+		char text[512];
+
+		if (!d) {
+			rp(&r, "ERR no SPI device on '%s'", argv[1]);
+			return 0;
+		}
+		text[0] = 0;
+		if (d->dump) {
+			d->dump(d, text, sizeof(text));
+		}
+		rp(&r, "%s mode %d %s %s", d->kind, d->mode, d->lsb_first ? "lsb" : "msb", text);
+	} else if (!strcasecmp(cmd, "signals") && argc == 1) {
+		for (int i = 0; i < bm->signals.count; i++) {
+			rp(&r, "%s%s", i ? " " : "", bm->signals.sig[i]->name);
+		}
+	} else if (!strcasecmp(cmd, "help") && argc == 1) {
+		rp(&r, "%s", control_help);
+	} else {
+		rp(&r, "ERR unknown request or wrong arguments: %s", control_help);
+	}
+	return 0;
+}
+
+/* --- socket ---------------------------------------------------------------- */
+
+int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm)
+{
+	struct sockaddr_un sa = { .sun_family = AF_UNIX };
+
+	memset(c, 0, sizeof(*c));
+	c->fd = -1;
+	c->avr = avr;
+	c->bm = bm;
+	for (int i = 0; i < CONTROL_CLIENTS; i++) {
+		c->client[i].fd = -1;
+	}
+	if (strlen(path) >= sizeof(sa.sun_path)) {
+		errno = ENAMETOOLONG;
+		return -1;
+	}
+	strcpy(sa.sun_path, path);
+	unlink(path);
+	c->fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+	if (c->fd < 0) {
+		return -1;
+	}
+	if (bind(c->fd, (struct sockaddr *)&sa, sizeof(sa)) < 0 || listen(c->fd, 8) < 0) {
+		int e = errno;
+
+		close(c->fd);
+		c->fd = -1;
+		errno = e;
+		return -1;
+	}
+	c->path = strdup(path);
+	return 0;
+}
+
+static void client_drop(control_client_t *cl)
+{
+	close(cl->fd);
+	cl->fd = -1;
+	free(cl->out);
+	cl->out = NULL;
+	cl->out_len = cl->out_cap = 0;
+	cl->in_len = 0;
+	cl->waiting = 0;
+	cl->overlong = 0;
+}
+
+static void client_reply_end(control_client_t *cl)
+{
+	reply_t r = { &cl->out, &cl->out_len, &cl->out_cap };
+
+	rp(&r, "\n");
+}
+
+/* Answer the complete lines in CL's input until one must wait. */
+static void client_process(control_t *c, control_client_t *cl)
+{
+	while (!cl->waiting && cl->fd >= 0) {
+		char *nl = memchr(cl->in, '\n', cl->in_len);
+
+		if (!nl) {
+			if (cl->in_len == sizeof(cl->in)) {
+				cl->overlong = 1;	/* drop until the newline */
+				cl->in_len = 0;
+			}
+			return;
+		}
+		*nl = 0;
+		size_t used = (size_t)(nl - cl->in) + 1;
+
+		if (cl->overlong) {
+			reply_t r = { &cl->out, &cl->out_len, &cl->out_cap };
+
+			rp(&r, "ERR line too long");
+			client_reply_end(cl);
+			cl->overlong = 0;
+		} else if (control_request(c, cl->in, &cl->out, &cl->out_len, &cl->out_cap,
+					   &cl->wait_until)) {
+			cl->waiting = 1;
+		} else {
+			client_reply_end(cl);
+		}
+		memmove(cl->in, cl->in + used, cl->in_len - used);
+		cl->in_len -= used;
+	}
+}
+
+void control_poll(control_t *c)
+{
+	if (c->fd < 0) {
+		return;
+	}
+	for (;;) {
+		int fd = accept4(c->fd, NULL, NULL, SOCK_NONBLOCK | SOCK_CLOEXEC);
+		int slot = -1;
+
+		if (fd < 0) {
+			break;
+		}
+		for (int i = 0; i < CONTROL_CLIENTS; i++) {
+			if (c->client[i].fd < 0) {
+				slot = i;
+				break;
+			}
+		}
+		if (slot < 0) {
+			static const char busy[] = "ERR too many clients\n";
+
+			if (write(fd, busy, sizeof(busy) - 1) < 0) {
+				/* nothing to do */
+			}
+			close(fd);
+			continue;
+		}
+		c->client[slot].fd = fd;
+		c->activity++;
+	}
+	for (int i = 0; i < CONTROL_CLIENTS; i++) {
+		control_client_t *cl = &c->client[i];
+
+		if (cl->fd < 0) {
+			continue;
+		}
+		if (cl->waiting && c->avr->cycle >= cl->wait_until) {
+			reply_t r = { &cl->out, &cl->out_len, &cl->out_cap };
+
+			cl->waiting = 0;
+			rp(&r, "%" PRIu64 "\n", (uint64_t)c->avr->cycle);
+		}
+		if (cl->in_len < sizeof(cl->in)) {
+			ssize_t n = read(cl->fd, cl->in + cl->in_len, sizeof(cl->in) - cl->in_len);
+
+			if (n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK &&
+				       errno != EINTR)) {
+				client_drop(cl);
+				continue;
+			}
+			if (n > 0) {
+				cl->in_len += (size_t)n;
+			}
+		}
+		client_process(c, cl);
+		if (cl->out_len) {
+			ssize_t n = write(cl->fd, cl->out, cl->out_len);
+
+			if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
+				client_drop(cl);
+				continue;
+			}
+			if (n > 0) {
+				memmove(cl->out, cl->out + n, cl->out_len - (size_t)n);
+				cl->out_len -= (size_t)n;
+			}
+			if (cl->out_len > CONTROL_OUT_MAX) {
+				client_drop(cl);	/* a client that never reads */
+			}
+		}
+	}
+}
+
+int control_waiting(const control_t *c)
+{
+	for (int i = 0; i < CONTROL_CLIENTS; i++) {
+		if (c->client[i].fd >= 0 && c->client[i].waiting) {
+			return 1;
+		}
+	}
+	return 0;
+}
+
+uint64_t control_deadline(const control_t *c)
+{
+	uint64_t d = UINT64_MAX;
+
+	for (int i = 0; i < CONTROL_CLIENTS; i++) {
+		const control_client_t *cl = &c->client[i];
+
+		if (cl->fd >= 0 && cl->waiting && cl->wait_until < d) {
+			d = cl->wait_until;
+		}
+	}
+	return d;
+}
+
+int control_pollfds(const control_t *c, struct pollfd *pfd, int max)
+{
+	int n = 0;
+
+	if (c->fd < 0) {
+		return 0;
+	}
+	if (n < max) {
+		pfd[n++] = (struct pollfd) { .fd = c->fd, .events = POLLIN };
+	}
+	for (int i = 0; i < CONTROL_CLIENTS && n < max; i++) {
+		if (c->client[i].fd >= 0) {
+			pfd[n++] = (struct pollfd) { .fd = c->client[i].fd, .events = POLLIN };
+		}
+	}
+	return n;
+}
+
+void control_close(control_t *c)
+{
+	for (int i = 0; i < CONTROL_CLIENTS; i++) {
+		if (c->client[i].fd >= 0) {
+			client_drop(&c->client[i]);
+		}
+	}
+	if (c->fd >= 0) {
+		close(c->fd);
+		c->fd = -1;
+	}
+	if (c->path) {
+		unlink(c->path);
+		free(c->path);
+		c->path = NULL;
+	}
+}

@@ -1,0 +1,63 @@
+/*
+ * control.h: the control socket (--control PATH): a unix stream socket
+ * serviced from the main loop between batches; one request line, one reply
+ * line (docs/simulator.md lists the commands). Several clients may be
+ * connected at once; a client's `wait` holds back only its own later
+ * requests, never the simulation.
+ */
+#ifndef SIM_CONTROL_H
+#define SIM_CONTROL_H
+
+#include <poll.h>
+#include <stdint.h>
+
+#include "sim_avr.h"
+
+#include "board_model.h"
+
+#define CONTROL_CLIENTS 8
+#define CONTROL_LINE 1024
+
+typedef struct control_client_t {
+	int fd;				/* -1: free */
+	char in[CONTROL_LINE];
+	size_t in_len;
+	int overlong;			/* discarding a line that was too long */
+	char *out;
+	size_t out_len, out_cap;
+	int waiting;
+	uint64_t wait_until;
+} control_client_t;
+
+typedef struct control_t {
+	int fd;				/* listening socket, -1: off */
+	char *path;
+	avr_t *avr;
+	board_model_t *bm;
+	control_client_t client[CONTROL_CLIENTS];
+	uint32_t activity;		/* bumps on every request */
+} control_t;
+
+/* Listen on PATH (an existing socket file there is replaced). 0 or -1. */
+int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm);
+
+/* Accept, read, answer, send: never blocks. */
+void control_poll(control_t *c);
+
+/* True while some client waits for simulated time. */
+int control_waiting(const control_t *c);
+
+/* The earliest cycle a waiting client wants (UINT64_MAX when none). */
+uint64_t control_deadline(const control_t *c);
+
+/* Add the socket's descriptors to PFD (room for MAX); returns how many. */
+int control_pollfds(const control_t *c, struct pollfd *pfd, int max);
+
+void control_close(control_t *c);
+
+/* Answer one request LINE into OUT (no newline); exposed for tests. Returns
+ * 1 when the reply must wait until *WAIT_UNTIL. */
+int control_request(control_t *c, const char *line, char **out, size_t *len,
+		    size_t *cap, uint64_t *wait_until);
+
+#endif

@@ -1,0 +1,86 @@
+/*
+ * signals.h: named digital signals of the board (port pins, counter outputs)
+ * with cycle-stamped edge records, change listeners and a VCD writer.
+ *
+ * A signal changes only through signal_set(); equal levels are ignored, so
+ * every record is a real edge. Each signal keeps its last SIGNAL_RING edges.
+ */
+#ifndef SIM_SIGNALS_H
+#define SIM_SIGNALS_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#define SIGNAL_RING 1024
+#define SIGNAL_MAX 160
+#define SIGNAL_LISTENERS 4
+
+struct signal_t;
+
+/* Called after S changed to LEVEL at CYCLE. */
+typedef void (*signal_listener_t)(void *param, struct signal_t *s,
+				  uint64_t cycle, int level);
+
+typedef struct signal_edge_t {
+	uint64_t cycle;
+	uint8_t level;
+} signal_edge_t;
+
+typedef struct signal_t {
+	char name[16];
+	int level;
+	uint64_t last_cycle;		/* cycle of the last edge (0: none) */
+	signal_edge_t ring[SIGNAL_RING];
+	unsigned head;			/* next slot to write */
+	unsigned count;			/* edges held (<= SIGNAL_RING) */
+	uint64_t total;			/* edges ever */
+	signal_listener_t listener[SIGNAL_LISTENERS];
+	void *listener_param[SIGNAL_LISTENERS];
+	int listeners;
+	struct signals_t *set;
+	int index;
+} signal_t;
+
+typedef struct vcd_event_t {
+	uint64_t cycle;
+	uint64_t seq;
+	uint16_t sig;
+	uint8_t level;
+} vcd_event_t;
+
+typedef struct signals_t {
+	signal_t *sig[SIGNAL_MAX];
+	int count;
+	/* VCD: events wait in a buffer until they are old enough to be in
+	 * time order (some edges are stamped a few cycles in the past). */
+	FILE *vcd;
+	vcd_event_t *pending;
+	size_t npending, cap;
+	uint64_t seq, vcd_last;
+	int vcd_have_time;
+} signals_t;
+
+/* Register S under NAME with initial LEVEL. 0, or -1 when full. */
+int signal_add(signals_t *set, signal_t *s, const char *name, int level);
+
+/* The signal called NAME (case-insensitive), or NULL. */
+signal_t *signal_find(signals_t *set, const char *name);
+
+/* Set S to LEVEL at CYCLE; records an edge and notifies when it changed. */
+void signal_set(signal_t *s, uint64_t cycle, int level);
+
+void signal_listen(signal_t *s, signal_listener_t fn, void *param);
+
+/* The i-th newest edge held (0 = newest); NULL past the end. */
+const signal_edge_t *signal_edge(const signal_t *s, unsigned i);
+
+/* VCD of every registered signal to PATH (call after all signal_add).
+ * 0 or -1 with errno. */
+int signals_vcd_open(signals_t *set, const char *path, uint32_t frequency);
+
+/* Write buffered VCD events older than NOW - SIGNALS_VCD_LAG cycles. */
+#define SIGNALS_VCD_LAG 8192
+void signals_vcd_flush(signals_t *set, uint64_t now, int all);
+void signals_vcd_close(signals_t *set, uint64_t now);
+
+#endif
