@@ -13,7 +13,9 @@ import subprocess
 import tempfile
 import time
 from pathlib import Path
-from typing import Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
+
+from .simctl import SimControl
 
 #: The repository root (host/orfa/../..), so nothing needs installing.
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -65,12 +67,18 @@ class SimBoard:
     """A simulated ORFA board running as a child process; a context manager.
 
     `.port` is the link to the board's serial port (open it with pyserial or
-    Gateway); `.trace_path` the trace file (if trace=True).
+    Gateway); `.trace_path` the trace file (if trace=True). With control=True
+    `.control` is a SimControl on the board's control socket; vcd=True writes
+    `.vcd_path`; spi=["eeprom25@B4", "mcp3008@B3:mode=0"], adc={0: 1000},
+    avcc/aref (mV) set the board's SPI devices and analog inputs.
     """
 
     def __init__(self, board: str = "m32d", eeproms: Sequence[int] = (),
                  trace: bool = True, firmware: Union[str, Path, None] = None,
-                 start_timeout: float = 15.0, extra_args: Sequence[str] = ()):
+                 start_timeout: float = 15.0, extra_args: Sequence[str] = (),
+                 control: bool = False, vcd: bool = False, spi: Sequence[str] = (),
+                 adc: Optional[Dict[int, int]] = None, avcc: Optional[int] = None,
+                 aref: Optional[int] = None):
         if board not in BOARDS:
             raise ValueError("board must be one of %s" % (BOARDS,))
         self.board = board
@@ -79,6 +87,15 @@ class SimBoard:
         self.start_timeout = start_timeout
         self.extra_args = tuple(extra_args)
         self.want_trace = trace
+        self.want_control = control
+        self.want_vcd = vcd
+        self.spi = tuple(spi)
+        self.adc = dict(adc or {})
+        self.avcc = avcc
+        self.aref = aref
+        self.control_path: Optional[Path] = None
+        self.vcd_path: Optional[Path] = None
+        self._control: Optional[SimControl] = None
         self.dir: Optional[Path] = None
         self.port = ""
         self.trace_path: Optional[Path] = None
@@ -92,6 +109,18 @@ class SimBoard:
             cmd += ["--eeprom", "0x%02X" % addr]
         if self.trace_path is not None:
             cmd += ["--trace", str(self.trace_path)]
+        if self.control_path is not None:
+            cmd += ["--control", str(self.control_path)]
+        if self.vcd_path is not None:
+            cmd += ["--vcd", str(self.vcd_path)]
+        for spec in self.spi:
+            cmd += ["--spi", spec]
+        for ch, mv in sorted(self.adc.items()):
+            cmd += ["--adc", "%d=%d" % (ch, mv)]
+        if self.avcc is not None:
+            cmd += ["--avcc", str(self.avcc)]
+        if self.aref is not None:
+            cmd += ["--aref", str(self.aref)]
         return cmd + list(self.extra_args) + [str(self.firmware)]
 
     def start(self) -> "SimBoard":
@@ -101,6 +130,8 @@ class SimBoard:
         self.dir = Path(tempfile.mkdtemp(prefix="orfa-sim-%s-" % self.board))
         self.port = str(self.dir / "tty")
         self.trace_path = self.dir / "trace.log" if self.want_trace else None
+        self.control_path = self.dir / "control" if self.want_control else None
+        self.vcd_path = self.dir / "board.vcd" if self.want_vcd else None
         self._stdout = open(self.dir / "stdout", "wb")
         self._stderr = open(self.dir / "stderr", "wb")
         self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL,
@@ -131,6 +162,9 @@ class SimBoard:
     def stop(self, keep_dir: bool = False) -> Optional[int]:
         """SIGTERM the simulator, wait for it; returns its exit status."""
         status = None
+        if self._control is not None:
+            self._control.close()
+            self._control = None
         if self.proc is not None:
             if self.proc.poll() is None:
                 self.proc.send_signal(signal.SIGTERM)
@@ -157,6 +191,15 @@ class SimBoard:
     @property
     def running(self) -> bool:
         return self.proc is not None and self.proc.poll() is None
+
+    @property
+    def control(self) -> SimControl:
+        """The control socket's client (start the board with control=True)."""
+        if self.control_path is None or self.proc is None:
+            raise SimError("this board was started without control=True")
+        if self._control is None:
+            self._control = SimControl(str(self.control_path))
+        return self._control
 
     @property
     def stderr(self) -> str:
