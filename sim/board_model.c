@@ -100,6 +100,22 @@ static void bm_port_update(bm_port_t *p, uint64_t cycle)
 	}
 }
 
+/* PINx of an output reads the pin's real level: simavr returns PORTx,
+ * stale while a compare unit or the SPI drives the pin. */
+static uint8_t bm_read_pin(avr_t *avr, avr_io_addr_t addr, void *param)
+{
+	bm_port_t *p = param;
+	uint8_t v = p->pin_read ? p->pin_read(avr, addr, p->pin_read_param) : avr->data[addr];
+	uint8_t levels = 0;
+
+	for (int b = 0; b < 8; b++) {
+		levels |= (uint8_t)(p->pin[b].level << b);
+	}
+	v = (uint8_t)((v & ~p->ddr) | (levels & p->ddr));
+	avr->data[addr] = v;
+	return v;
+}
+
 static void bm_on_port(struct avr_irq_t *irq, uint32_t value, void *param)
 {
 	bm_port_t *p = param;
@@ -430,6 +446,12 @@ static int bm_find_ports(board_model_t *bm)
 			}
 		}
 		if (p) {
+			avr_io_addr_t io = AVR_DATA_TO_IO(p->io->r_pin);
+
+			p->pin_read = bm->avr->io[io].r.c;
+			p->pin_read_param = bm->avr->io[io].r.param;
+			bm->avr->io[io].r.c = bm_read_pin;
+			bm->avr->io[io].r.param = p;
 			avr_irq_register_notify(p->irq + IOPORT_IRQ_REG_PORT, bm_on_port, p);
 			avr_irq_register_notify(p->irq + IOPORT_IRQ_DIRECTION_ALL, bm_on_ddr, p);
 		}

@@ -60,6 +60,8 @@ typedef struct bm_port_t {
 	signal_t pin[8];
 	bm_oc_t *oc[8][2];
 	int noc[8];
+	avr_io_read_t pin_read;		/* simavr's PINx read, chained */
+	void *pin_read_param;
 } bm_port_t;
 
 typedef struct bm_com_hook_t {
