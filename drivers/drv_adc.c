@@ -30,14 +30,16 @@ static reg_status_t adc_write(uint8_t reg, const uint8_t *data, uint8_t len)
 		return REG_BAD_VALUE;
 	}
 	uint8_t taking = mask & (uint8_t)~adc_cfg.mask;
+	/* Check every line before taking any: giving a taken line back would
+	 * reset it to an input, though it may have been a GPIO output. */
 	for (uint8_t ch = 0; ch < 8; ch++) {
-		if ((taking & (1u << ch)) && !pins_claim((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC)) {
-			while (ch--) {
-				if (taking & (1u << ch)) {
-					pins_release((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC);
-				}
-			}
+		if ((taking & (1u << ch)) && !pins_can_claim((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC)) {
 			return REG_PIN_BUSY;
+		}
+	}
+	for (uint8_t ch = 0; ch < 8; ch++) {
+		if (taking & (1u << ch)) {
+			pins_claim((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC);
 		}
 	}
 	port_io_dir(ADC_PORT, taking, 0);

@@ -56,15 +56,17 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	for (uint8_t i = 0; i < len; i += 3) {
 		next[data[i]] = servo_clamp((uint16_t)(data[i + 1] << 8 | data[i + 2]));
 	}
-	/* Channels turned on take their pins; any refusal undoes the others. */
+	/* Channels turned on take their pins. All are checked before any is
+	 * taken: a claim sets its pin up (output low) and a release cannot
+	 * bring back what GPIO had there. */
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		if (next[ch] && !servo.width[ch] && !servo_hw_claim(ch)) {
-			while (ch--) {
-				if (next[ch] && !servo.width[ch]) {
-					servo_hw_release(ch);
-				}
-			}
+		if (next[ch] && !servo.width[ch] && !servo_hw_can_claim(ch)) {
 			return REG_PIN_BUSY;
+		}
+	}
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		if (next[ch] && !servo.width[ch]) {
+			servo_hw_claim(ch);
 		}
 	}
 	servo_hw_apply(next);

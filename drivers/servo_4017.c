@@ -177,6 +177,12 @@ void servo_hw_init(void)
 	SFIOR = 0;
 }
 
+bool servo_hw_can_claim(uint8_t ch)
+{
+	(void)ch;
+	return true;
+}
+
 bool servo_hw_claim(uint8_t ch)
 {
 	(void)ch;  /* channels have no MCU pins: the counters' lines are ours */

@@ -12,6 +12,9 @@
 /* Timers and pins set up; no channel pulses. */
 void servo_hw_init(void);
 
+/* Whether servo_hw_claim(ch) would succeed; changes nothing. */
+bool servo_hw_can_claim(uint8_t ch);
+
 /* Takes the pins channel `ch` needs; false if another function holds one. */
 bool servo_hw_claim(uint8_t ch);
 

@@ -165,6 +165,11 @@ void servo_hw_init(void)
 	TIMSK |= _BV(TOIE2);
 }
 
+bool servo_hw_can_claim(uint8_t ch)
+{
+	return pins_can_claim(board_pin(BF_SERVO, ch), PIN_SERVO);
+}
+
 bool servo_hw_claim(uint8_t ch)
 {
 	uint8_t pin = board_pin(BF_SERVO, ch);

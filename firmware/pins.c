@@ -18,17 +18,22 @@ void pins_init(void)
 	owner[board_pin(BF_TWI_SDA, 0)] = PIN_TWI;
 }
 
-bool pins_claim(uint8_t pin, pin_owner_t who)
+bool pins_can_claim(uint8_t pin, pin_owner_t who)
 {
 	uint8_t now = owner[pin];
 	bool motor_line = now == PIN_MOTOR || now == PIN_MOTOR_IDLE;
 	bool motor_wants = who == PIN_MOTOR || who == PIN_MOTOR_IDLE;
-	if (now == who || now == PIN_FREE || (motor_line && motor_wants)
-	    || (now == PIN_MOTOR_IDLE && who == PIN_SERVO)) {
-		owner[pin] = who;
-		return true;
+	return now == who || now == PIN_FREE || (motor_line && motor_wants)
+	       || (now == PIN_MOTOR_IDLE && who == PIN_SERVO);
+}
+
+bool pins_claim(uint8_t pin, pin_owner_t who)
+{
+	if (!pins_can_claim(pin, who)) {
+		return false;
 	}
-	return false;
+	owner[pin] = who;
+	return true;
 }
 
 void pins_release(uint8_t pin, pin_owner_t who)

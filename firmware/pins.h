@@ -35,6 +35,11 @@ void pins_init(void);
  * motor's PWM output lent to a servo. False, and nothing changes, otherwise. */
 bool pins_claim(uint8_t pin, pin_owner_t who);
 
+/* Whether pins_claim(pin, who) would succeed; changes nothing. A write that
+ * needs several pins checks them all first: undoing a claim with
+ * pins_release would reset a GPIO line the write never had. */
+bool pins_can_claim(uint8_t pin, pin_owner_t who);
+
 /* Gives a pin back: a lent motor output returns to the stopped motor (output
  * low), any other pin to GPIO as an input without pull-up (its reset state).
  * Does nothing if `who` does not hold it. */
