@@ -24,6 +24,7 @@
 #include "board.h"
 #include "drivers/drv_servo.h"
 #include "firmware/board_pins.h"
+#include "firmware/mcu.h"
 #include "firmware/pins.h"
 #include "firmware/port_io.h"
 
@@ -31,7 +32,7 @@
 #define SERVO_FRAME   18432u                /* 20 ms in ticks */
 #define SERVO_HIGH    40u                   /* clock pulse high time */
 #define SERVO_GAP     80u                   /* slot of a channel that is off */
-#define SERVO_LEAD    64u                   /* frame start to first clock */
+#define SERVO_LEAD    256u                  /* frame start to first clock */
 #define SERVO_COUNTERS BOARD_SERVO_COUNTERS
 #define SERVO_SLOTS   BOARD_SERVO_PER_COUNTER
 
@@ -51,7 +52,9 @@ static struct {
 	uint8_t rises[SERVO_COUNTERS];     /* rising edges done this frame */
 	uint8_t high[SERVO_COUNTERS];      /* the clock line is high */
 	uint16_t rise_at[SERVO_COUNTERS];  /* tick of the last rising edge */
-	uint8_t rst_pin;
+	uint16_t t3_offset;                /* TCNT3 - TCNT1 */
+	volatile uint8_t *rst_port;        /* the reset line's PORT register */
+	uint8_t rst_mask;
 } s4;
 
 /* Compare unit of counter c: its OCR, its COM bits' register and shift. */
@@ -79,12 +82,31 @@ static void servo_com(uint8_t c, uint8_t com)
 #define COM_CLEAR 2
 #define COM_SET 3
 
+/* Programs counter c's next edge at tick `at`. A late interrupt must not
+ * lose an edge (the counter would drift a slot): an edge whose time has
+ * passed comes right away. Only a clock fall or the end of an off channel's
+ * short slot can be that close; a pulsing channel's end is >= 461 ticks
+ * after its start. */
+static void servo_next(uint8_t c, volatile uint16_t *ocr, uint16_t at)
+{
+	uint16_t now = (c < 3) ? TCNT3 : TCNT1;
+	if ((int16_t)(at - now) < 4) {
+		at = now + 4;
+	}
+	*ocr = at;
+}
+
 /* A counter's compare matched: program its next edge. */
 static void servo_counter_edge(uint8_t c)
 {
 	volatile uint16_t *ocr = servo_ocr(c);
 	uint16_t t = *ocr;
 	const servo_sched_t *s = &s4.sched[s4.cur];
+	uint16_t now = (c < 3) ? TCNT3 : TCNT1;
+
+	if ((int16_t)(now - t) < 0) {
+		return;  /* a flag left from before this compare was set: not yet */
+	}
 
 	if (!s4.high[c]) {
 		/* A rising edge: counter moved on; fall after SERVO_HIGH. */
@@ -92,7 +114,7 @@ static void servo_counter_edge(uint8_t c)
 		s4.rise_at[c] = t;
 		s4.rises[c]++;
 		servo_com(c, COM_CLEAR);
-		*ocr = t + SERVO_HIGH;
+		servo_next(c, ocr, t + SERVO_HIGH);
 		return;
 	}
 	s4.high[c] = 0;
@@ -102,7 +124,7 @@ static void servo_counter_edge(uint8_t c)
 		return;
 	}
 	servo_com(c, COM_SET);
-	*ocr = s4.rise_at[c] + s->dur[c][slot];
+	servo_next(c, ocr, s4.rise_at[c] + s->dur[c][slot]);
 }
 
 ISR(TIMER3_COMPA_vect) { servo_counter_edge(0); }
@@ -110,35 +132,25 @@ ISR(TIMER3_COMPB_vect) { servo_counter_edge(1); }
 ISR(TIMER3_COMPC_vect) { servo_counter_edge(2); }
 ISR(TIMER1_COMPC_vect) { servo_counter_edge(3); }
 
-static const __flash uint8_t ocie_bit[SERVO_COUNTERS] = { OCIE3A, OCIE3B, OCIE3C, OCIE1C };
+static const __flash uint8_t ocie_bit[SERVO_COUNTERS] = {
+	_BV(OCIE3A), _BV(OCIE3B), _BV(OCIE3C), _BV(OCIE1C),
+};
 
 /* Frame start (Timer1 compare A): reset the counters, start the active ones. */
 ISR(TIMER1_COMPA_vect)
 {
 	uint16_t f = OCR1A;
-	uint8_t rst = PIN_MASK(s4.rst_pin);
-	/* Reset pulse: CD4017 needs 0.3 us at 5 V; this is 2.5 us. */
-	port_io_write(PIN_PORT(s4.rst_pin), rst, rst);
-	__builtin_avr_delay_cycles(16);
-	port_io_write(PIN_PORT(s4.rst_pin), rst, 0);
 	if (s4.pending) {
 		s4.cur ^= 1;
 		s4.pending = 0;
 	}
 	const servo_sched_t *s = &s4.sched[s4.cur];
-	if (!s->active) {
-		/* Nothing pulses: counters held in reset, interrupts off. */
-		port_io_write(PIN_PORT(s4.rst_pin), rst, rst);
-		s4.running = 0;
-		TIMSK &= (uint8_t)~_BV(OCIE1A);
-		ETIMSK &= (uint8_t)~(_BV(OCIE3A) | _BV(OCIE3B) | _BV(OCIE3C) | _BV(OCIE1C));
-		return;
-	}
 	for (uint8_t c = 0; c < SERVO_COUNTERS; c++) {
 		s4.rises[c] = 0;
 		s4.high[c] = 0;
 		if (s->active & (1u << c)) {
-			*servo_ocr(c) = f + SERVO_LEAD;
+			/* Counters 0-2 count on Timer3, counter 3 on Timer1. */
+			*servo_ocr(c) = f + SERVO_LEAD + (c < 3 ? s4.t3_offset : 0);
 			servo_com(c, COM_SET);
 			ETIMSK |= ocie_bit[c];
 		} else {
@@ -146,6 +158,17 @@ ISR(TIMER1_COMPA_vect)
 			ETIMSK &= (uint8_t)~ocie_bit[c];
 		}
 	}
+	/* Reset pulse, well before the first clock: CD4017 needs 0.3 us at
+	 * 5 V; this is about 2.5 us. */
+	*s4.rst_port |= s4.rst_mask;
+	__builtin_avr_delay_cycles(16);
+	if (!s->active) {
+		/* Nothing pulses: counters held in reset, interrupts off. */
+		s4.running = 0;
+		TIMSK &= (uint8_t)~_BV(OCIE1A);
+		return;
+	}
+	*s4.rst_port &= (uint8_t)~s4.rst_mask;
 	OCR1A = f + s->frame;
 }
 
@@ -162,10 +185,12 @@ void servo_hw_init(void)
 		port_io_write(PIN_PORT(pin), PIN_MASK(pin), 0);
 		port_io_dir(PIN_PORT(pin), PIN_MASK(pin), PIN_MASK(pin));
 	}
-	s4.rst_pin = board_pin(BF_SERVO_RST, 0);
-	pins_claim(s4.rst_pin, PIN_SERVO_CLK);
-	port_io_write(PIN_PORT(s4.rst_pin), PIN_MASK(s4.rst_pin), PIN_MASK(s4.rst_pin));
-	port_io_dir(PIN_PORT(s4.rst_pin), PIN_MASK(s4.rst_pin), PIN_MASK(s4.rst_pin));
+	uint8_t rst = board_pin(BF_SERVO_RST, 0);
+	pins_claim(rst, PIN_SERVO_CLK);
+	s4.rst_port = mcu_port((char)('A' + PIN_PORT(rst)))->port;
+	s4.rst_mask = PIN_MASK(rst);
+	port_io_write(PIN_PORT(rst), s4.rst_mask, s4.rst_mask);
+	port_io_dir(PIN_PORT(rst), s4.rst_mask, s4.rst_mask);
 	/* Timer1 and Timer3: normal mode, clk/8, started together. */
 	SFIOR = _BV(TSM) | _BV(PSR321);
 	TCCR1A = 0;
@@ -175,6 +200,13 @@ void servo_hw_init(void)
 	TCCR1B = _BV(CS11);
 	TCCR3B = _BV(CS31);
 	SFIOR = 0;
+	/* However the two started, they count alike from here: one offset
+	 * maps Timer1 (the frame) to Timer3 (counters 0-2). */
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		uint16_t t1 = TCNT1;
+		uint16_t t3 = TCNT3;
+		s4.t3_offset = t3 - t1;
+	}
 }
 
 bool servo_hw_can_claim(uint8_t ch)

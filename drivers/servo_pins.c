@@ -4,10 +4,11 @@
  * Channel n's pulse starts SERVO_SLOT * n cycles into each 20 ms frame, so
  * at most a few pulses overlap and their edges rarely meet. Every edge is
  * written by the Timer2 compare interrupt at an exact CPU cycle: Timer2
- * (clk/8) wakes the interrupt about SERVO_LEAD cycles early, and the
- * interrupt then waits on Timer0 (clk/1, free running) for the edge's cycle.
- * The edges' error is the few cycles of that last loop, whatever else the
- * firmware is doing (UART interrupts are short and lower priority).
+ * (clk/8) wakes the interrupt about SERVO_LEAD cycles early (more than any
+ * other interrupt plus this one's entry can delay it), the interrupt waits on
+ * Timer2 until the edge is SERVO_FINE cycles away and then on Timer0 (clk/1,
+ * free running) for the edge's cycle. The edges' error is the few cycles of
+ * that last loop, whatever else the firmware is doing.
  *
  * The schedule (edges sorted by time) is built in the main loop when widths
  * change, into the buffer the interrupt is not using, and taken over at the
@@ -27,8 +28,9 @@
 
 #define SERVO_FRAME  147456UL  /* 20 ms at 7.3728 MHz */
 #define SERVO_SLOT   8191UL    /* between channel starts: 1.111 ms */
-#define SERVO_LEAD   96        /* wake-up before an edge, cycles */
-#define SERVO_NEAR   (SERVO_LEAD + 32)  /* closer than this: wait in place */
+#define SERVO_LEAD   320       /* wake-up before an edge, cycles */
+#define SERVO_NEAR   (SERVO_LEAD + 80)  /* closer than this: wait in place */
+#define SERVO_FINE   96        /* last stretch, waited on Timer0 */
 #define SERVO_EDGES  (2 * SERVO_CHANNELS)
 #define SERVO_FALL   0x80      /* edge code: channel | SERVO_FALL */
 
@@ -50,6 +52,7 @@ static struct {
 	uint32_t frame;              /* Timer0 cycle of the frame's start */
 	uint32_t target;             /* Timer0 cycle of the next edge */
 	volatile uint16_t wraps;     /* Timer2 overflows */
+	uint8_t t0_offset;           /* TCNT0 - 8 * TCNT2, measured at start */
 } sv;
 
 /* Each channel's pin (PIN_ID), from the board's pin map. */
@@ -79,15 +82,22 @@ static uint32_t edge_time(const servo_sched_t *s, uint8_t e)
 	return t;
 }
 
-/* Timer0 cycles as a 32-bit count, good to a few cycles (for planning). */
-static uint32_t servo_now(void)
+/* Timer2 ticks (8 cycles) as a 16-bit count: edges are never more than a
+ * frame (18432 ticks) ahead, so 16-bit differences order them. */
+static uint16_t servo_ticks(void)
 {
 	uint16_t w = sv.wraps;
 	uint8_t t = TCNT2;
 	if ((TIFR & _BV(TOV2)) && t < 128) {
-		w++;
+		w++;  /* an overflow not yet counted (interrupts are off) */
 	}
-	return ((uint32_t)w << 11) | ((uint32_t)t << 3);
+	return (uint16_t)(w << 8 | t);
+}
+
+/* Ticks from now until `cycle`. */
+static int16_t servo_ticks_to(uint32_t cycle)
+{
+	return (int16_t)((uint16_t)(cycle >> 3) - servo_ticks());
 }
 
 /* Arms Timer2 to wake SERVO_LEAD cycles before sv.target; false if that is
@@ -95,7 +105,7 @@ static uint32_t servo_now(void)
  * once per Timer2 wrap; the interrupt ignores the wraps before the edge's. */
 static bool servo_arm(void)
 {
-	if ((int32_t)(sv.target - servo_now()) < SERVO_NEAR) {
+	if (servo_ticks_to(sv.target) < SERVO_NEAR / 8) {
 		return false;
 	}
 	OCR2 = (uint8_t)((sv.target - SERVO_LEAD) >> 3);
@@ -109,7 +119,7 @@ ISR(TIMER2_OVF_vect)
 
 ISR(TIMER2_COMP_vect)
 {
-	if (!sv.running || (int32_t)(sv.target - servo_now()) > SERVO_NEAR) {
+	if (!sv.running || servo_ticks_to(sv.target) > SERVO_NEAR / 8) {
 		return;  /* an earlier wrap, or a stale flag */
 	}
 	for (;;) {
@@ -118,15 +128,18 @@ ISR(TIMER2_COMP_vect)
 		uint8_t pin = servo_pin[e & (uint8_t)~SERVO_FALL];
 		volatile uint8_t *reg = (volatile uint8_t *)(uint16_t)port_addr[PIN_PORT(pin)];
 		uint8_t mask = line_mask[pin & 7];
-		uint8_t lo = (uint8_t)sv.target;
+		uint8_t lo = (uint8_t)(sv.target + sv.t0_offset);
+		uint8_t and_mask = (e & SERVO_FALL) ? (uint8_t)~mask : 0xFF;
+		uint8_t or_mask = (e & SERVO_FALL) ? 0 : mask;
+		uint16_t fine_from = (uint16_t)((sv.target - SERVO_FINE) >> 3);
 
+		/* Near the edge on Timer2, then to its cycle on Timer0; the write
+		 * takes the same instructions for rising and falling edges. */
+		while ((int16_t)(fine_from - servo_ticks()) > 0) {
+		}
 		while ((int8_t)(TCNT0 - lo) < 0) {
 		}
-		if (e & SERVO_FALL) {
-			*reg &= (uint8_t)~mask;
-		} else {
-			*reg |= mask;
-		}
+		*reg = (uint8_t)((*reg & and_mask) | or_mask);
 
 		if (++sv.next == s->n) {
 			/* Frame done: take a newer schedule over, start the next. */
@@ -163,6 +176,14 @@ void servo_hw_init(void)
 	TCCR0 = _BV(CS00);
 	TCCR2 = _BV(CS21);
 	TIMSK |= _BV(TOIE2);
+	/* Edge times are planned on Timer2 and met on Timer0: how far apart
+	 * the two count only shifts the last wait's window (by up to 7 cycles,
+	 * Timer2's tick), never an edge's place relative to the others. */
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		uint8_t t0 = TCNT0;
+		uint8_t t2 = TCNT2;
+		sv.t0_offset = (uint8_t)(t0 - (uint8_t)(t2 << 3));
+	}
 }
 
 bool servo_hw_can_claim(uint8_t ch)
@@ -227,7 +248,7 @@ void servo_hw_apply(const uint16_t *widths_us)
 			/* Start: the first frame begins a little from now. */
 			sv.active ^= 1;
 			sv.next = 0;
-			sv.frame = servo_now() + 4096;
+			sv.frame = ((uint32_t)servo_ticks() << 3) + 4096;
 			sv.target = sv.frame + edge_time(s, s->edge[0]);
 			servo_arm();
 			sv.running = 1;
