@@ -11,6 +11,7 @@
 #include "sim_regbit.h"
 #include "avr_adc.h"
 
+#include "avr_extint.h"
 #include "board_model.h"
 
 _Static_assert(MAX_CYCLE_TIMERS <= 64, "the slot mask is 64 bits");
@@ -398,6 +399,17 @@ static int bm_counters(board_model_t *bm)
 
 /* --- setup ----------------------------------------------------------------- */
 
+/* simavr polls a low INTn pin on every cycle ("strict" level triggering,
+ * switched on again at each reset) even with the interrupt off: the M128-S
+ * counter clocks sit low on INT4/INT5 and made the simulation ten times
+ * slower. Level interrupts still fire, once per level change. */
+static void bm_no_strict_level(avr_t *avr)
+{
+	for (uint8_t i = 0; i < 8; i++) {
+		avr_extint_set_strict_lvl_trig(avr, i, 0);
+	}
+}
+
 static void bm_reset(avr_io_t *io)
 {
 	board_model_t *bm = (board_model_t *)io;
@@ -414,6 +426,7 @@ static void bm_reset(avr_io_t *io)
 	avr->avcc = bm->avcc;
 	avr->vcc = bm->avcc;
 	avr->aref = bm->aref;
+	bm_no_strict_level(avr);
 }
 
 static int bm_find_ports(board_model_t *bm)
@@ -528,6 +541,7 @@ int board_model_init(board_model_t *bm, avr_t *avr, const board_desc_t *board,
 	bm->io.kind = "orfa-board";
 	bm->io.reset = bm_reset;
 	mcu_register_io_last(avr, &bm->io);
+	bm_no_strict_level(avr);
 	bm->activity = 0;
 	return 0;
 }
