@@ -410,6 +410,17 @@ static void bm_no_strict_level(avr_t *avr)
 	}
 }
 
+/* Stack painting: SRAM keeps its contents over a reset, as on silicon, so
+ * the simulator fills it with BM_PAINT before the firmware starts; the
+ * startup code then initialises .data and .bss, and the stack overwrites
+ * the paint as deep as it ever goes. */
+static void bm_paint_sram(avr_t *avr)
+{
+	for (uint32_t a = avr->ioend + 1u; a <= avr->ramend; a++) {
+		avr->data[a] = BM_PAINT;
+	}
+}
+
 static void bm_reset(avr_io_t *io)
 {
 	board_model_t *bm = (board_model_t *)io;
@@ -427,6 +438,7 @@ static void bm_reset(avr_io_t *io)
 	avr->vcc = bm->avcc;
 	avr->aref = bm->aref;
 	bm_no_strict_level(avr);
+	bm_paint_sram(avr);
 }
 
 static int bm_find_ports(board_model_t *bm)
@@ -542,6 +554,33 @@ int board_model_init(board_model_t *bm, avr_t *avr, const board_desc_t *board,
 	bm->io.reset = bm_reset;
 	mcu_register_io_last(avr, &bm->io);
 	bm_no_strict_level(avr);
+	bm_paint_sram(avr);
 	bm->activity = 0;
 	return 0;
+}
+
+int board_model_stack_peak(board_model_t *bm, uint32_t from, uint32_t *deepest)
+{
+	avr_t *avr = bm->avr;
+	uint32_t a;
+
+	if (from == 0) {
+		/* Not told where the static data end: the stack lies above the
+		 * highest run of 16 untouched bytes. */
+		uint32_t run = 0;
+		for (a = avr->ramend; a > avr->ioend; a--) {
+			run = (avr->data[a] == BM_PAINT) ? run + 1 : 0;
+			if (run == 16) {
+				break;
+			}
+		}
+		from = a;
+	}
+	if (from <= avr->ioend || from > avr->ramend) {
+		return -1;
+	}
+	for (a = from; a <= avr->ramend && avr->data[a] == BM_PAINT; a++) {
+	}
+	*deepest = a;
+	return (int)(avr->ramend + 1u - a);
 }

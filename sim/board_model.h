@@ -126,6 +126,14 @@ void board_model_set_adc(board_model_t *bm, int ch, uint32_t mv);
 void board_model_set_avcc(board_model_t *bm, uint32_t mv);
 void board_model_set_aref(board_model_t *bm, uint32_t mv);
 
+/* Byte the simulator paints free SRAM with before the firmware runs. */
+#define BM_PAINT 0xA5
+
+/* Peak stack use since the last reset, in bytes: from the first byte above
+ * FROM (the end of the firmware's static data, __heap_start; 0 = guess) that
+ * the stack has written. *deepest = that address. -1 if FROM is not SRAM. */
+int board_model_stack_peak(board_model_t *bm, uint32_t from, uint32_t *deepest);
+
 /* "1 out", "0 in", "1 in pullup", "0 in ext", ... */
 void board_model_pin_text(board_model_t *bm, bm_port_t *p, int bit, char *buf, int size);
 

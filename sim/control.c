@@ -199,7 +199,7 @@ static void cmd_spi(control_t *c, reply_t *r)
 static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
-	"signals | help";
+	"stack [FROM] | signals | help";
 
 int control_request(control_t *c, const char *line, char **out, size_t *len,
 		    size_t *cap, uint64_t *wait_until)
@@ -231,6 +231,22 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 
 	if (!strcasecmp(cmd, "time") && argc == 1) {
 		rp(&r, "%" PRIu64, (uint64_t)avr->cycle);
+	} else if (!strcasecmp(cmd, "stack") && (argc == 1 || argc == 2)) {
+		uint64_t from = 0;
+		uint32_t deepest;
+		int peak;
+
+		if (argc == 2 && parse_u64(argv[1], &from) < 0) {
+			rp(&r, "ERR stack [FROM]: FROM = end of static data, decimal");
+			return 0;
+		}
+		peak = board_model_stack_peak(bm, (uint32_t)from, &deepest);
+		if (peak < 0) {
+			rp(&r, "ERR FROM is not an SRAM address");
+			return 0;
+		}
+		rp(&r, "peak %d deepest 0x%04X ramend 0x%04X", peak, (unsigned)deepest,
+		   (unsigned)avr->ramend);
 	} else if (!strcasecmp(cmd, "wait") && argc == 2) {
 		if (parse_u64(argv[1], &u) < 0 || u > (1ull << 40)) {
 			rp(&r, "ERR wait N: N cycles, decimal");

@@ -130,3 +130,11 @@ class SimControl:
 
     def signals(self) -> List[str]:
         return self.request("signals").split()
+
+    def stack(self, heap_start: int = 0) -> Dict[str, int]:
+        """Peak stack use since the last reset (the simulator paints SRAM).
+
+        heap_start: the end of the firmware's static data (avr-nm's
+        __heap_start, minus 0x800000); 0 lets the simulator guess."""
+        words = self.request("stack %d" % heap_start).split()
+        return {"peak": int(words[1]), "deepest": int(words[3], 16), "ramend": int(words[5], 16)}
