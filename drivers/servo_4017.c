@@ -187,7 +187,7 @@ void servo_hw_init(void)
 	}
 	uint8_t rst = board_pin(BF_SERVO_RST, 0);
 	pins_claim(rst, PIN_SERVO_CLK);
-	s4.rst_port = mcu_port((char)('A' + PIN_PORT(rst)))->port;
+	s4.rst_port = mcu_port(PIN_PORT(rst)).port;
 	s4.rst_mask = PIN_MASK(rst);
 	port_io_write(PIN_PORT(rst), s4.rst_mask, s4.rst_mask);
 	port_io_dir(PIN_PORT(rst), s4.rst_mask, s4.rst_mask);

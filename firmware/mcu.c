@@ -2,26 +2,30 @@
 
 #include <avr/wdt.h>
 
-/* Ports in letter order from 'A'; each MCU lists the ports it has. */
-static const __flash mcu_port_t ports[] = {
-	{ &PINA, &DDRA, &PORTA },
-	{ &PINB, &DDRB, &PORTB },
-	{ &PINC, &DDRC, &PORTC },
-	{ &PIND, &DDRD, &PORTD },
+/* PINx, DDRx, PORTx data addresses in letter order from 'A'. Named, not
+ * computed: the ATmega128's port F registers are not next to each other.
+ * Addresses rather than pointers in flash: avr-gcc 5.4 at -O2 miscompiled
+ * reads of pointers through __flash. */
+static const __flash uint8_t port_regs[][3] = {
+	{ _SFR_MEM_ADDR(PINA), _SFR_MEM_ADDR(DDRA), _SFR_MEM_ADDR(PORTA) },
+	{ _SFR_MEM_ADDR(PINB), _SFR_MEM_ADDR(DDRB), _SFR_MEM_ADDR(PORTB) },
+	{ _SFR_MEM_ADDR(PINC), _SFR_MEM_ADDR(DDRC), _SFR_MEM_ADDR(PORTC) },
+	{ _SFR_MEM_ADDR(PIND), _SFR_MEM_ADDR(DDRD), _SFR_MEM_ADDR(PORTD) },
 #if defined(__AVR_ATmega128__)
-	{ &PINE, &DDRE, &PORTE },
-	{ &PINF, &DDRF, &PORTF },
-	{ &PING, &DDRG, &PORTG },
+	{ _SFR_MEM_ADDR(PINE), _SFR_MEM_ADDR(DDRE), _SFR_MEM_ADDR(PORTE) },
+	{ _SFR_MEM_ADDR(PINF), _SFR_MEM_ADDR(DDRF), _SFR_MEM_ADDR(PORTF) },
+	{ _SFR_MEM_ADDR(PING), _SFR_MEM_ADDR(DDRG), _SFR_MEM_ADDR(PORTG) },
 #endif
 };
 
-const __flash mcu_port_t *mcu_port(char letter)
+mcu_port_t mcu_port(uint8_t index)
 {
-	uint8_t i = (uint8_t)(letter - 'A');
-	if (i >= sizeof ports / sizeof ports[0]) {
-		return 0;
-	}
-	return &ports[i];
+	mcu_port_t p = {
+		.pin = (volatile uint8_t *)(uint16_t)port_regs[index][0],
+		.ddr = (volatile uint8_t *)(uint16_t)port_regs[index][1],
+		.port = (volatile uint8_t *)(uint16_t)port_regs[index][2],
+	};
+	return p;
 }
 
 void mcu_watchdog_start(void)

@@ -41,8 +41,9 @@ typedef struct {
 	volatile uint8_t *port;
 } mcu_port_t;
 
-/* The port named by its letter ('A'...), or 0 if the MCU has no such port. */
-const __flash mcu_port_t *mcu_port(char letter);
+/* The registers of port `index` (0 = port A). The MCU's ports only: the
+ * board files name nothing else. */
+mcu_port_t mcu_port(uint8_t index);
 
 /* Watchdog on, reset flags cleared (simavr re-arms a fired watchdog until
  * WDRF is cleared; harmless on silicon). */

@@ -109,13 +109,13 @@ void twi_stop(void)
 }
 
 /* Open-drain lines by hand: low = output 0, released = input with pull-up. */
-static void line_low(const __flash mcu_port_t *p, uint8_t bit)
+static void line_low(const mcu_port_t *p, uint8_t bit)
 {
 	*p->port &= (uint8_t)~bit;
 	*p->ddr |= bit;
 }
 
-static void line_release(const __flash mcu_port_t *p, uint8_t bit)
+static void line_release(const mcu_port_t *p, uint8_t bit)
 {
 	*p->ddr &= (uint8_t)~bit;
 	*p->port |= bit;
@@ -123,7 +123,8 @@ static void line_release(const __flash mcu_port_t *p, uint8_t bit)
 
 void twi_clear_bus(void)
 {
-	const __flash mcu_port_t *p = mcu_port(BOARD_TWI_PORT);
+	mcu_port_t port = mcu_port(BOARD_TWI_PORT - 'A');
+	const mcu_port_t *p = &port;
 	const uint8_t scl = _BV(BOARD_TWI_SCL);
 	const uint8_t sda = _BV(BOARD_TWI_SDA);
 

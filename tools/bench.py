@@ -3,9 +3,13 @@
 
 For each board: latency from the last request byte (end of its stop bit) to
 the first reply byte (start of its start bit) for a few requests, sustained
-throughput of back-to-back introspection reads against the wire limit, flash
-and static RAM. Everything is counted in simulated CPU cycles, so every figure
-is exact and repeatable; wall time enters only the simulator-speed line.
+throughput of back-to-back introspection reads against the wire limit, flash,
+static RAM and measured peak stack (the simulator paints SRAM; the firmware
+is first put through every driver's requests), and servo pulse accuracy:
+width error against the commanded width and its spread (jitter) while
+requests stream over the UART back to back. Everything is counted in
+simulated CPU cycles, so every figure is exact and repeatable; wall time
+enters only the simulator-speed line.
 
     python3 tools/bench.py [--boards m32d m128s] [--requests 1000]
 """
@@ -35,6 +39,7 @@ PIPELINE_REQUEST = "S AA 00 00 S AB 01 P\r"
 
 # ORFA 0.7.5, measured the same way (issue 2).
 ORIGINAL = {"V": 1084, "introspection count": 2702, "driver info": 3966}
+SRAM_START = {"m32d": 0x60, "m128s": 0x100}
 BUDGET_FLASH = 11152
 BUDGET_RAM = 992
 
@@ -83,15 +88,79 @@ def port_request_reply(port, request):
     return port.readline()
 
 
+# Requests that reach every driver (register numbers from docs/registers.md).
+EXERCISE = {
+    "m32d": ["S AA 02 55 0F P", "S AA 06 0F 0F S AB 01 P", "S AA 0B 00 02 02 P",
+             "S AA 0A 00 9F 00 00 P", "S AA 0A S AB 03 P", "S AA 0B S AB 09 P",
+             "S AA 0C 05 F0 P", "S AA 0D S AB 10 P", "S AA 0E 80 60 00 01 P",
+             "S AA 0E 00 00 00 00 P", "S AA 00 01 S AB 3C P"],
+    "m128s": ["S AA 02 55 0F P", "S AA 04 0F 0F S AB 01 P", "S AA 07 00 00 02 P",
+              "S AA 06 00 9F 00 00 P", "S AA 06 S AB 03 P", "S AA 07 S AB 09 P",
+              "S AA 08 05 F0 P", "S AA 09 S AB 10 P", "S AA 00 01 S AB 3C P"],
+}
+# Servo channels measured: (SP register, [(channel, us, signal)]).
+SERVOS = {
+    "m32d": (0x13, [(0, 500, "A0"), (1, 1500, "A1"), (9, 2500, "C6"), (13, 1234, "B2")]),
+    "m128s": (0x0B, [(0, 500, "servo0"), (9, 1500, "servo9"), (18, 2500, "servo18"),
+                     (31, 1234, "servo31")]),
+}
+SERVO_LOAD = "S AA 00 01 S AB 06 P\r"
+
+
+def servo_request(board):
+    reg, chans = SERVOS[board]
+    return "S AA %02X %s P" % (reg, " ".join("%02X %04X" % (ch, us) for ch, us, _ in chans))
+
+
+def servo_figures(ctl, port, board):
+    """Worst width error (us) and width spread (cycles), quiet and under load."""
+    reg, chans = SERVOS[board]
+    port.write((servo_request(board) + "\r").encode())
+    port.readline()
+    ctl.wait(F_CPU // 5)  # 10 frames
+
+    def sample(since):
+        err, spread, period = 0.0, 0, 0
+        for _, us, sig in chans:
+            m = ctl.measure(sig, 50, since)
+            want = us * F_CPU / 1e6
+            err = max(err, abs(m["high"][0] - want), abs(m["high"][1] - want))
+            spread = max(spread, m["high"][1] - m["high"][0])
+            period = max(period, abs(m["period"][0] - 147456), abs(m["period"][1] - 147456))
+        return err / F_CPU * 1e6, spread, period
+
+    quiet = sample(ctl.time() - F_CPU // 6)
+    t0 = ctl.time()
+    n = 400
+    port.write((SERVO_LOAD * n).encode())
+    ctl.wait(n * len(SERVO_LOAD) * CYCLES_PER_BYTE)
+    loaded = sample(t0)
+    for _ in range(n):
+        port.readline()
+    return quiet, loaded
+
+
+def heap_start(board):
+    out = subprocess.run(["avr-nm", str(firmware_path(board))], check=True,
+                         capture_output=True, text=True).stdout
+    end = next(line.split()[0] for line in out.splitlines() if line.endswith(" _end"))
+    return int(end, 16) - 0x800000
+
+
 def bench_board(board, count):
     rows = {}
     wall0 = time.monotonic()
-    with SimBoard(board) as sim:
+    with SimBoard(board, control=True) as sim:
         with serial.Serial(sim.port, 115200, timeout=10) as port:
             for name, request, _ in LATENCY_REQUESTS:
                 rows[name] = latency(sim, port, request)
             correct, cycles, rx_bytes = pipeline(sim, port, count)
-        cycles_total = read_trace(sim, 0)[-1].cycle
+            rows["servo"] = servo_figures(sim.control, port, board)
+            for request in EXERCISE[board]:
+                port.write((request + "\r").encode())
+                port.readline()
+        rows["stack"] = sim.control.stack(heap_start(board))
+        cycles_total = sim.control.time()
     wall = time.monotonic() - wall0
     wire = rx_bytes * CYCLES_PER_BYTE
     rows["pipeline"] = (correct, cycles, wire)
@@ -131,6 +200,20 @@ def main():
           + "%10s%12d" % ("<= %d" % BUDGET_FLASH, BUDGET_FLASH))
     print("%-*s" % (width, "static RAM (B)") + "".join("%14d" % results[b]["footprint"][1] for b in args.boards)
           + "%10s%12d" % ("<= %d" % BUDGET_RAM, BUDGET_RAM))
+    print("%-*s" % (width, "peak stack (B)") + "".join(
+        "%14d" % results[b]["stack"]["peak"] for b in args.boards))
+    print("%-*s" % (width, "SRAM never touched (%)") + "".join(
+        "%14.1f" % (100.0 * (results[b]["stack"]["deepest"] - heap_start(b))
+                    / (results[b]["stack"]["ramend"] + 1 - SRAM_START[b])) for b in args.boards)
+        + "%10s" % ">= 25")
+    print("%-*s" % (width, "servo width error, quiet (us)") + "".join(
+        "%14.3f" % results[b]["servo"][0][0] for b in args.boards) + "%10s" % "<= 1.1")
+    print("%-*s" % (width, "servo width error, UART load (us)") + "".join(
+        "%14.3f" % results[b]["servo"][1][0] for b in args.boards) + "%10s" % "<= 1.1")
+    print("%-*s" % (width, "servo jitter, UART load (cycles)") + "".join(
+        "%14d" % results[b]["servo"][1][1] for b in args.boards))
+    print("%-*s" % (width, "servo period error, load (cycles)") + "".join(
+        "%14d" % results[b]["servo"][1][2] for b in args.boards) + "%10s" % "<= 147")
     print("%-*s" % (width, "simulator speed (sim MHz / wall s)") + "".join(
         "%14.1f" % results[b]["speed"] for b in args.boards))
     print()
