@@ -149,3 +149,188 @@ def board(bench):
     bench.restore()
     resets = bench.events(mark, ["reset"])
     assert resets == [], "the MCU reset during the test: %r" % resets
+
+
+# --- driver suites (tests/sim/test_drv_*.py) ----------------------------------
+#
+# The driver tests look at the board's pins through the simulator's control
+# socket (docs/simulator.md), so their simulators run with control=True. Each
+# test module gets its own simulator per board (module scope) through the
+# `drv_sim` fixture; the `drv` fixture gives it to a test and puts every
+# driver back into its reset state afterwards (servos off, motors stopped, ADC
+# off, SPI bus settings 02, GPIO lines inputs without pull-up, external drives
+# released), so no test sees another's state.
+
+F_CPU = 7372800
+#: One servo frame: 20 ms.
+SERVO_FRAME = 147456
+
+#: Registers and pins of each board (docs/registers.md, docs/boards.md).
+DRV_LAYOUT = {
+    "m32d": {
+        "gpio_ports": "ABCD", "gpio_val": 0x02, "gpio_mode": 0x06,
+        "spi": 0x0A, "adc": 0x0C, "motor": 0x0E, "servo": 0x12,
+        "servo_channels": 16, "adc_port": "A",
+        "spi_pins": {"SS": "B4", "MOSI": "B5", "MISO": "B6", "SCK": "B7"},
+        # channel n's pin
+        "servo_pins": ["A0", "A1", "A2", "A3", "A4", "A5", "A6", "A7",
+                       "C7", "C6", "C5", "C4", "B3", "B2", "D5", "D4"],
+        # pins of functions that GPIO never has (UART, TWI, SPI, motors)
+        "fixed_pins": {"D0": "UART", "D1": "UART", "C0": "TWI", "C1": "TWI",
+                       "B4": "SPI", "B5": "SPI", "B6": "SPI", "B7": "SPI",
+                       "D5": "MOTOR", "D4": "MOTOR", "B0": "MOTOR", "B1": "MOTOR"},
+    },
+    "m128s": {
+        "gpio_ports": "AF", "gpio_val": 0x02, "gpio_mode": 0x04,
+        "spi": 0x06, "adc": 0x08, "motor": None, "servo": 0x0A,
+        "servo_channels": 32, "adc_port": "F",
+        "spi_pins": {"SS": "B0", "SCK": "B1", "MOSI": "B2", "MISO": "B3"},
+        "servo_pins": ["servo%d" % n for n in range(32)],
+        "fixed_pins": {"E0": "UART", "E1": "UART", "D0": "TWI", "D1": "TWI",
+                       "B0": "SPI", "B1": "SPI", "B2": "SPI", "B3": "SPI",
+                       "E3": "SERVO", "E4": "SERVO", "E5": "SERVO", "B7": "SERVO",
+                       "E6": "SERVO"},
+    },
+}
+
+
+def us_to_cycles(us: float) -> float:
+    return us * F_CPU / 1e6
+
+
+class DrvBench(Bench):
+    """A Bench with the simulator's control socket and register helpers."""
+
+    def __init__(self, sim: SimBoard):
+        super().__init__(sim)
+        self.ctl = sim.control
+        self.lay = DRV_LAYOUT[sim.board]
+        self.driven = set()
+
+    # --- registers ------------------------------------------------------------
+    def wr(self, reg: int, data: bytes = b"") -> None:
+        """A register write the driver must accept."""
+        data = bytes(data)
+        req = "SAA%02X%sP" % (reg, data.hex().upper())
+        reply = self.ask(req)
+        assert reply == b"SW" + b"A" * (1 + len(data)) + b"P\r\n", (req, reply)
+
+    def wr_refused(self, reg: int, data: bytes, status: int) -> None:
+        """A register write the driver must reject with `status`."""
+        data = bytes(data)
+        req = "SAA%02X%sP" % (reg, data.hex().upper())
+        reply = self.ask(req)
+        assert reply == b"ERROR 07\r\n", (req, reply)
+        assert self.status() == status, req
+
+    def rd(self, reg: int, count: int) -> bytes:
+        """Select `reg`, read `count` bytes; the reply must be a good one."""
+        req = "S AA %02X S AB %02X P" % (reg, count)
+        reply = self.ask(req)
+        assert reply[:5] == b"SWASR" and reply[-3:] == b"P\r\n", (req, reply)
+        data = bytes.fromhex(reply[5:-3].decode())
+        assert len(data) == count, (req, reply)
+        return data
+
+    # --- the pins ---------------------------------------------------------------
+    def pin(self, name: str):
+        return self.ctl.pin(name)
+
+    def drive(self, name: str, value) -> None:
+        self.ctl.drive(name, value)
+        if value is None or value == "z":
+            self.driven.discard(name)
+        else:
+            self.driven.add(name)
+
+    def now(self) -> int:
+        return self.ctl.time()
+
+    def wait(self, cycles: int) -> int:
+        return self.ctl.wait(cycles)
+
+    def edges(self, sig: str, since: int):
+        return self.ctl.edges(sig, since)
+
+    def measure(self, sig: str, since: int, n: int = 50):
+        return self.ctl.measure(sig, n, since)
+
+    def highs(self, sig: str, since: int, until: int = None):
+        """[(rise, high cycles, period to the next rise or None)] of complete
+        pulses whose rising edge is at or after `since` (and falls <= until)."""
+        edges = self.edges(sig, since)
+        out = []
+        for i, (cycle, level) in enumerate(edges):
+            if level != 1 or i + 1 >= len(edges):
+                continue
+            fall = edges[i + 1][0]
+            if until is not None and fall > until:
+                continue
+            nxt = [c for c, l in edges[i + 1:] if l == 1]
+            out.append((cycle, fall - cycle, (nxt[0] - cycle) if nxt else None))
+        return out
+
+    # --- state --------------------------------------------------------------------
+    def servos_off(self) -> None:
+        lay = self.lay
+        chans = lay["servo_channels"]
+        for first in range(0, chans, 16):
+            self.wr(lay["servo"] + 1, b"".join(bytes([ch, 0, 0]) for ch in range(first, first + 16)))
+        self.wr(lay["servo"] + 1, b"\x00")
+
+    def drv_restore(self) -> None:
+        """Every driver back to its reset state (SPI chip selects aside)."""
+        lay = self.lay
+        self.gw.send(b"\n")          # end a line a test left open
+        self.gw.read_available(0.2)
+        for name in sorted(self.driven):
+            self.ctl.drive(name, None)
+        self.driven.clear()
+        self.servos_off()
+        if lay["motor"] is not None:
+            self.wr(lay["motor"], b"\x00\x00\x00\x00")
+        self.wr(lay["adc"], b"\x00\x00")
+        self.wr(lay["spi"] + 1, b"\xff\x00\x02")
+        for i, _ in enumerate(lay["gpio_ports"]):
+            self.wr(lay["gpio_mode"] + i, b"\x00\xff")
+            self.wr(lay["gpio_val"] + i, b"\x00\xff")
+
+
+#: Simulator options of the driver test modules: a module sets
+#: `DRV_SIM_OPTIONS = {"m32d": {...}, "m128s": {...}}` (SimBoard keyword
+#: arguments such as spi=[...], adc={...}, aref=...) and
+#: `DRV_BOARDS = ("m32d",)` to run on some boards only.
+@pytest.fixture(scope="module")
+def drv_sim(request):
+    board_name = request.param
+    require_builds([board_name])
+    options = getattr(request.module, "DRV_SIM_OPTIONS", {}).get(board_name, {})
+    sim = SimBoard(board_name, trace=True, control=True, **options)
+    sim.start()
+    b = DrvBench(sim)
+    try:
+        yield b
+    finally:
+        b.close()
+        status = sim.stop()
+        assert status == 0, "orfa-sim exited with %r" % status
+
+
+def pytest_generate_tests(metafunc):
+    if "drv_sim" in metafunc.fixturenames:
+        boards = getattr(metafunc.module, "DRV_BOARDS", BOARDS)
+        metafunc.parametrize("drv_sim", boards, indirect=True, scope="module")
+
+
+@pytest.fixture
+def drv(drv_sim):
+    """The module's board for a driver test; every driver is put back after."""
+    bench = drv_sim
+    assert bench.sim.running, "the simulator died: %s" % bench.sim.stderr
+    bench.gw.serial.reset_input_buffer()
+    mark = bench.mark()
+    yield bench
+    bench.drv_restore()
+    bench.restore()
+    resets = bench.events(mark, ["reset"])
+    assert resets == [], "the MCU reset during the test: %r" % resets
