@@ -16,7 +16,7 @@ static struct {
 
 /* RC: [settings][mask], always both. Enabled channels take their pins
  * (input, no pull-up); all of the write or none of it. */
-static reg_status_t adc_write(uint8_t reg, const uint8_t *data, uint8_t len)
+reg_status_t drv_adc_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (reg != ADC_REG_RC) {
 		return REG_NOT_WRITABLE;
@@ -59,7 +59,7 @@ static reg_status_t adc_write(uint8_t reg, const uint8_t *data, uint8_t len)
 
 /* RC reads back [settings][mask]; RD gives channels 0..7, one byte each
  * (8-bit) or two, big-endian (10-bit); channels off read 0. */
-static uint8_t adc_read(uint8_t reg, uint8_t *dst, uint8_t max)
+uint8_t drv_adc_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
 	uint8_t n = 0;
 	if (reg == ADC_REG_RC) {
@@ -84,19 +84,9 @@ static uint8_t adc_read(uint8_t reg, uint8_t *dst, uint8_t max)
 	return n;
 }
 
-static void adc_init(void)
+void drv_adc_init(void)
 {
 	adc_cfg.settings = 0;
 	adc_cfg.mask = 0;
 	adc_hw_config(0, 0);
 }
-
-const ORFA_FLASH drv_t drv_adc = {
-	.uid = 0x0040,
-	.major = 1,
-	.minor = 1,
-	.nregs = DRV_adc_NREGS,
-	.init = adc_init,
-	.write = adc_write,
-	.read = adc_read,
-};

@@ -10,6 +10,12 @@
 #define ADC_SET_REF_MASK 0x03  /* 00 AREF, 01 AVCC, 10/11 internal 2.56 V */
 #define ADC_SET_10BIT    0x04  /* else 8-bit results */
 
-extern const ORFA_FLASH drv_t drv_adc;
+#define DRV_adc_UID 0x0040
+#define DRV_adc_MAJOR 1
+#define DRV_adc_MINOR 1
+
+void drv_adc_init(void);
+reg_status_t drv_adc_write(uint8_t reg, const uint8_t *data, uint8_t len);
+uint8_t drv_adc_read(uint8_t reg, uint8_t *dst, uint8_t max);
 
 #endif

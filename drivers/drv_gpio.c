@@ -12,7 +12,7 @@ static const ORFA_FLASH uint8_t gpio_ports[GPIO_NPORTS] = {
 
 /* Write [value] or [value][mask]: only lines in the mask that GPIO holds
  * change; lines of other functions are left alone (not an error). */
-static reg_status_t gpio_write(uint8_t reg, const uint8_t *data, uint8_t len)
+reg_status_t drv_gpio_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (len < 1 || len > 2) {
 		return REG_BAD_LENGTH;
@@ -29,7 +29,7 @@ static reg_status_t gpio_write(uint8_t reg, const uint8_t *data, uint8_t len)
 }
 
 /* Values read the levels on the pins; modes read the direction bits. */
-static uint8_t gpio_read(uint8_t reg, uint8_t *dst, uint8_t max)
+uint8_t drv_gpio_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
 	(void)max;
 	if (reg >= GPIO_NPORTS) {
@@ -40,12 +40,6 @@ static uint8_t gpio_read(uint8_t reg, uint8_t *dst, uint8_t max)
 	return 1;
 }
 
-const ORFA_FLASH drv_t drv_gpio = {
-	.uid = BOARD_GPIO_UID,
-	.major = 1,
-	.minor = 1,
-	.nregs = DRV_gpio_NREGS,
-	.init = 0,
-	.write = gpio_write,
-	.read = gpio_read,
-};
+void drv_gpio_init(void)
+{
+}

@@ -10,6 +10,12 @@
 #define GPIO_NPORTS (0 BOARD_GPIO_PORTS(GPIO_COUNT_PORT))
 #define DRV_gpio_NREGS (2 * GPIO_NPORTS)
 
-extern const ORFA_FLASH drv_t drv_gpio;
+#define DRV_gpio_UID BOARD_GPIO_UID
+#define DRV_gpio_MAJOR 1
+#define DRV_gpio_MINOR 1
+
+void drv_gpio_init(void);
+reg_status_t drv_gpio_write(uint8_t reg, const uint8_t *data, uint8_t len);
+uint8_t drv_gpio_read(uint8_t reg, uint8_t *dst, uint8_t max);
 
 #endif

@@ -9,7 +9,7 @@
 /* [PWM1, PWM2, DIR1, DIR2] */
 static uint8_t motor_reg[DRV_motor_NREGS];
 
-static void motor_init(void)
+void drv_motor_init(void)
 {
 	for (uint8_t i = 0; i < DRV_motor_NREGS; i++) {
 		motor_reg[i] = 0;
@@ -25,7 +25,7 @@ static void motor_init(void)
 
 /* A write of k bytes to register r sets registers r..r+k-1 (4 bytes to PWM1
  * set all four), all of them or none. */
-static reg_status_t motor_write(uint8_t reg, const uint8_t *data, uint8_t len)
+reg_status_t drv_motor_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (len == 0 || reg + len > DRV_motor_NREGS) {
 		return REG_BAD_LENGTH;
@@ -63,7 +63,7 @@ static reg_status_t motor_write(uint8_t reg, const uint8_t *data, uint8_t len)
 }
 
 /* Reading register r gives registers r..3. */
-static uint8_t motor_read(uint8_t reg, uint8_t *dst, uint8_t max)
+uint8_t drv_motor_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
 	uint8_t n = 0;
 	for (uint8_t r = reg; r < DRV_motor_NREGS && n < max; r++) {
@@ -71,13 +71,3 @@ static uint8_t motor_read(uint8_t reg, uint8_t *dst, uint8_t max)
 	}
 	return n;
 }
-
-const ORFA_FLASH drv_t drv_motor = {
-	.uid = 0x0060,
-	.major = 1,
-	.minor = 1,
-	.nregs = DRV_motor_NREGS,
-	.init = motor_init,
-	.write = motor_write,
-	.read = motor_read,
-};

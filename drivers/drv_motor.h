@@ -6,6 +6,12 @@
 
 #define DRV_motor_NREGS 4
 
-extern const ORFA_FLASH drv_t drv_motor;
+#define DRV_motor_UID 0x0060
+#define DRV_motor_MAJOR 1
+#define DRV_motor_MINOR 1
+
+void drv_motor_init(void);
+reg_status_t drv_motor_write(uint8_t reg, const uint8_t *data, uint8_t len);
+uint8_t drv_motor_read(uint8_t reg, uint8_t *dst, uint8_t max);
 
 #endif

@@ -10,7 +10,7 @@ static struct {
 	uint8_t first;                   /* first channel a read of SP gives */
 } servo;
 
-static void servo_init(void)
+void drv_servo_init(void)
 {
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
 		servo.width[ch] = 0;
@@ -79,7 +79,7 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	return REG_OK;
 }
 
-static reg_status_t servo_write(uint8_t reg, const uint8_t *data, uint8_t len)
+reg_status_t drv_servo_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (reg == SERVO_REG_RS) {
 		return REG_OK;  /* driver 1.0's channel mask: accepted, not needed */
@@ -89,7 +89,7 @@ static reg_status_t servo_write(uint8_t reg, const uint8_t *data, uint8_t len)
 
 /* RS: the mask of pulsing channels, channel 0 in the last byte's bit 0.
  * SP: the widths from the first channel on, 2 bytes each. */
-static uint8_t servo_read(uint8_t reg, uint8_t *dst, uint8_t max)
+uint8_t drv_servo_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
 	uint8_t n = 0;
 	if (reg == SERVO_REG_RS) {
@@ -114,13 +114,3 @@ static uint8_t servo_read(uint8_t reg, uint8_t *dst, uint8_t max)
 	}
 	return n;
 }
-
-const ORFA_FLASH drv_t drv_servo = {
-	.uid = BOARD_SERVO_UID,
-	.major = 2,
-	.minor = 0,
-	.nregs = DRV_servo_NREGS,
-	.init = servo_init,
-	.write = servo_write,
-	.read = servo_read,
-};

@@ -11,6 +11,12 @@
 #define SERVO_MAX_US 2500
 #define SERVO_MAX_TRIPLES 16
 
-extern const ORFA_FLASH drv_t drv_servo;
+#define DRV_servo_UID BOARD_SERVO_UID
+#define DRV_servo_MAJOR 2
+#define DRV_servo_MINOR 0
+
+void drv_servo_init(void);
+reg_status_t drv_servo_write(uint8_t reg, const uint8_t *data, uint8_t len);
+uint8_t drv_servo_read(uint8_t reg, uint8_t *dst, uint8_t max);
 
 #endif

@@ -32,7 +32,7 @@ static void spi_apply(uint8_t settings)
 		      settings & SPI_SET_LSB_FIRST);
 }
 
-static void spi_init(void)
+void drv_spi_init(void)
 {
 	for (uint8_t i = 0; i < SPI_CHANNELS; i++) {
 		spi.cs[i] = SPI_UNBOUND;
@@ -110,14 +110,14 @@ static reg_status_t spi_data(const uint8_t *data, uint8_t len)
 	return REG_OK;
 }
 
-static reg_status_t spi_write(uint8_t reg, const uint8_t *data, uint8_t len)
+reg_status_t drv_spi_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	return reg == SPI_REG_CONFIG ? spi_config(data, len) : spi_data(data, len);
 }
 
 /* DATA: the bytes received in the last exchange. CONFIG: [settings] then
  * each channel's [port][line] (FF FF when unbound). */
-static uint8_t spi_read(uint8_t reg, uint8_t *dst, uint8_t max)
+uint8_t drv_spi_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
 	uint8_t n = 0;
 	if (reg == SPI_REG_DATA) {
@@ -147,13 +147,3 @@ static uint8_t spi_read(uint8_t reg, uint8_t *dst, uint8_t max)
 	}
 	return n;
 }
-
-const ORFA_FLASH drv_t drv_spi = {
-	.uid = 0x0001,
-	.major = 1,
-	.minor = 1,
-	.nregs = DRV_spi_NREGS,
-	.init = spi_init,
-	.write = spi_write,
-	.read = spi_read,
-};

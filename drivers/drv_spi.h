@@ -15,6 +15,12 @@
 #define SPI_SET_LSB_FIRST 0x20
 #define SPI_SET_DEFAULT   0x02  /* F_CPU/8 = 921.6 kHz, mode 0, MSB first */
 
-extern const ORFA_FLASH drv_t drv_spi;
+#define DRV_spi_UID 0x0001
+#define DRV_spi_MAJOR 1
+#define DRV_spi_MINOR 1
+
+void drv_spi_init(void);
+reg_status_t drv_spi_write(uint8_t reg, const uint8_t *data, uint8_t len);
+uint8_t drv_spi_read(uint8_t reg, uint8_t *dst, uint8_t max);
 
 #endif

@@ -16,19 +16,43 @@ enum {
 
 _Static_assert(REGMAP_END <= 0x100, "registers must fit in one byte");
 
+/* One flat table in flash: function pointers read straight from it (a
+ * pointer to a descriptor that itself lives in flash is the double
+ * indirection avr-gcc 5.4 gets wrong at -O2). */
 typedef struct {
-	const ORFA_FLASH drv_t *drv;
-	uint8_t start;
+	void (*init)(void);
+	reg_status_t (*write)(uint8_t reg, const uint8_t *data, uint8_t len);
+	uint8_t (*read)(uint8_t reg, uint8_t *dst, uint8_t max);
 } regmap_entry_t;
 
 static const ORFA_FLASH regmap_entry_t regmap_table[] = {
-	{ &drv_intro, REGMAP_INTRO_REG },
-#define X(name) { &drv_##name, REGMAP_START_##name },
+	{ drv_intro_init, drv_intro_write, drv_intro_read },
+#define X(name) { drv_##name##_init, drv_##name##_write, drv_##name##_read },
 	ORFA_DRIVER_LIST
 #undef X
 };
 
 #define REGMAP_NDRIVERS ((uint8_t)(sizeof regmap_table / sizeof regmap_table[0]))
+
+/* Start registers on their own: selecting walks bytes, not 7-byte rows. */
+static const ORFA_FLASH uint8_t regmap_starts[] = {
+	REGMAP_INTRO_REG,
+#define X(name) REGMAP_START_##name,
+	ORFA_DRIVER_LIST
+#undef X
+};
+
+/* Introspection records, made by the compiler. */
+#define REGMAP_RECORD(uid, major, minor, start, nregs) \
+	{ (uint8_t)((uid) >> 8), (uint8_t)(uid), major, minor, start, nregs }
+static const ORFA_FLASH uint8_t regmap_records[][REGMAP_RECORD_LEN] = {
+	REGMAP_RECORD(DRV_intro_UID, DRV_intro_MAJOR, DRV_intro_MINOR, REGMAP_INTRO_REG,
+		      DRV_intro_NREGS),
+#define X(name) REGMAP_RECORD(DRV_##name##_UID, DRV_##name##_MAJOR, DRV_##name##_MINOR, \
+			      REGMAP_START_##name, DRV_##name##_NREGS),
+	ORFA_DRIVER_LIST
+#undef X
+};
 
 static struct {
 	uint8_t reg;     /* selected register */
@@ -39,10 +63,7 @@ static struct {
 void regmap_init(void)
 {
 	for (uint8_t i = 0; i < REGMAP_NDRIVERS; i++) {
-		void (*init)(void) = regmap_table[i].drv->init;
-		if (init) {
-			init();
-		}
+		regmap_table[i].init();
 	}
 	rm.reg = REGMAP_INTRO_REG;
 	rm.entry = 0;
@@ -54,9 +75,9 @@ bool regmap_select(uint8_t reg)
 	if (reg >= REGMAP_END) {
 		return false;
 	}
-	uint8_t i = REGMAP_NDRIVERS - 1;
-	while (regmap_table[i].start > reg) {
-		i--;
+	uint8_t i = 0;
+	while (i + 1 < REGMAP_NDRIVERS && regmap_starts[i + 1] <= reg) {
+		i++;
 	}
 	rm.reg = reg;
 	rm.entry = i;
@@ -66,13 +87,12 @@ bool regmap_select(uint8_t reg)
 reg_status_t regmap_write(const uint8_t *data, uint8_t len)
 {
 	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
-	reg_status_t (*write)(uint8_t, const uint8_t *, uint8_t) = e->drv->write;
 	reg_status_t st;
 
-	if (rm.reg == REGMAP_STATUS_REG || !write) {
+	if (rm.reg == REGMAP_STATUS_REG) {
 		st = REG_NOT_WRITABLE;
 	} else {
-		st = write((uint8_t)(rm.reg - e->start), data, len);
+		st = e->write((uint8_t)(rm.reg - regmap_starts[rm.entry]), data, len);
 	}
 	rm.status = st;
 	return st;
@@ -88,12 +108,12 @@ reg_status_t regmap_read(uint8_t *dst, uint8_t n)
 		return REG_OK;
 	}
 	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
-	uint8_t (*read)(uint8_t, uint8_t *, uint8_t) = e->drv->read;
-	uint8_t reg = (uint8_t)(rm.reg - e->start);
+	uint8_t (*read)(uint8_t, uint8_t *, uint8_t) = e->read;
+	uint8_t reg = (uint8_t)(rm.reg - regmap_starts[rm.entry]);
 
 	rm.status = REG_OK;
 	while (n) {
-		uint8_t got = read ? read(reg, dst, n) : 0;
+		uint8_t got = read(reg, dst, n);
 		if (got == 0 || got > n) {
 			rm.status = REG_NOT_READABLE;
 			return REG_NOT_READABLE;
@@ -114,14 +134,10 @@ uint8_t regmap_driver_count(void)
 	return REGMAP_NDRIVERS;
 }
 
-void regmap_driver_record(uint8_t n, uint8_t rec[6])
+void regmap_driver_record(uint8_t n, uint8_t *dst, uint8_t len)
 {
-	const ORFA_FLASH regmap_entry_t *e = &regmap_table[n - 1];
-	const ORFA_FLASH drv_t *d = e->drv;
-	rec[0] = (uint8_t)(d->uid >> 8);
-	rec[1] = (uint8_t)d->uid;
-	rec[2] = d->major;
-	rec[3] = d->minor;
-	rec[4] = e->start;
-	rec[5] = d->nregs;
+	const ORFA_FLASH uint8_t *r = regmap_records[n - 1];
+	for (uint8_t i = 0; i < len; i++) {
+		dst[i] = r[i];
+	}
 }

@@ -29,22 +29,17 @@ typedef enum {
 #define REGMAP_READ_MAX    64
 
 /*
- * A driver. `reg` is the register's offset inside the driver's range.
- * write: applies all of `data` or nothing; returns REG_OK or why not.
- * read: puts up to `max` bytes of the register's data at `dst` and returns how
- *       many; 0 means the register cannot be read. The regmap asks again when
- *       a read frame wants more bytes than one answer gave.
- * Either may be 0 (register never written / never read).
+ * A driver `name` (listed in ORFA_DRIVER_LIST) provides, in its header:
+ *   DRV_name_UID, DRV_name_MAJOR, DRV_name_MINOR, DRV_name_NREGS
+ *   void drv_name_init(void);
+ *   reg_status_t drv_name_write(uint8_t reg, const uint8_t *data, uint8_t len);
+ *       applies all of `data` or nothing; REG_OK or why not
+ *   uint8_t drv_name_read(uint8_t reg, uint8_t *dst, uint8_t max);
+ *       puts up to `max` bytes of the register's data at `dst` and returns
+ *       how many; 0 means the register cannot be read. The regmap asks again
+ *       when a read frame wants more bytes than one answer gave.
+ * `reg` is the register's offset inside the driver's range.
  */
-typedef struct {
-	uint16_t uid;
-	uint8_t major;
-	uint8_t minor;
-	uint8_t nregs;
-	void (*init)(void);
-	reg_status_t (*write)(uint8_t reg, const uint8_t *data, uint8_t len);
-	uint8_t (*read)(uint8_t reg, uint8_t *dst, uint8_t max);
-} drv_t;
 
 /* Calls every driver's init; selects register 0x00; status OK. */
 void regmap_init(void);
@@ -66,7 +61,10 @@ void regmap_set_status(reg_status_t status);
 /* Number of drivers, introspection included. */
 uint8_t regmap_driver_count(void);
 
-/* Driver n (1-based) as [UID hi][UID lo][major][minor][start][count]. */
-void regmap_driver_record(uint8_t n, uint8_t rec[6]);
+#define REGMAP_RECORD_LEN 6
+
+/* The first `len` (<= 6) bytes of driver n's record (n 1-based):
+ * [UID hi][UID lo][major][minor][start][count]. */
+void regmap_driver_record(uint8_t n, uint8_t *dst, uint8_t len);
 
 #endif

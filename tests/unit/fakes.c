@@ -111,13 +111,13 @@ static struct {
 	uint8_t len;
 } fake;
 
-static void fake_init(void)
+void drv_fake_init(void)
 {
 	fake.len = 1;
 	fake.data[0] = 0x5A;
 }
 
-static reg_status_t fake_write(uint8_t reg, const uint8_t *data, uint8_t len)
+reg_status_t drv_fake_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (reg == 1) {
 		return REG_NOT_WRITABLE;
@@ -133,7 +133,7 @@ static reg_status_t fake_write(uint8_t reg, const uint8_t *data, uint8_t len)
 	return REG_OK;
 }
 
-static uint8_t fake_read(uint8_t reg, uint8_t *dst, uint8_t max)
+uint8_t drv_fake_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
 	static const uint8_t ro[3] = { 0x11, 0x22, 0x33 };
 	const uint8_t *src = reg == 0 ? fake.data : ro;
@@ -148,12 +148,3 @@ static uint8_t fake_read(uint8_t reg, uint8_t *dst, uint8_t max)
 	return n;
 }
 
-const drv_t drv_fake = {
-	.uid = 0x0F0F,
-	.major = 2,
-	.minor = 3,
-	.nregs = DRV_fake_NREGS,
-	.init = fake_init,
-	.write = fake_write,
-	.read = fake_read,
-};

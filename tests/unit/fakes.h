@@ -12,7 +12,12 @@
  *   +1: read-only, gives 3 bytes 0x11 0x22 0x33 per answer
  *   +2: write-only, any length */
 #define DRV_fake_NREGS 3
-extern const drv_t drv_fake;
+#define DRV_fake_UID 0x0F0F
+#define DRV_fake_MAJOR 2
+#define DRV_fake_MINOR 3
+void drv_fake_init(void);
+reg_status_t drv_fake_write(uint8_t reg, const uint8_t *data, uint8_t len);
+uint8_t drv_fake_read(uint8_t reg, uint8_t *dst, uint8_t max);
 
 /* Everything the fake bus saw, as text: "S A0+ W00+ R11+ R22- P ". */
 extern char bus_log[4096];
