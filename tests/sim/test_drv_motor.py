@@ -1,0 +1,155 @@
+"""Motor driver (OR-AVR-M32-D; docs/registers.md "Motors"), on the pins:
+PWM1 = PD5 (OC1A), PWM2 = PD4 (OC1B), DIR1 = PB0, DIR2 = PB1."""
+
+import pytest
+
+from conftest import SERVO_FRAME
+
+DRV_BOARDS = ("m32d",)
+PWM_PERIOD = 368                    # F_CPU / 368 = 20.035 kHz
+PWM_PINS = ("D5", "D4")
+DIR_PINS = ("B0", "B1")
+BAD_LENGTH, BAD_VALUE, PIN_BUSY = 0x01, 0x02, 0x03
+
+
+def reg(drv, i=0):
+    return drv.lay["motor"] + i
+
+
+def settle(drv):
+    drv.wait(4 * PWM_PERIOD)
+    since = drv.now()
+    drv.wait(60 * PWM_PERIOD)
+    return since
+
+
+def check_pwm(drv, pin, pwm, since):
+    m = drv.measure(pin, since)
+    if pwm == 0:
+        assert m == {"steady": 0}, (pin, m)
+        assert drv.edges(pin, since) == [], pin
+        assert drv.pin(pin) == (0, "out"), pin
+    elif pwm == 255:
+        assert m == {"steady": 1}, (pin, m)
+        assert drv.edges(pin, since) == [], pin
+    else:
+        assert "high" in m and m["n"] >= 40, (pin, m)
+        assert m["period"][:2] == (PWM_PERIOD, PWM_PERIOD), (pin, m)
+        for high in m["high"][:2]:
+            # docs: duty = PWM/255 within 1/368 (brief: 1/256)
+            assert abs(high / PWM_PERIOD - pwm / 255) <= 1 / 368, (pin, pwm, m)
+
+
+def check_state(drv, pwm1, pwm2, dir1, dir2):
+    since = settle(drv)
+    check_pwm(drv, "D5", pwm1, since)
+    check_pwm(drv, "D4", pwm2, since)
+    assert drv.pin("B0") == (dir1, "out")
+    assert drv.pin("B1") == (dir2, "out")
+    assert drv.rd(reg(drv), 4) == bytes([pwm1, pwm2, dir1, dir2])
+
+
+@pytest.mark.parametrize("pwm", [0, 1, 2, 64, 127, 128, 200, 254, 255])
+def test_pwm_duty_on_both_motors(drv, pwm):
+    drv.wr(reg(drv, 0), bytes([pwm]))
+    drv.wr(reg(drv, 1), bytes([255 - pwm]))
+    check_state(drv, pwm, 255 - pwm, 0, 0)
+
+
+def test_pwm_frequency(drv):
+    drv.wr(reg(drv), bytes([0x80, 0x40]))
+    since = settle(drv)
+    for pin in PWM_PINS:
+        m = drv.measure(pin, since)
+        assert m["period"] == (PWM_PERIOD, PWM_PERIOD, float(PWM_PERIOD)), m
+    # both lines rise together at the timer's BOTTOM
+    r5 = [c for c, l in drv.edges("D5", since) if l == 1]
+    r4 = [c for c, l in drv.edges("D4", since) if l == 1]
+    assert r5[:10] == r4[:10]
+
+
+@pytest.mark.parametrize("dir1, dir2", [(0, 1), (1, 0), (1, 1), (0, 0)])
+def test_direction_lines(drv, dir1, dir2):
+    drv.wr(reg(drv, 2), bytes([dir1, dir2]))
+    check_state(drv, 0, 0, dir1, dir2)
+
+
+def test_four_byte_write_from_the_manual(drv):
+    drv.wr(reg(drv), bytes.fromhex("80600001"))
+    check_state(drv, 0x80, 0x60, 0, 1)
+    assert drv.rd(reg(drv, 1), 3) == bytes.fromhex("600001")    # r..DIR2
+    assert drv.rd(reg(drv, 3), 1) == b"\x01"
+
+
+def test_both_motors_change_in_the_same_period(drv):
+    drv.wr(reg(drv), bytes([50, 200]))
+    drv.wait(10 * PWM_PERIOD)
+    t0 = drv.now()
+    drv.wr(reg(drv), bytes([150, 100]))
+    drv.wait(10 * PWM_PERIOD)
+
+    def first_new(pin, new):
+        want = round(new * PWM_PERIOD / 255)
+        edges = drv.edges(pin, t0)
+        for i, (c, l) in enumerate(edges[:-1]):
+            if l == 1 and abs(edges[i + 1][0] - c - want) <= 1:
+                return c
+        raise AssertionError((pin, edges[:8]))
+    assert first_new("D5", 150) == first_new("D4", 100)
+
+
+@pytest.mark.parametrize("register, data, status", [
+    (0, "8060000100", BAD_LENGTH),      # past DIR2
+    (1, "80600001", BAD_LENGTH),
+    (2, "000000", BAD_LENGTH),
+    (3, "0101", BAD_LENGTH),
+    (2, "02", BAD_VALUE),               # DIR other than 0/1
+    (3, "FF", BAD_VALUE),
+    (0, "10200002", BAD_VALUE),         # atomic: the PWM bytes do not apply
+    (0, "30400100", None),              # (a good write, for contrast below)
+])
+def test_rejected_writes_change_nothing(drv, register, data, status):
+    drv.wr(reg(drv), bytes.fromhex("64C80100"))      # PWM1 100, PWM2 200, DIR1 1
+    check_state(drv, 100, 200, 1, 0)
+    if status is None:
+        drv.wr(reg(drv, register), bytes.fromhex(data))
+        check_state(drv, 0x30, 0x40, 1, 0)
+        return
+    t0 = drv.now()
+    drv.wr_refused(reg(drv, register), bytes.fromhex(data), status)
+    check_state(drv, 100, 200, 1, 0)
+    for pin in DIR_PINS:
+        assert drv.edges(pin, t0) == [], pin
+
+
+def test_servo_14_15_borrow_stopped_motor_lines(drv):
+    """A stopped motor lends its PWM line to servo 14 (PD5) / 15 (PD4);
+    while the servo pulses, a non-zero PWM for that motor is refused (03);
+    turning the servo on while the motor runs is refused too; turning the
+    servo off gives the line back to the stopped motor (low)."""
+    sp = drv.lay["servo"] + 1
+    drv.wr(sp, bytes([14, 0x05, 0xDC]))                       # servo 14: 1500 us
+    drv.wait(2 * SERVO_FRAME + 8192)
+    since = drv.now()
+    drv.wr_refused(reg(drv, 0), b"\x01", PIN_BUSY)                # motor 1 refused
+    drv.wr_refused(reg(drv), bytes.fromhex("01400000"), PIN_BUSY)  # all four refused
+    drv.wr(reg(drv, 1), b"\x80")                                 # motor 2 runs
+    drv.wr(reg(drv, 0), b"\x00")                                 # PWM1 0 is fine
+    drv.wait(5 * SERVO_FRAME)
+    m = drv.measure("D5", since)
+    assert abs(m["high"][0] - 11059.2) <= 8 and abs(m["high"][1] - 11059.2) <= 8, m
+    assert m["period"][0] >= SERVO_FRAME - 147, m
+    assert drv.rd(reg(drv), 4) == bytes([0, 0x80, 0, 0])
+    check_pwm(drv, "D4", 0x80, since)
+    # servo 15 while motor 2 runs: refused, whole write
+    drv.wr_refused(sp, bytes([13, 0x05, 0xDC, 15, 0x05, 0xDC]), PIN_BUSY)
+    assert drv.rd(sp, 32)[26:32] == bytes([0, 0, 0x05, 0xDC, 0, 0])
+    # servo 14 off: PD5 goes back to the stopped motor, low
+    drv.wr(sp, bytes([14, 0, 0]))
+    drv.wait(2 * SERVO_FRAME + 8192)
+    t1 = drv.now()
+    drv.wait(3 * SERVO_FRAME)
+    assert drv.edges("D5", t1) == []
+    assert drv.pin("D5") == (0, "out")
+    drv.wr(reg(drv, 0), b"\x80")                                 # motor 1 may run again
+    check_state(drv, 0x80, 0x80, 0, 0)
