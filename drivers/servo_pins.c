@@ -1,8 +1,11 @@
 /*
  * Servo pulses on ordinary port pins (M32-D: one pin per channel).
  *
- * Channel n's pulse starts SERVO_SLOT * n cycles into each 20 ms frame, so
- * at most a few pulses overlap and their edges rarely meet. Every edge is
+ * Channel n's pulse starts about SERVO_SLOT * n cycles into each 20 ms frame,
+ * so at most a few pulses overlap. Where an edge would come within SERVO_GAP
+ * cycles of another channel's edge, the schedule moves that channel's whole
+ * pulse a little (its width and period stay exact): the interrupt needs that
+ * much time between two edges to make each at its cycle. Every edge is
  * written by the Timer2 compare interrupt at an exact CPU cycle: Timer2
  * (clk/8) wakes the interrupt about SERVO_LEAD cycles early (more than any
  * other interrupt plus this one's entry can delay it), the interrupt waits on
@@ -33,14 +36,18 @@
 #define SERVO_FINE   96        /* last stretch, waited on Timer0 */
 #define SERVO_EDGES  (2 * SERVO_CHANNELS)
 #define SERVO_FALL   0x80      /* edge code: channel | SERVO_FALL */
+#define SERVO_GAP    400       /* least distance between two edges, cycles */
+#define SERVO_SHIFT  32        /* unit of a channel's move, cycles */
+#define SERVO_MOVES  96        /* most units a channel moves either way */
 
-_Static_assert(SERVO_SLOT * (SERVO_CHANNELS - 1) + 18432UL + 1000UL < SERVO_FRAME,
-	       "the last channel's longest pulse ends inside the frame");
+_Static_assert(SERVO_SLOT * (SERVO_CHANNELS - 1) + SERVO_SHIFT * SERVO_MOVES + 18432UL + 1000UL
+	       < SERVO_FRAME, "the last channel's longest pulse ends inside the frame");
 
 typedef struct {
 	uint8_t n;                        /* edges in this frame */
 	uint8_t edge[SERVO_EDGES];        /* sorted by time */
-	uint16_t width[SERVO_CHANNELS];   /* cycles */
+	uint16_t delta[SERVO_EDGES];      /* cycles after the edge before (the
+					   * first: after the frame's start) */
 } servo_sched_t;
 
 static struct {
@@ -71,16 +78,6 @@ static const __flash uint32_t slot_start[SERVO_CHANNELS] = {
 #undef S
 };
 _Static_assert(SERVO_CHANNELS == 16, "slot_start lists 16 channels");
-
-static uint32_t edge_time(const servo_sched_t *s, uint8_t e)
-{
-	uint8_t ch = e & (uint8_t)~SERVO_FALL;
-	uint32_t t = slot_start[ch];
-	if (e & SERVO_FALL) {
-		t += s->width[ch];
-	}
-	return t;
-}
 
 /* Timer2 ticks (8 cycles) as a 16-bit count: edges are never more than a
  * frame (18432 ticks) ahead, so 16-bit differences order them. */
@@ -135,9 +132,18 @@ ISR(TIMER2_COMP_vect)
 
 		/* Near the edge on Timer2, then to its cycle on Timer0; the write
 		 * takes the same instructions for rising and falling edges. */
-		while ((int16_t)(fine_from - servo_ticks()) > 0) {
-		}
-		while ((int8_t)(TCNT0 - lo) < 0) {
+		/* Already past the edge (it should not happen): make it now rather
+		 * than wait for Timer0 to come round again. */
+		if ((int16_t)(fine_from - servo_ticks()) > -(SERVO_FINE / 8)) {
+			while ((int16_t)(fine_from - servo_ticks()) > 0) {
+			}
+			/* 4 cycles a turn (C made it 8): edges within 3 cycles. */
+			__asm__ __volatile__(
+				"1:	in __tmp_reg__, %[tcnt]\n"
+				"	sub __tmp_reg__, %[lo]\n"
+				"	brmi 1b\n"
+				:
+				: [tcnt] "I" (_SFR_IO_ADDR(TCNT0)), [lo] "r" (lo));
 		}
 		*reg = (uint8_t)((*reg & and_mask) | or_mask);
 
@@ -145,6 +151,7 @@ ISR(TIMER2_COMP_vect)
 			/* Frame done: take a newer schedule over, start the next. */
 			sv.next = 0;
 			sv.frame += SERVO_FRAME;
+			sv.target = sv.frame;
 			if (sv.pending) {
 				sv.active ^= 1;
 				sv.pending = 0;
@@ -156,7 +163,7 @@ ISR(TIMER2_COMP_vect)
 				}
 			}
 		}
-		sv.target = sv.frame + edge_time(s, s->edge[sv.next]);
+		sv.target += s->delta[sv.next];
 		if (servo_arm()) {
 			return;
 		}
@@ -213,23 +220,51 @@ static uint16_t servo_cycles(uint16_t us)
 	return (uint16_t)(((uint32_t)us * (F_CPU / 1000UL) + 500UL) / 1000UL);
 }
 
+/* Whether an edge at `t` keeps SERVO_GAP from the `n` edges in `when`. */
+static bool servo_clear_of(uint32_t t, const uint32_t *when, uint8_t n)
+{
+	for (uint8_t i = 0; i < n; i++) {
+		uint32_t d = t > when[i] ? t - when[i] : when[i] - t;
+		if (d < SERVO_GAP) {
+			return false;
+		}
+	}
+	return true;
+}
+
 void servo_hw_apply(const uint16_t *widths_us)
 {
 	sv.pending = 0;  /* the interrupt must not take the buffer half written */
 	servo_sched_t *s = &sv.sched[sv.active ^ 1];
+	uint32_t when[SERVO_EDGES];
 	uint8_t n = 0;
+
+	/* Place the channels one by one, each clear of those placed before:
+	 * moves tried 0, +1, -1, +2, ... (never before the frame's start). */
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		s->width[ch] = servo_cycles(widths_us[ch]);
-		if (widths_us[ch]) {
-			s->edge[n++] = ch;
-			s->edge[n++] = ch | SERVO_FALL;
+		if (!widths_us[ch]) {
+			continue;
 		}
+		uint16_t width = servo_cycles(widths_us[ch]);
+		uint32_t rise = slot_start[ch];
+		for (int16_t k = 0; k <= 2 * SERVO_MOVES; k++) {
+			int16_t move = (k & 1) ? -(k + 1) / 2 : k / 2;
+			int32_t r = (int32_t)slot_start[ch] + (int32_t)move * SERVO_SHIFT;
+			if (r >= 0 && servo_clear_of((uint32_t)r, when, n)
+			    && servo_clear_of((uint32_t)r + width, when, n)) {
+				rise = (uint32_t)r;
+				break;
+			}
+		}
+		s->edge[n] = ch;
+		when[n++] = rise;
+		s->edge[n] = ch | SERVO_FALL;
+		when[n++] = rise + width;
 	}
 	/* Insertion sort by time: at most 32 edges, run only on a change. */
-	uint32_t when[SERVO_EDGES];
-	for (uint8_t i = 0; i < n; i++) {
+	for (uint8_t i = 1; i < n; i++) {
 		uint8_t e = s->edge[i];
-		uint32_t t = edge_time(s, e);
+		uint32_t t = when[i];
 		uint8_t j = i;
 		while (j > 0 && when[j - 1] > t) {
 			s->edge[j] = s->edge[j - 1];
@@ -238,6 +273,9 @@ void servo_hw_apply(const uint16_t *widths_us)
 		}
 		s->edge[j] = e;
 		when[j] = t;
+	}
+	for (uint8_t i = 0; i < n; i++) {
+		s->delta[i] = (uint16_t)(when[i] - (i ? when[i - 1] : 0));
 	}
 	s->n = n;
 
@@ -249,7 +287,7 @@ void servo_hw_apply(const uint16_t *widths_us)
 			sv.active ^= 1;
 			sv.next = 0;
 			sv.frame = ((uint32_t)servo_ticks() << 3) + 4096;
-			sv.target = sv.frame + edge_time(s, s->edge[0]);
+			sv.target = sv.frame + s->delta[0];
 			servo_arm();
 			sv.running = 1;
 			/* (No TIFR write: simavr 1.6 clears every flag on one.) */

@@ -199,7 +199,7 @@ static void cmd_spi(control_t *c, reply_t *r)
 static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
-	"stack [FROM] | signals | help";
+	"stack [FROM] | peek ADDR [LEN] | signals | help";
 
 int control_request(control_t *c, const char *line, char **out, size_t *len,
 		    size_t *cap, uint64_t *wait_until)
@@ -247,6 +247,17 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 		}
 		rp(&r, "peak %d deepest 0x%04X ramend 0x%04X", peak, (unsigned)deepest,
 		   (unsigned)avr->ramend);
+	} else if (!strcasecmp(cmd, "peek") && (argc == 2 || argc == 3)) {
+		uint64_t addr, n = 1;
+
+		if (parse_u64(argv[1], &addr) < 0 || (argc == 3 && parse_u64(argv[2], &n) < 0) ||
+		    n == 0 || n > 64 || addr + n > (uint64_t)avr->ramend + 1) {
+			rp(&r, "ERR peek ADDR [LEN]: data address and 1..64 bytes, decimal");
+			return 0;
+		}
+		for (uint64_t i = 0; i < n; i++) {
+			rp(&r, "%02X", avr->data[addr + i]);
+		}
 	} else if (!strcasecmp(cmd, "wait") && argc == 2) {
 		if (parse_u64(argv[1], &u) < 0 || u > (1ull << 40)) {
 			rp(&r, "ERR wait N: N cycles, decimal");

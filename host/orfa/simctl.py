@@ -138,3 +138,7 @@ class SimControl:
         __heap_start, minus 0x800000); 0 lets the simulator guess."""
         words = self.request("stack %d" % heap_start).split()
         return {"peak": int(words[1]), "deepest": int(words[3], 16), "ramend": int(words[5], 16)}
+
+    def peek(self, addr: int, n: int = 1) -> bytes:
+        """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
+        return bytes.fromhex(self.request("peek %d %d" % (addr, n)))
