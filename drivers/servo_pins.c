@@ -31,7 +31,7 @@
 
 #define SERVO_FRAME  147456UL  /* 20 ms at 7.3728 MHz */
 #define SERVO_SLOT   8191UL    /* between channel starts: 1.111 ms */
-#define SERVO_LEAD   320       /* wake-up before an edge, cycles */
+#define SERVO_LEAD   480       /* wake-up before an edge, cycles */
 #define SERVO_NEAR   (SERVO_LEAD + 80)  /* closer than this: wait in place */
 #define SERVO_FINE   96        /* last stretch, waited on Timer0 */
 #define SERVO_EDGES  (2 * SERVO_CHANNELS)
