@@ -69,6 +69,13 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 			servo_hw_claim(ch);
 		}
 	}
+	uint8_t changed = 0;
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		changed |= (uint8_t)(next[ch] != servo.width[ch]);
+	}
+	if (!changed) {
+		return REG_OK;  /* the pulses already are so: no new schedule */
+	}
 	servo_hw_apply(next);
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
 		if (!next[ch] && servo.width[ch]) {

@@ -60,6 +60,8 @@ static struct {
 	uint32_t target;             /* Timer0 cycle of the next edge */
 	volatile uint16_t wraps;     /* Timer2 overflows */
 	uint8_t t0_offset;           /* TCNT0 - 8 * TCNT2, measured at start */
+	int8_t move[SERVO_CHANNELS]; /* each channel's place: SERVO_SHIFTs off its slot */
+	uint16_t width[SERVO_CHANNELS];  /* cycles, as last planned; 0 = off */
 } sv;
 
 /* Each channel's pin (PIN_ID), from the board's pin map. */
@@ -214,18 +216,26 @@ void servo_hw_release(uint8_t ch)
 	pins_release(board_pin(BF_SERVO, ch), PIN_SERVO);
 }
 
-/* Cycles for a width in microseconds, rounded to the nearest. */
+/* Cycles for a width in microseconds, rounded to the nearest: us * 7.3728
+ * as a 16.16 fixed-point product (a division took 600 cycles a channel). */
+#define SERVO_CYCLES_PER_US_Q16 ((uint32_t)((F_CPU * 65536ULL + 500000ULL) / 1000000ULL))
 static uint16_t servo_cycles(uint16_t us)
 {
-	return (uint16_t)(((uint32_t)us * (F_CPU / 1000UL) + 500UL) / 1000UL);
+	return (uint16_t)(((uint32_t)us * SERVO_CYCLES_PER_US_Q16 + 32768UL) >> 16);
 }
 
-/* Whether an edge at `t` keeps SERVO_GAP from the `n` edges in `when`. */
-static bool servo_clear_of(uint32_t t, const uint32_t *when, uint8_t n)
+/* Edge times in the planning are kept in 8-cycle units, 16 bits: a frame is
+ * 18432 of them, and edges SERVO_GAP apart stay apart. */
+#define SERVO_GAP8 (SERVO_GAP / 8)
+
+/* Whether an edge at `t8` keeps SERVO_GAP from the edges in `at8`, except
+ * those of channel `self`. */
+static bool servo_clear_of(uint16_t t8, const uint16_t *at8, const uint8_t *edge, uint8_t n,
+			   uint8_t self)
 {
 	for (uint8_t i = 0; i < n; i++) {
-		uint32_t d = t > when[i] ? t - when[i] : when[i] - t;
-		if (d < SERVO_GAP) {
+		int16_t d = (int16_t)(t8 - at8[i]);
+		if ((edge[i] & (uint8_t)~SERVO_FALL) != self && d < SERVO_GAP8 && d > -SERVO_GAP8) {
 			return false;
 		}
 	}
@@ -236,46 +246,73 @@ void servo_hw_apply(const uint16_t *widths_us)
 {
 	sv.pending = 0;  /* the interrupt must not take the buffer half written */
 	servo_sched_t *s = &sv.sched[sv.active ^ 1];
-	uint32_t when[SERVO_EDGES];
+	uint16_t at8[SERVO_EDGES];
+	uint16_t *width = sv.width;
+	uint16_t changed = 0;
 	uint8_t n = 0;
 
-	/* Place the channels one by one, each clear of those placed before:
-	 * moves tried 0, +1, -1, +2, ... (never before the frame's start). */
+	/* Every pulsing channel at its last place: a write changes few, and
+	 * only the changed ones are placed again. */
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		if (!widths_us[ch]) {
+		uint16_t w = widths_us[ch] ? servo_cycles(widths_us[ch]) : 0;
+		if (w != width[ch]) {
+			width[ch] = w;
+			changed |= (uint16_t)(1u << ch);
+		}
+		if (w) {
+			uint32_t rise = slot_start[ch] + (int32_t)sv.move[ch] * SERVO_SHIFT;
+			s->edge[n] = ch;
+			at8[n++] = (uint16_t)(rise >> 3);
+			s->edge[n] = ch | SERVO_FALL;
+			at8[n++] = (uint16_t)((rise + w) >> 3);
+		}
+	}
+	/* A changed channel whose edges come too close to another's moves:
+	 * tries 0, +1, -1, +2, ... SERVO_SHIFTs from its slot (never before
+	 * the frame's start), its width and period unchanged. The others were
+	 * clear of each other already. */
+	for (uint8_t i = 0; i < n; i += 2) {
+		uint8_t ch = s->edge[i];
+		if (!(changed & (1u << ch))) {
 			continue;
 		}
-		uint16_t width = servo_cycles(widths_us[ch]);
-		uint32_t rise = slot_start[ch];
 		for (int16_t k = 0; k <= 2 * SERVO_MOVES; k++) {
-			int16_t move = (k & 1) ? -(k + 1) / 2 : k / 2;
+			int8_t move = (int8_t)((k & 1) ? -(k + 1) / 2 : k / 2);
 			int32_t r = (int32_t)slot_start[ch] + (int32_t)move * SERVO_SHIFT;
-			if (r >= 0 && servo_clear_of((uint32_t)r, when, n)
-			    && servo_clear_of((uint32_t)r + width, when, n)) {
-				rise = (uint32_t)r;
+			uint16_t r8 = (uint16_t)(r >> 3);
+			uint16_t f8 = (uint16_t)((r + width[ch]) >> 3);
+			if (r >= 0 && servo_clear_of(r8, at8, s->edge, n, ch)
+			    && servo_clear_of(f8, at8, s->edge, n, ch)) {
+				sv.move[ch] = move;
+				at8[i] = r8;
+				at8[i + 1] = f8;
 				break;
 			}
 		}
-		s->edge[n] = ch;
-		when[n++] = rise;
-		s->edge[n] = ch | SERVO_FALL;
-		when[n++] = rise + width;
 	}
-	/* Insertion sort by time: at most 32 edges, run only on a change. */
+	/* Insertion sort by time: at most 32 edges. */
 	for (uint8_t i = 1; i < n; i++) {
 		uint8_t e = s->edge[i];
-		uint32_t t = when[i];
+		uint16_t t = at8[i];
 		uint8_t j = i;
-		while (j > 0 && when[j - 1] > t) {
+		while (j > 0 && at8[j - 1] > t) {
 			s->edge[j] = s->edge[j - 1];
-			when[j] = when[j - 1];
+			at8[j] = at8[j - 1];
 			j--;
 		}
 		s->edge[j] = e;
-		when[j] = t;
+		at8[j] = t;
 	}
+	/* Exact cycles from here on: each edge after the one before. */
+	uint32_t prev = 0;
 	for (uint8_t i = 0; i < n; i++) {
-		s->delta[i] = (uint16_t)(when[i] - (i ? when[i - 1] : 0));
+		uint8_t ch = s->edge[i] & (uint8_t)~SERVO_FALL;
+		uint32_t t = slot_start[ch] + (int32_t)sv.move[ch] * SERVO_SHIFT;
+		if (s->edge[i] & SERVO_FALL) {
+			t += width[ch];
+		}
+		s->delta[i] = (uint16_t)(t - prev);
+		prev = t;
 	}
 	s->n = n;
 

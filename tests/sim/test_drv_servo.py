@@ -118,12 +118,11 @@ def test_m128s_long_counter_frame_stretches(drv):
 
 # --- under load on the serial line ------------------------------------------------
 
-def load_requests(drv, count):
+def load_requests(drv, count, w0):
     """Requests in one write, each reply no longer than its request; some
     rewrite channel 0's width (same value), some are RS writes (no effect)."""
     lay = drv.lay
     reqs, replies = [], []
-    w0 = 600
     for i in range(count):
         k = i % 5
         if k == 0:
@@ -154,7 +153,7 @@ def test_widths_under_uart_load(drv):
         widths = {ch: 600 + 50 * ch for ch in channels(drv)}
     set_widths(drv, widths)
     drv.wait(3 * SERVO_FRAME)
-    reqs, replies = load_requests(drv, 300)
+    reqs, replies = load_requests(drv, 300, widths[0])
     mark = drv.mark()
     t0 = drv.now()
     drv.gw.send(b"".join(r + b"\n" for r in reqs))
