@@ -334,3 +334,55 @@ def drv(drv_sim):
     bench.restore()
     resets = bench.events(mark, ["reset"])
     assert resets == [], "the MCU reset during the test: %r" % resets
+
+
+# --- known defects (open work of issue 3) -----------------------------------
+# Each entry marks tests that fail today for a reason written down here and in
+# the issue's notes. strict: the test fails every run, so an XPASS (the defect
+# gone) fails the suite until the entry is removed. Not strict: the failure
+# comes and goes (timing), so it may pass.
+KNOWN_DEFECTS = [
+    ("tests/sim/test_drv_motor.py::test_pwm_duty_on_both_motors", True,
+     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
+     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
+     "datasheet)"),
+    ("tests/sim/test_drv_motor.py::test_four_byte_write_from_the_manual", True,
+     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
+     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
+     "datasheet)"),
+    ("tests/sim/test_drv_motor.py::test_both_motors_change_in_the_same_period", True,
+     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
+     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
+     "datasheet)"),
+    ("tests/sim/test_drv_motor.py::test_rejected_writes_change_nothing", True,
+     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
+     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
+     "datasheet)"),
+    ("tests/sim/test_drv_motor.py::test_servo_14_15_borrow_stopped_motor_lines", True,
+     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
+     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
+     "datasheet)"),
+    ("tests/sim/test_drv_servo.py::test_m32d_servo_on_an_adc_line_is_refused", False,
+     "M32-D: with an ADC channel converting, servo widths come out ~24 cycles short; "
+     "the firmware's own Timer0 view says its edges are exact, cause not found yet"),
+    ("tests/sim/test_drv_servo.py::test_width_on_every_channel[m128s", False,
+     "M128-S: now and then a CD4017 counter skips a slot (about every 32 frames)"),
+    ("tests/sim/test_drv_servo.py::test_widths_under_uart_load[m128s", False,
+     "M128-S: now and then a CD4017 counter skips a slot (about every 32 frames)"),
+    ("tests/sim/test_drv_servo.py::test_widths_while_the_adc_converts[m128s", False,
+     "M128-S: now and then a CD4017 counter skips a slot (about every 32 frames)"),
+    ("tests/sim/test_drv_servo.py::test_m128s_off_channel_on_a_running_counter", False,
+     "M128-S: the off slots of a running counter last 87 us with one counter and up "
+     "to 1.1 ms with several (interrupt latency): both outside the documented 90-125 us"),
+    ("tests/sim/test_drv_spi.py::test_clock_polarity_mismatch_works_like_the_other_phase", True,
+     "simulator vs docs: a CPOL mismatch (mode 3 against a mode-0 device) reads one "
+     "bit shifted, docs/simulator.md says it behaves like the other CPHA"),
+]
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        for prefix, strict, reason in KNOWN_DEFECTS:
+            if item.nodeid.startswith(prefix):
+                item.add_marker(pytest.mark.xfail(reason=reason, strict=strict))
+                break
