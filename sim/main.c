@@ -66,7 +66,7 @@ static void sim_on_signal(int sig)
 static void sim_usage(void)
 {
 	fprintf(stderr,
-		"usage: orfa-sim --board %s --link PATH [--eeprom ADDR]...\n"
+		"usage: orfa-sim --board %s --link PATH [--eeprom ADDR[:wp]]...\n"
 		"                [--trace FILE] [--no-idle-throttle] [--control PATH]\n"
 		"                [--vcd FILE] [--spi KIND@PIN[:mode=N][:lsb]]...\n"
 		"                [--adc CH=MV]... [--avcc MV] [--aref MV] FIRMWARE.elf\n",
@@ -164,6 +164,7 @@ static uint32_t sim_activity(const sim_t *sim)
 typedef struct sim_args_t {
 	const char *link, *trace, *firmware, *control, *vcd;
 	uint8_t eeprom_addr[SIM_MAX_EEPROMS];
+	uint8_t eeprom_wp[SIM_MAX_EEPROMS];
 	int eeprom_count;
 	const char *spi[SIM_MAX_SPI];
 	int spi_count;
@@ -220,9 +221,24 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		case 'l':
 			args->link = optarg;
 			break;
-		case 'e':
+		case 'e': {
+			/* ADDR or ADDR:wp (write-protected: data bytes NACKed) */
+			char addr[16];
+			const char *colon = strchr(optarg, ':');
+			size_t alen = colon ? (size_t)(colon - optarg) : strlen(optarg);
+			int wp = colon && !strcmp(colon, ":wp");
+
+			if (alen >= sizeof(addr) || (colon && !wp)) {
+				fprintf(stderr, "orfa-sim: bad --eeprom '%s' (ADDR or ADDR:wp)\n", optarg);
+				return 2;
+			}
+			memcpy(addr, optarg, alen);
+			addr[alen] = 0;
+			if (args->eeprom_count < SIM_MAX_EEPROMS) {
+				args->eeprom_wp[args->eeprom_count] = (uint8_t)wp;
+			}
 			if (args->eeprom_count == SIM_MAX_EEPROMS ||
-			    sim_parse_addr(optarg, &args->eeprom_addr[args->eeprom_count]) < 0) {
+			    sim_parse_addr(addr, &args->eeprom_addr[args->eeprom_count]) < 0) {
 				fprintf(stderr, "orfa-sim: bad or too many --eeprom '%s'"
 					" (an even 8-bit address like 0xA0)\n", optarg);
 				return 2;
@@ -235,6 +251,7 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 			}
 			args->eeprom_count++;
 			break;
+		}
 		case 't':
 			args->trace = optarg;
 			break;
@@ -326,6 +343,7 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	twi_bus_init(&sim->bus, &sim->trace);
 	for (int i = 0; i < args->eeprom_count; i++) {
 		eeprom24_init(&sim->eeprom[i], args->eeprom_addr[i]);
+		sim->eeprom[i].write_protect = args->eeprom_wp[i];
 		twi_bus_attach(&sim->bus, &sim->eeprom[i].dev);
 	}
 	usart_init(&sim->usart, sim->avr, &sim->mcu->usart[sim->board->host_usart],

@@ -26,6 +26,9 @@ static int eeprom24_write(twi_dev_t *dev, uint8_t byte)
 		e->ptr = byte;
 		return 1;
 	}
+	if (e->write_protect) {
+		return 0;	/* like the AT24C parts with WP high: data NACKed */
+	}
 	e->mem[e->ptr] = byte;
 	/* The counter's low bits roll over inside the page while writing. */
 	e->ptr = (uint8_t)((e->ptr & ~(EEPROM24_PAGE - 1)) |

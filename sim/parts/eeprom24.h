@@ -21,6 +21,7 @@ typedef struct eeprom24_t {
 	uint8_t ptr;			/* word address counter */
 	uint8_t selected;		/* addressed since the last START */
 	uint8_t want_word_addr;		/* next written byte is the word address */
+	uint8_t write_protect;		/* WP high: data bytes are not acknowledged */
 } eeprom24_t;
 
 /* Erased (FF) EEPROM answering at ADDR8 (0xA0). */

@@ -15,6 +15,8 @@ from orfa.gateway import Gateway
 from orfa.sim import BOARDS, BUILD_HINT, SimBoard, missing_builds
 
 EEPROM = 0xA0
+EEPROM_WP = 0xA6         # write-protected 24C02: acknowledges its address and
+                         # the word address, not the data bytes
 #: Wall-clock seconds a reply may take (the simulator runs faster than real time).
 REPLY_TIMEOUT = 5.0
 
@@ -128,7 +130,9 @@ class Bench:
 @pytest.fixture(scope="module", params=BOARDS)
 def bench(request):
     require_builds([request.param])
-    sim = SimBoard(request.param, eeproms=(EEPROM,), trace=True)
+    # and a write-protected one that refuses data bytes (ERROR 07)
+    sim = SimBoard(request.param, eeproms=(EEPROM,), trace=True,
+                   extra_args=("--eeprom", "0x%02X:wp" % EEPROM_WP))
     sim.start()
     b = Bench(sim)
     try:

@@ -164,3 +164,28 @@ def test_bus_clock_from_the_trace(board, khz):
     assert min(gaps) >= 9 * period, gaps
     # the firmware reacts within 200 cycles, far less than the next slower clock
     assert max(gaps) < 9 * period + 200, gaps
+
+
+def test_data_byte_not_acknowledged(board):
+    """ERROR 07: the device took its address and the word address, refused
+    the data byte; STOP follows at once and only the error is replied."""
+    mark = board.mark()
+    assert board.ask("S A6 10 55 66 P") == b"ERROR 07\r\n"
+    assert board.bus(mark) == [
+        ("start",), ("addr", "A6", "ack"), ("write", "10", "ack"),
+        ("write", "55", "nack"), ("stop",)]
+
+
+def test_data_nack_after_an_earlier_frame(board):
+    """Frames before the failing one took effect (as on any I2C bus); the
+    reply is only the error."""
+    board.eeprom_write(AREA + 40, b"\x00")
+    mark = board.mark()
+    assert board.ask("S A0 %02X 77 S A6 10 55 P" % (AREA + 40)) == b"ERROR 07\r\n"
+    assert board.bus(mark) == [
+        ("start",), ("addr", "A0", "ack"), ("write", "%02X" % (AREA + 40), "ack"),
+        ("write", "77", "ack"), ("start",), ("addr", "A6", "ack"), ("write", "10", "ack"),
+        ("write", "55", "nack"), ("stop",)]
+    assert board.eeprom_read(AREA + 40, 1) == b"\x77"
+    # and the protected part still reads
+    assert board.ask("S A6 10 S A7 01 P") == b"SWASRFFP\r\n"
