@@ -120,6 +120,13 @@ static void run_i2c(sg_parser_t *p)
 	out_end();
 }
 
+void sg_exec_lost(const sg_parser_t *p)
+{
+	for (uint8_t i = 0; i < p->lost; i++) {
+		out_error(SG_ERR_DATA);
+	}
+}
+
 void sg_exec_init(void)
 {
 	gate.local = SG_LOCAL_DEFAULT;

@@ -22,4 +22,7 @@ void sg_exec_init(void);
 /* Runs the request the parser just completed (or replies its error). */
 void sg_exec(sg_parser_t *p);
 
+/* After SG_LOST: ERROR 04 for each request the receive buffer lost. */
+void sg_exec_lost(const sg_parser_t *p);
+
 #endif

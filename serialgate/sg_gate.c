@@ -29,7 +29,10 @@ void front_poll(void)
 	if (c < 0) {
 		return;
 	}
-	if (sg_parse_char(&parser, (uint8_t)c) == SG_REQUEST) {
+	sg_event_t ev = sg_parse_char(&parser, (uint8_t)c);
+	if (ev == SG_REQUEST) {
 		sg_exec(&parser);
+	} else if (ev == SG_LOST) {
+		sg_exec_lost(&parser);
 	}
 }

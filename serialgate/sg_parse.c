@@ -175,6 +175,31 @@ static sg_event_t end_line(sg_parser_t *p)
 	return SG_REQUEST;
 }
 
+/* The record after a lost-run marker. Every line whose end was lost is
+ * answered ERROR 04 now (the line in progress first, if it had something);
+ * the line going on after the run is refused too if it lost its start. */
+static sg_event_t lost_run(sg_parser_t *p, uint8_t info)
+{
+	uint8_t lines = info & SG_LOST_LINES;
+	p->lost_info = 0;
+	if (lines == 0) {
+		/* The run lies inside the line in progress. */
+		if (p->state == ST_BEGIN) {
+			sg_parse_init(p);
+		}
+		p->err = SG_ERR_DATA;
+		p->state = ST_ERROR;
+		return SG_MORE;
+	}
+	p->lost = lines;
+	sg_parse_init(p);
+	if (info & SG_LOST_TAIL) {
+		p->err = SG_ERR_DATA;
+		p->state = ST_ERROR;
+	}
+	return SG_LOST;
+}
+
 void sg_parse_init(sg_parser_t *p)
 {
 	p->state = ST_BEGIN;
@@ -185,10 +210,14 @@ void sg_parse_init(sg_parser_t *p)
 	p->nbytes = 0;
 	p->frame = 0;
 	p->reply_len = 0;
+	p->lost_info = 0;
 }
 
 sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 {
+	if (p->lost_info) {
+		return lost_run(p, c);
+	}
 	if (c == '\r' || c == '\n') {
 		return end_line(p);
 	}
@@ -196,9 +225,7 @@ sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 		sg_parse_init(p);
 	}
 	if (c == SG_CHAR_LOST) {
-		/* Characters were lost here: whatever the line was, it is refused. */
-		p->err = SG_ERR_DATA;
-		p->state = ST_ERROR;
+		p->lost_info = 1;
 		return SG_MORE;
 	}
 	if (p->state == ST_COMMENT || p->state == ST_ERROR) {

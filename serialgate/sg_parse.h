@@ -29,8 +29,11 @@ typedef enum {
  * and read bytes 2 reply characters each, so the limits bound this. */
 #define SG_BUF_SIZE   128
 
-/* Null marker the UART puts where it lost characters. */
+/* Marker the UART puts where it lost characters, followed by one byte:
+ * bits 0-6 the line ends lost, bit 7 the line going on lost characters. */
 #define SG_CHAR_LOST  0x80
+#define SG_LOST_LINES 0x7F
+#define SG_LOST_TAIL  0x80
 
 typedef enum {
 	SG_CMD_NONE = 0,
@@ -46,6 +49,8 @@ typedef enum {
 	SG_MORE = 0,     /* the line goes on */
 	SG_IGNORED,      /* an empty line or a comment ended: no reply */
 	SG_REQUEST,      /* a request ended: execute it, or reply its error */
+	SG_LOST,         /* `lost` requests were lost whole or in part: reply
+			  * ERROR 04 to each */
 } sg_event_t;
 
 typedef struct {
@@ -57,6 +62,8 @@ typedef struct {
 	uint8_t nbytes;     /* bytes used in buf */
 	uint8_t frame;      /* index in buf of the current frame's [addr] */
 	uint8_t reply_len;  /* length of the reply this request will have */
+	uint8_t lost;       /* after SG_LOST: how many ERROR 04 to reply */
+	uint8_t lost_info;  /* the next character is the lost-run record */
 	uint8_t buf[SG_BUF_SIZE];
 } sg_parser_t;
 

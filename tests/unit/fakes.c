@@ -9,7 +9,7 @@
 
 char bus_log[4096];
 uint8_t eeprom[256];
-char out_buf[4096];
+char out_buf[65536];
 unsigned out_len;
 
 static struct {

@@ -24,7 +24,7 @@ extern char bus_log[4096];
 /* Fake 24C02 at 0xA0. */
 extern uint8_t eeprom[256];
 /* Reply characters sent by the executor. */
-extern char out_buf[4096];
+extern char out_buf[65536];
 extern unsigned out_len;
 
 void fakes_reset(void);

@@ -37,8 +37,11 @@ static void boot(void)
 static void feed(const char *in, size_t n)
 {
 	for (size_t i = 0; i < n; i++) {
-		if (sg_parse_char(&parser, (uint8_t)in[i]) == SG_REQUEST) {
+		sg_event_t ev = sg_parse_char(&parser, (uint8_t)in[i]);
+		if (ev == SG_REQUEST) {
 			sg_exec(&parser);
+		} else if (ev == SG_LOST) {
+			sg_exec_lost(&parser);
 		}
 	}
 }
@@ -267,10 +270,28 @@ static void test_limits(void)
 static void test_lost_characters(void)
 {
 	boot();
-	char in[] = "S A0 00 12 \x80 P\rV\r";
+	/* a run lost inside one line: that line is refused, the next is fine */
+	char in[] = "S A0 00 12 \x80\x80 P\rV\r";
 	expect(in, "ERROR 04\r\nV1.1\r\n", "");
-	char in2[] = "#comment\x80V\rV\r";
-	expect(in2, "ERROR 04\r\nV1.1\r\n", "");
+	/* the run ate the end of "S A0 00" and two whole lines, and the start of
+	 * the line after it: four ERROR 04, then the next line as usual */
+	char in2[] = "S A0 00\x80\x82 00 P\rV\r";
+	expect(in2, "ERROR 04\r\nERROR 04\r\nERROR 04\r\nV1.1\r\n", "");
+	/* the run ended at a line end: the line after it is whole */
+	char in3[] = "S A0 00\x80\x02V\rV\r";
+	expect(in3, "ERROR 04\r\nERROR 04\r\nV1.1\r\nV1.1\r\n", "");
+	/* the record byte can be any value, a line end's too */
+	char in4[] = "V\x80\x0D\rV\r";
+	expect(in4, NULL, NULL);
+	char want4[200] = "";
+	for (int i = 0; i < 13; i++) {
+		strcat(want4, "ERROR 04\r\n");
+	}
+	strcat(want4, "V1.1\r\n");
+	check(strcmp(out_buf, want4) == 0, "13 lost lines", out_buf);
+	/* a comment can lose characters too: refused */
+	char in5[] = "#comment\x80\x80V\rV\r";
+	expect(in5, "ERROR 04\r\nV1.1\r\n", "");
 }
 
 static void test_registers(void)
@@ -347,6 +368,23 @@ static void test_fuzz(void)
 		int lines = 0, content = 0, comment = 0, first = 1, lost = 0;
 		for (size_t i = 0; i < n; i++) {
 			char c = in[i];
+			if ((unsigned char)c == 0x80) {
+				/* a lost-run record: the next byte says what was lost */
+				if (++i == n) {
+					break;
+				}
+				unsigned char info = (unsigned char)in[i];
+				if ((info & 0x7F) == 0) {
+					lost = 1;
+					first = 0;
+				} else {
+					lines += info & 0x7F;
+					content = comment = 0;
+					first = 1;
+					lost = (info & 0x80) != 0;
+				}
+				continue;
+			}
 			if (c == '\r' || c == '\n') {
 				if (lost || (content && !comment)) {
 					lines++;
@@ -355,9 +393,7 @@ static void test_fuzz(void)
 				first = 1;
 				continue;
 			}
-			if ((unsigned char)c == 0x80) {
-				lost = 1;
-			} else if (first && c == '#') {
+			if (first && c == '#') {
 				comment = 1;
 			} else if (c != ' ') {
 				content = 1;
@@ -374,7 +410,7 @@ static void test_fuzz(void)
 		}
 		if (replies != lines) {
 			bad++;
-			char a[1600], b[8192];
+			char a[1600], b[140000];
 			in[n] = 0;
 			escape(a, sizeof a, in);
 			escape(b, sizeof b, out_buf);
