@@ -23,8 +23,7 @@ void motor_hw_init(void)
 	motor_hw_apply(zero, zero, 0x03);
 }
 
-/* High for OCR+1 of 368 cycles: OCR = round(pwm * 368 / 255) - 1; 255 gives
- * TOP, a steady high. */
+/* High for OCR+1 of 368 cycles: OCR = round(pwm * 368 / 255) - 1. */
 static uint16_t motor_ocr(uint8_t pwm)
 {
 	return (uint16_t)(((uint32_t)pwm * (MOTOR_TOP + 1) + 127) / 255 - 1);
@@ -39,7 +38,7 @@ void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
 		uint8_t com = m ? _BV(COM1B1) : _BV(COM1A1);
 		ocr[m] = pwm[m] ? motor_ocr(pwm[m]) : 0;
 		if (lines & (1u << m)) {
-			if (pwm[m]) {
+			if (pwm[m] != 0 && pwm[m] != 255) {
 				com_on |= com;
 			} else {
 				com_off |= com;
@@ -47,9 +46,13 @@ void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
 		}
 	}
 	/* OCR1A/B are double-buffered up to the next PWM period: written
-	 * together, both motors change in the same period. Short: the servo
-	 * interrupt waits while interrupts are off. */
+	 * together, both motors change in the same period. Short (under 50
+	 * cycles): the servo interrupt waits while interrupts are off. */
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		/* Not across the end of a period, or the motors would change a
+		 * period apart: at most 32 cycles of waiting. */
+		while (TCNT1 > MOTOR_TOP - 32) {
+		}
 		OCR1A = ocr[0];
 		OCR1B = ocr[1];
 		TCCR1A = (uint8_t)((TCCR1A & ~com_off) | com_on);
@@ -59,10 +62,12 @@ void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
 		port_io_write(PIN_PORT(d), PIN_MASK(d), dir[m] ? PIN_MASK(d) : 0);
 		port_io_dir(PIN_PORT(d), PIN_MASK(d), PIN_MASK(d));
 		if (lines & (1u << m)) {
-			/* A disconnected output (PWM 0) holds the line low: at OCR 0
-			 * the compare output would still spike once a period. */
+			/* 0 and 255 are steady levels from the port with the compare
+			 * output disconnected: at OCR 0 the output would still spike
+			 * once a period, and OCR = TOP relies on compare and overflow
+			 * meeting in the same cycle. */
 			uint8_t p = board_pin(BF_MOTOR_PWM, m);
-			port_io_write(PIN_PORT(p), PIN_MASK(p), 0);
+			port_io_write(PIN_PORT(p), PIN_MASK(p), pwm[m] == 255 ? PIN_MASK(p) : 0);
 			port_io_dir(PIN_PORT(p), PIN_MASK(p), PIN_MASK(p));
 		}
 	}

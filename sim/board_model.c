@@ -484,6 +484,100 @@ static int bm_find_ports(board_model_t *bm)
 	return 0;
 }
 
+/* simavr 1.6 does not apply an OCRnx written while the timer runs in a PWM
+ * mode with TOP = ICRn: the compare keeps the value it had when the timer
+ * started (a compare interrupt reading TCNT shows it). After such a write the
+ * board model waits for the end of the PWM period, as silicon's double
+ * buffer does, and there stops and restarts the timer's clock through
+ * simavr's own TCCRnB handler, which re-plans the compares from the
+ * registers; the new period starts from 0 as it would anyway. */
+static void bm_io_write(avr_t *avr, uint16_t addr, uint8_t v)
+{
+	avr_io_addr_t io = AVR_DATA_TO_IO(addr);
+
+	if (avr->io[io].w.c) {
+		avr->io[io].w.c(avr, addr, v, avr->io[io].w.param);
+	} else {
+		avr->data[addr] = v;
+	}
+}
+
+static uint8_t bm_cs_mask(const avr_timer_t *t)
+{
+	uint8_t mask = 0;
+
+	for (int i = 0; i < (int)(sizeof(t->cs) / sizeof(t->cs[0])); i++) {
+		if (t->cs[i].reg == t->cs[0].reg) {
+			mask |= (uint8_t)(t->cs[i].mask << t->cs[i].bit);
+		}
+	}
+	return mask;
+}
+
+static avr_cycle_count_t bm_ocr_latch(avr_t *avr, avr_cycle_count_t when, void *param)
+{
+	avr_timer_t *t = param;
+	uint16_t cs_reg = t->cs[0].reg;
+	uint8_t cs_val = avr->data[cs_reg];
+
+	(void)when;
+	if (cs_val & bm_cs_mask(t)) {
+		bm_io_write(avr, cs_reg, (uint8_t)(cs_val & ~bm_cs_mask(t)));
+		bm_io_write(avr, cs_reg, cs_val);
+	}
+	return 0;
+}
+
+static void bm_on_ocr_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *param)
+{
+	bm_ocr_hook_t *h = param;
+	avr_timer_t *t = h->timer;
+
+	if (h->w) {
+		h->w(avr, addr, v, h->param);
+	} else {
+		avr->data[addr] = v;
+	}
+	/* simavr's ATmega32 table files mode 14 (fast PWM, TOP = ICR1) as
+	 * avr_timer_wgm_pwm, whose OCR write does not re-plan either. */
+	if ((t->wgm_op_mode_kind != avr_timer_wgm_fast_pwm && t->wgm_op_mode_kind != avr_timer_wgm_pwm)
+	    || !(avr->data[t->cs[0].reg] & bm_cs_mask(t)) || !t->tov_cycles
+	    || avr_cycle_timer_status(avr, bm_ocr_latch, t)) {
+		return;
+	}
+	/* One cycle before the overflow: the restart then takes the overflow's
+	 * place (at the overflow itself simavr's own overflow timer and this
+	 * one race, and a period may lose its compare). */
+	avr_cycle_count_t end = t->tov_base + t->tov_cycles - 1;
+	avr_cycle_timer_register(avr, end > avr->cycle ? end - avr->cycle : 1, bm_ocr_latch, t);
+}
+
+static void bm_hook_ocr(board_model_t *bm, avr_timer_t *t, uint16_t addr)
+{
+	avr_io_addr_t io = AVR_DATA_TO_IO(addr);
+
+	if (!addr || !t->r_tcnth) {
+		return;	/* 16-bit timers only (the motor PWM) */
+	}
+	for (int i = 0; i < bm->nocr; i++) {
+		if (bm->ocr[i].addr == addr) {
+			return;
+		}
+	}
+	if (bm->nocr == BM_MAX_OC) {
+		return;
+	}
+	bm_ocr_hook_t *h = &bm->ocr[bm->nocr++];
+
+	h->bm = bm;
+	h->timer = t;
+	h->addr = addr;
+	h->w = bm->avr->io[io].w.c;
+	h->param = bm->avr->io[io].w.param;
+	bm->avr->io[io].w.c = bm_on_ocr_write;
+	bm->avr->io[io].w.param = h;
+}
+
 static void bm_find_ocs(board_model_t *bm)
 {
 	for (avr_io_t *io = bm->avr->io_port; io; io = io->next) {
@@ -515,6 +609,7 @@ static void bm_find_ocs(board_model_t *bm)
 				avr_irq_register_notify(t->io.irq + TIMER_IRQ_OUT_COMP + c,
 							bm_on_oc, oc);
 				bm_hook_com(bm, t->comp[c].com.reg);
+				bm_hook_ocr(bm, t, t->comp[c].r_ocr);
 			}
 		}
 	}

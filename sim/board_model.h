@@ -71,6 +71,15 @@ typedef struct bm_com_hook_t {
 	void *param;
 } bm_com_hook_t;
 
+/* An OCRnx low-byte write handler chained by the board model (fast PWM). */
+typedef struct bm_ocr_hook_t {
+	struct board_model_t *bm;
+	avr_timer_t *timer;
+	uint16_t addr;
+	avr_io_write_t w;
+	void *param;
+} bm_ocr_hook_t;
+
 typedef struct board_model_t {
 	avr_io_t io;			/* first: reset hook */
 	avr_t *avr;
@@ -86,6 +95,8 @@ typedef struct board_model_t {
 	uint64_t oc_seq;
 	bm_com_hook_t com[8];
 	int ncom;
+	bm_ocr_hook_t ocr[BM_MAX_OC];
+	int nocr;
 
 	uint32_t adc_mv[8];
 	uint32_t avcc, aref;

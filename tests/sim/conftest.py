@@ -346,26 +346,6 @@ def drv(drv_sim):
 # gone) fails the suite until the entry is removed. Not strict: the failure
 # comes and goes (timing), so it may pass.
 KNOWN_DEFECTS = [
-    ("tests/sim/test_drv_motor.py::test_pwm_duty_on_both_motors", True,
-     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
-     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
-     "datasheet)"),
-    ("tests/sim/test_drv_motor.py::test_four_byte_write_from_the_manual", True,
-     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
-     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
-     "datasheet)"),
-    ("tests/sim/test_drv_motor.py::test_both_motors_change_in_the_same_period", True,
-     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
-     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
-     "datasheet)"),
-    ("tests/sim/test_drv_motor.py::test_rejected_writes_change_nothing", True,
-     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
-     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
-     "datasheet)"),
-    ("tests/sim/test_drv_motor.py::test_servo_14_15_borrow_stopped_motor_lines", True,
-     "simulator: simavr 1.6 does not apply OCR1A/OCR1B written while Timer1 runs "
-     "in fast PWM; the pins keep a 1-cycle pulse (the firmware's writes follow the "
-     "datasheet)"),
     ("tests/sim/test_drv_servo.py::test_m32d_servo_on_an_adc_line_is_refused", False,
      "M32-D: with an ADC channel converting, servo widths come out ~24 cycles short; "
      "the firmware's own Timer0 view says its edges are exact, cause not found yet"),
