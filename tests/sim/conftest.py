@@ -354,9 +354,6 @@ KNOWN_DEFECTS = [
      "every 32 frames, when compares of the same timer fall together; suspected simavr "
      "1.6 dropping a compare whose time comes as another compare register is written); "
      "with several counters running an off slot then lasts up to 1.1 ms"),
-    ("tests/sim/test_drv_spi.py::test_clock_polarity_mismatch_works_like_the_other_phase", True,
-     "simulator vs docs: a CPOL mismatch (mode 3 against a mode-0 device) reads one "
-     "bit shifted, docs/simulator.md says it behaves like the other CPHA"),
 ]
 
 

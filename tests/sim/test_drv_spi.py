@@ -218,12 +218,16 @@ def test_clock_phase_mismatch_shifts_by_one_bit(spi):
 
 
 def test_clock_polarity_mismatch_works_like_the_other_phase(spi):
-    """docs: mode 3 against a mode-0 device works."""
+    """docs: in mode 3 a mode-0 device samples on the same (rising) edges, so
+    what the master writes arrives whole; what it sends back comes a bit
+    early (it moves on the first, falling, edge)."""
     drv = spi
-    bus(drv, 2, 0)
-    eeprom_write(drv, 0, 0x48, b"\x5A\xC3")
     bus(drv, 2, 3)
+    eeprom_write(drv, 0, 0x48, b"\x5A\xC3")
+    bus(drv, 2, 0)
     assert eeprom_read(drv, 0, 0x48, 2) == b"\xff\xff\x5a\xc3"
+    bus(drv, 2, 3)
+    assert eeprom_read(drv, 0, 0x48, 2) != b"\xff\xff\x5a\xc3"
 
 
 @pytest.mark.parametrize("ch, mv", [(0, 0), (3, 1234), (5, 2500), (7, 4999)])
