@@ -350,10 +350,11 @@ KNOWN_DEFECTS = [
      "M32-D: with an ADC channel converting, servo widths come out ~24 cycles short; "
      "the firmware's own Timer0 view says its edges are exact, cause not found yet"),
     ("tests/sim/test_drv_servo.py::*[m128s", False,
-     "M128-S: now and then a CD4017 counter misses a clock edge and skips a slot (about "
-     "every 32 frames, when compares of the same timer fall together; suspected simavr "
-     "1.6 dropping a compare whose time comes as another compare register is written); "
-     "with several counters running an off slot then lasts up to 1.1 ms"),
+     "M128-S: now and then a CD4017 counter misses a clock edge and skips a slot; with "
+     "several counters running an off slot then lasts up to 1.1 ms. simavr 1.6 loses "
+     "compare matches of one comparator while another comparator of the same timer is "
+     "rewritten (a 20-line program rewriting OCR3A every 13 ticks got 21 OCR3B "
+     "interrupts instead of ~27000): the simulator needs its own Timer1/Timer3 model"),
 ]
 
 
