@@ -352,9 +352,9 @@ KNOWN_DEFECTS = [
     ("tests/sim/test_drv_servo.py::*[m128s", False,
      "M128-S: now and then a CD4017 counter misses a clock edge and skips a slot; with "
      "several counters running an off slot then lasts up to 1.1 ms. simavr 1.6 loses "
-     "compare matches of one comparator while another comparator of the same timer is "
-     "rewritten (a 20-line program rewriting OCR3A every 13 ticks got 21 OCR3B "
-     "interrupts instead of ~27000): the simulator needs its own Timer1/Timer3 model"),
+     "one comparator's interrupts while another comparator's interrupt of the same timer "
+     "comes often (a 20-line program with an OCR3A interrupt every 13 ticks got 21 OCR3B "
+     "interrupts instead of ~27000; without the OCR3A interrupt, all of them)"),
 ]
 
 
