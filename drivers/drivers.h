@@ -13,10 +13,6 @@
 #include "drivers/drv_spi.h"
 #include "firmware/intro.h"
 
-#ifdef ORFA_UNIT_TEST
-#include "fakes.h"
-#endif
-
 #ifndef ORFA_DRIVER_LIST
 #define ORFA_DRIVER_LIST
 #endif

@@ -183,10 +183,8 @@ static sg_event_t lost_run(sg_parser_t *p, uint8_t info)
 	uint8_t lines = info & SG_LOST_LINES;
 	p->lost_info = 0;
 	if (lines == 0) {
-		/* The run lies inside the line in progress. */
-		if (p->state == ST_BEGIN) {
-			sg_parse_init(p);
-		}
+		/* The run lies inside the line in progress (the marker, as any
+		 * first character, already started a fresh line if need be). */
 		p->err = SG_ERR_DATA;
 		p->state = ST_ERROR;
 		return SG_MORE;
