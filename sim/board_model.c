@@ -23,7 +23,7 @@ _Static_assert(MAX_CYCLE_TIMERS <= 64, "the slot mask is 64 bits");
  * cycle. While a cycle timer runs, its slot is in neither of the pool's
  * lists and still holds that cycle: find it by the timer's param.
  */
-static uint64_t bm_event_cycle(avr_t *avr, void *param)
+static avr_cycle_timer_slot_p bm_event_slot(avr_t *avr, void *param)
 {
 	avr_cycle_timer_pool_t *pool = &avr->cycle_timers;
 	uint64_t listed = 0;
@@ -38,10 +38,49 @@ static uint64_t bm_event_cycle(avr_t *avr, void *param)
 		avr_cycle_timer_slot_p t = &pool->timer_slots[i];
 
 		if (!(listed & (1ull << i)) && t->param == param && t->when <= avr->cycle) {
-			return t->when;
+			return t;
 		}
 	}
-	return avr->cycle;
+	return NULL;
+}
+
+static uint64_t bm_event_cycle(avr_t *avr, void *param)
+{
+	avr_cycle_timer_slot_p t = bm_event_slot(avr, param);
+
+	return t ? t->when : avr->cycle;
+}
+
+/*
+ * Whether a compare output change simavr reports is one a real AVR makes.
+ * simavr 1.6 gives every mode fast-PWM rules: at each overflow, and each
+ * time an OCR, TCNT or mode write re-plans the timer, it drives every
+ * compare output whose match is still ahead to its "before the match"
+ * level (set-on-match to 0, clear-on-match to 1). In normal and CTC modes
+ * an AVR's OCnx changes on a compare match only, so those are dropped:
+ * a servo counter's clock line would otherwise get an edge of its own at
+ * every Timer3 overflow (an extra CD4017 step, a slot skipped).
+ * Real matches come from the comparator's own cycle timer (its time is
+ * the overflow's plus the compare's, never the overflow's own), or, for
+ * a compare at TOP, straight from the overflow timer.
+ */
+static int bm_oc_event_real(avr_t *avr, const avr_timer_t *t, int comp)
+{
+	if (t->wgm_op_mode_kind != avr_timer_wgm_normal && t->wgm_op_mode_kind != avr_timer_wgm_ctc) {
+		return 1;
+	}
+	if (t->ext_clock_flags & (AVR_TIMER_EXTCLK_FLAG_TN | AVR_TIMER_EXTCLK_FLAG_AS2)) {
+		return 1;	/* clocked from a pin: simavr's other path */
+	}
+	avr_cycle_timer_slot_p slot = bm_event_slot(avr, (void *)t);
+
+	if (!slot) {
+		return 0;	/* a register write re-planning the timer */
+	}
+	if (slot->when != t->tov_base) {
+		return 1;	/* the comparator's own timer */
+	}
+	return t->comp[comp].comp_cycles == t->tov_cycles;
 }
 
 /* --- pins ---------------------------------------------------------------- */
@@ -140,6 +179,9 @@ static void bm_on_oc(struct avr_irq_t *irq, uint32_t value, void *param)
 	bm_oc_t *oc = param;
 
 	(void)irq;
+	if (!bm_oc_event_real(oc->bm->avr, oc->timer, oc->comp)) {
+		return;
+	}
 	oc->latch = value & 1;
 	oc->seq = ++oc->bm->oc_seq;
 	bm_port_update(oc->port, bm_event_cycle(oc->bm->avr, oc->timer));
@@ -578,6 +620,146 @@ static void bm_hook_ocr(board_model_t *bm, avr_timer_t *t, uint16_t addr)
 	bm->avr->io[io].w.param = h;
 }
 
+/*
+ * Writing TIFR / ETIFR: a 1 clears that flag, a 0 leaves it. simavr 1.6
+ * clears every timer flag that is set whatever the value (SIMAVR-NOTES),
+ * so one flag cleared before enabling an interrupt would drop another
+ * counter's pending compare. The board model owns these registers.
+ */
+static void bm_on_flag_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *param)
+{
+	bm_flag_reg_t *r = param;
+
+	(void)addr;
+	for (int i = 0; i < r->n; i++) {
+		avr_int_vector_t *vec = r->vec[i];
+		uint8_t m = (uint8_t)(vec->raised.mask << vec->raised.bit);
+
+		if ((v & m) && avr_regbit_get(avr, vec->raised)) {
+			avr_clear_interrupt(avr, vec);
+		}
+	}
+}
+
+static void bm_add_flag(board_model_t *bm, avr_int_vector_t *vec)
+{
+	bm_flag_reg_t *r = NULL;
+
+	if (!vec->vector || !vec->raised.reg) {
+		return;
+	}
+	for (int i = 0; i < bm->nflag_regs; i++) {
+		if (bm->flag_regs[i].addr == vec->raised.reg) {
+			r = &bm->flag_regs[i];
+		}
+	}
+	if (!r) {
+		if (bm->nflag_regs == (int)(sizeof(bm->flag_regs) / sizeof(bm->flag_regs[0]))) {
+			return;
+		}
+		r = &bm->flag_regs[bm->nflag_regs++];
+		r->addr = vec->raised.reg;
+		/* replaced, not chained: simavr's own handler is the bug */
+		bm->avr->io[AVR_DATA_TO_IO(r->addr)].w.c = bm_on_flag_write;
+		bm->avr->io[AVR_DATA_TO_IO(r->addr)].w.param = r;
+	}
+	if (r->n < BM_MAX_FLAGS) {
+		r->vec[r->n++] = vec;
+	}
+}
+
+static void bm_own_timer_flags(board_model_t *bm)
+{
+	for (avr_io_t *io = bm->avr->io_port; io; io = io->next) {
+		if (!io->kind || strcmp(io->kind, "timer") != 0) {
+			continue;
+		}
+		avr_timer_t *t = (avr_timer_t *)io;
+
+		bm_add_flag(bm, &t->overflow);
+		bm_add_flag(bm, &t->icr);
+		for (int c = 0; c < AVR_TIMER_COMP_COUNT; c++) {
+			bm_add_flag(bm, &t->comp[c].interrupt);
+		}
+	}
+}
+
+/*
+ * A forced compare (FOCnx written 1): in normal and CTC modes the unit acts
+ * on its pin as on a match (toggle, clear, set by its COM bits), with no
+ * interrupt flag; in PWM modes the strobe does nothing. The FOC bits read 0.
+ */
+static void bm_on_foc_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *param)
+{
+	bm_foc_hook_t *h = param;
+	uint8_t strobes = 0;
+
+	for (int i = 0; i < h->n; i++) {
+		strobes |= (uint8_t)(1u << h->bit[i]);
+	}
+	if (h->w) {
+		h->w(avr, addr, (uint8_t)(v & ~strobes), h->param);
+	} else {
+		avr->data[addr] = (uint8_t)(v & ~strobes);
+	}
+	for (int i = 0; i < h->n; i++) {
+		bm_oc_t *oc = h->oc[i];
+		const avr_timer_t *t = oc->timer;
+
+		if (!(v & (1u << h->bit[i])) ||
+		    (t->wgm_op_mode_kind != avr_timer_wgm_normal && t->wgm_op_mode_kind != avr_timer_wgm_ctc)) {
+			continue;
+		}
+		switch (avr_regbit_get(avr, t->comp[oc->comp].com)) {
+		case 1: oc->latch = !oc->latch; break;
+		case 2: oc->latch = 0; break;
+		case 3: oc->latch = 1; break;
+		default: continue;
+		}
+		oc->seq = ++oc->bm->oc_seq;
+		bm_port_update(oc->port, avr->cycle);
+	}
+}
+
+static void bm_hook_foc(board_model_t *bm, const mcu_desc_t *mcu)
+{
+	for (int f = 0; f < mcu->foc_count; f++) {
+		const mcu_foc_t *d = &mcu->foc[f];
+		bm_oc_t *oc = NULL;
+		bm_foc_hook_t *h = NULL;
+
+		for (int i = 0; i < bm->noc; i++) {
+			if (bm->oc[i].timer->name == d->timer && bm->oc[i].comp == d->comp) {
+				oc = &bm->oc[i];
+			}
+		}
+		if (!oc) {
+			continue;	/* no pin on this board's MCU */
+		}
+		for (int i = 0; i < bm->nfoc; i++) {
+			if (bm->foc[i].addr == d->reg) {
+				h = &bm->foc[i];
+			}
+		}
+		if (!h) {
+			avr_io_addr_t io = AVR_DATA_TO_IO(d->reg);
+
+			h = &bm->foc[bm->nfoc++];
+			h->bm = bm;
+			h->addr = d->reg;
+			h->w = bm->avr->io[io].w.c;
+			h->param = bm->avr->io[io].w.param;
+			bm->avr->io[io].w.c = bm_on_foc_write;
+			bm->avr->io[io].w.param = h;
+		}
+		if (h->n < 3) {
+			h->oc[h->n] = oc;
+			h->bit[h->n] = d->bit;
+			h->n++;
+		}
+	}
+}
+
 static void bm_find_ocs(board_model_t *bm)
 {
 	for (avr_io_t *io = bm->avr->io_port; io; io = io->next) {
@@ -629,6 +811,8 @@ int board_model_init(board_model_t *bm, avr_t *avr, const board_desc_t *board,
 		return -1;
 	}
 	bm_find_ocs(bm);
+	bm_own_timer_flags(bm);
+	bm_hook_foc(bm, mcu);
 	if (bm_counters(bm) < 0) {
 		return -1;
 	}

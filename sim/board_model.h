@@ -80,6 +80,25 @@ typedef struct bm_ocr_hook_t {
 	void *param;
 } bm_ocr_hook_t;
 
+/* A register with force-output-compare strobes (TCCR1C, TCCR3C). */
+typedef struct bm_foc_hook_t {
+	struct board_model_t *bm;
+	uint16_t addr;
+	avr_io_write_t w;	/* simavr's handler, chained */
+	void *param;
+	struct bm_oc_t *oc[3];	/* the unit each strobe bit acts on */
+	uint8_t bit[3];
+	int n;
+} bm_foc_hook_t;
+
+/* A timer interrupt flag register (TIFR, ETIFR): which vectors' flags it holds. */
+#define BM_MAX_FLAGS 16
+typedef struct bm_flag_reg_t {
+	uint16_t addr;
+	avr_int_vector_t *vec[BM_MAX_FLAGS];
+	int n;
+} bm_flag_reg_t;
+
 typedef struct board_model_t {
 	avr_io_t io;			/* first: reset hook */
 	avr_t *avr;
@@ -97,6 +116,10 @@ typedef struct board_model_t {
 	int ncom;
 	bm_ocr_hook_t ocr[BM_MAX_OC];
 	int nocr;
+	bm_flag_reg_t flag_regs[2];
+	int nflag_regs;
+	bm_foc_hook_t foc[MCU_MAX_FOC];
+	int nfoc;
 
 	uint32_t adc_mv[8];
 	uint32_t avcc, aref;

@@ -42,6 +42,11 @@ static const mcu_desc_t mcu_table[] = {
 			.twcr = 0x74, .vect_twi = 33,
 		},
 		.spi = { .spcr = 0x2d, .spsr = 0x2e, .spdr = 0x2f, .vect_spi = 17 },
+		.foc = {	/* TCCR1C, TCCR3C: FOCnA/B/C = bits 7/6/5 */
+			{ '1', 0, 0x7a, 7 }, { '1', 1, 0x7a, 6 }, { '1', 2, 0x7a, 5 },
+			{ '3', 0, 0x8c, 7 }, { '3', 1, 0x8c, 6 }, { '3', 2, 0x8c, 5 },
+		},
+		.foc_count = 6,
 	},
 };
 

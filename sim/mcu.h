@@ -28,12 +28,25 @@ typedef struct mcu_spi_regs_t {
 	uint8_t vect_spi;		/* SPI_STC */
 } mcu_spi_regs_t;
 
+/* A force-output-compare strobe: writing 1 to BIT of REG forces timer
+ * TIMER's compare unit COMP (0 = A) to act on its pin (simavr 1.6 has no FOC). */
+typedef struct mcu_foc_t {
+	char timer;		/* simavr's timer name: '1', '3' */
+	uint8_t comp;
+	uint16_t reg;
+	uint8_t bit;
+} mcu_foc_t;
+
+#define MCU_MAX_FOC 6
+
 typedef struct mcu_desc_t {
 	const char *name;	/* simavr's name: "atmega32" */
 	mcu_usart_regs_t usart[2];
 	uint8_t usart_count;
 	mcu_twi_regs_t twi;
 	mcu_spi_regs_t spi;
+	mcu_foc_t foc[MCU_MAX_FOC];	/* the 16-bit timers' dedicated FOC registers */
+	uint8_t foc_count;
 } mcu_desc_t;
 
 /* The description of MCU NAME, or NULL if the simulator does not know it. */
