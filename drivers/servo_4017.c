@@ -1,19 +1,31 @@
 /*
  * Servo pulses through CD4017 decade counters (M128-S: 32 channels).
  *
- * Counter c is clocked by a timer compare output (OC3A, OC3B, OC3C, OC1C),
+ * Counter c is clocked by a timer compare output (OC3A, OC3B, OC3C, OC1C);
  * all four share a reset line. After the reset at a frame's start a counter
- * sits in Q0 (idle); each clock's rising edge moves it on, so output Q(k+1),
- * channel 8c+k, is high from one rising edge to the next. Every edge is made
- * by the timer hardware (set / clear on compare match, clk/8 = 1.085 us
- * ticks), the compare interrupt only programs the next one: widths are
- * exact to the tick whatever the rest of the firmware does.
+ * sits in Q0 (not wired); each rising clock edge moves it on, so output
+ * Q(k+1), channel 8c+k, is high from one rising edge to the next, and Q9
+ * (not wired either) is where it rests until the next frame.
  *
- * A counter cannot skip an output: a channel that is off but lies on a
- * counter with pulsing channels is passed in SERVO_GAP ticks (a short pulse
- * servos ignore); a counter with no channel on is not clocked at all and all
- * its outputs stay low. A frame is 20 ms unless one counter's widths add up
- * to more than fits (8 x 2.5 ms does not): then the frame stretches to fit.
+ * Every rising edge that starts or ends a pulse is made by the timer
+ * hardware (set on compare match, clk/8 = 1.085 us ticks): widths are exact
+ * to the tick whatever the rest of the firmware does. The compare interrupt
+ * that follows brings the clock line low again with a forced compare (FOC,
+ * clear mode) and programs the next rise.
+ *
+ * A counter cannot skip an output. Off channels between pulsing ones are
+ * passed by the same interrupt with forced compares, a clock pulse of about
+ * 1.5 us each, so an off channel's output sees a pulse of a few
+ * microseconds: the first of a run of off channels from the hardware rise
+ * until the interrupt runs, the last until the next hardware rise
+ * SERVO_PASS ticks after the run began; servos ignore pulses that short.
+ * After a counter's last pulsing channel the interrupt runs it through to
+ * Q9. A counter with no channel on is not clocked at all. A frame is 20 ms
+ * unless one counter's widths add up to more than fits (8 x 2.5 ms does
+ * not): then the frame stretches to fit.
+ *
+ * One interrupt per hardware rise, at most nine per counter and frame, at
+ * least SERVO_PASS ticks apart: four counters never keep the CPU busy.
  */
 #include "drivers/servo_hw.h"
 
@@ -30,18 +42,41 @@
 
 #define SERVO_TICK_HZ (F_CPU / 8)           /* 921.6 kHz */
 #define SERVO_FRAME   18432u                /* 20 ms in ticks */
-#define SERVO_HIGH    40u                   /* clock pulse high time */
-#define SERVO_GAP     80u                   /* slot of a channel that is off */
-#define SERVO_LEAD    256u                  /* frame start to first clock */
+#define SERVO_LEAD    256u                  /* frame start to counter 0's first rise */
+#define SERVO_STAGGER 96u                   /* counter c starts c x this later */
+#define SERVO_PASS    24u                   /* run of off channels: first to next rise, */
+#define SERVO_PASS_STEP 4u                  /* plus this per forced clock */
+#define SERVO_AHEAD   4u                    /* a rise is programmed at least this far ahead */
+#define SERVO_TAIL    64u                   /* last rise to the next frame, at least */
 #define SERVO_COUNTERS BOARD_SERVO_COUNTERS
 #define SERVO_SLOTS   BOARD_SERVO_PER_COUNTER
+/* Hardware rises per counter and frame: each enters a different output
+ * Q1..Q(SLOTS + 1). */
+#define SERVO_RISES   (SERVO_SLOTS + 1u)
+#define SERVO_REST    0x80u                 /* steps[]: then rest in Q9, clock off */
+/* Forced clock phases: >= 1 us high and low (CD4017B at 5 V: 200 ns). */
+#define SERVO_FOC_WAIT 4u
 
 _Static_assert(SERVO_COUNTERS * SERVO_SLOTS == SERVO_CHANNELS, "channels = counters x slots");
+_Static_assert(SERVO_COUNTERS == 4, "one compare unit per counter: OC3A, OC3B, OC3C, OC1C");
 
+/* What the interrupt after one hardware rise does: pass `steps` off
+ * outputs with forced clocks (SERVO_REST: through to Q9 and stop), then
+ * program the next rise `dur` ticks after this one. */
 typedef struct {
-	uint16_t dur[SERVO_COUNTERS][SERVO_SLOTS];  /* slot lengths, ticks */
+	uint16_t dur;
+	uint8_t steps;
+} servo_step_t;
+
+/* One frame's plan, made by servo_hw_apply() outside any interrupt so the
+ * compare interrupts only read it: entry i of counter c is for its i-th
+ * hardware rise. */
+typedef struct {
+	servo_step_t step[SERVO_COUNTERS][SERVO_RISES];
+	uint16_t first[SERVO_COUNTERS];             /* first rise after the frame start */
 	uint16_t frame;                             /* frame length, ticks */
-	uint8_t active;                             /* bit c: counter c runs */
+	uint8_t units;                              /* ETIMSK bits of the running counters */
+	uint8_t com3, com1;                         /* their COM bits (set on match) */
 } servo_sched_t;
 
 static struct {
@@ -49,94 +84,65 @@ static struct {
 	volatile uint8_t cur;
 	volatile uint8_t pending;
 	volatile uint8_t running;
-	uint8_t rises[SERVO_COUNTERS];     /* rising edges done this frame */
-	uint8_t high[SERVO_COUNTERS];      /* the clock line is high */
-	uint16_t rise_at[SERVO_COUNTERS];  /* tick of the last rising edge */
-	uint16_t t3_offset;                /* TCNT3 - TCNT1 */
-	volatile uint8_t *rst_port;        /* the reset line's PORT register */
+	const servo_step_t *next[SERVO_COUNTERS];  /* counter c's next entry in sched[cur] */
+	uint16_t t3_offset;                     /* TCNT3 - TCNT1 */
+	volatile uint8_t *rst_port;             /* the reset line's PORT register */
 	uint8_t rst_mask;
 } s4;
 
-/* Compare unit of counter c: its OCR, its COM bits' register and shift. */
-static volatile uint16_t *servo_ocr(uint8_t c)
+/* A compare unit's COM bits: 0 off (the pin follows PORT: low), 2 clear,
+ * 3 set on match; flipping the low bit turns set into clear and back. */
+
+/*
+ * Counter c's compare unit made a rising edge: the counter moved on. Bring
+ * the clock low, pass the off outputs that follow, program the next rise
+ * from this one (so a late interrupt never changes a width) or rest.
+ * Inlined into each compare vector with its unit's registers as constants.
+ */
+static inline __attribute__((always_inline)) void
+servo_rise(uint8_t c, volatile uint16_t *ocr, volatile uint16_t *tcnt, volatile uint8_t *tccr,
+	   uint8_t com0, volatile uint8_t *focr, uint8_t foc)
 {
-	switch (c) {
-	case 0: return &OCR3A;
-	case 1: return &OCR3B;
-	case 2: return &OCR3C;
-	default: return &OCR1C;
+	const uint8_t flip = (uint8_t)(1u << com0);
+
+	*tccr ^= flip;          /* set -> clear */
+	*focr = foc;            /* clock low */
+	const servo_step_t *e = s4.next[c];
+	s4.next[c] = e + 1;
+	uint8_t steps = e->steps;
+	uint16_t dur = e->dur;
+	for (uint8_t k = steps & (uint8_t)~SERVO_REST; k; k--) {
+		__builtin_avr_delay_cycles(SERVO_FOC_WAIT);
+		*tccr ^= flip;
+		*focr = foc;    /* high: the next output */
+		__builtin_avr_delay_cycles(SERVO_FOC_WAIT);
+		*tccr ^= flip;
+		*focr = foc;    /* low */
 	}
-}
-
-static const __flash uint8_t com_shift[SERVO_COUNTERS] = { COM3A0, COM3B0, COM3C0, COM1C0 };
-
-/* COM bits: 0 off (the pin follows PORT: low), 2 clear, 3 set on match. */
-static void servo_com(uint8_t c, uint8_t com)
-{
-	volatile uint8_t *tccr = (c < 3) ? &TCCR3A : &TCCR1A;
-	uint8_t shift = com_shift[c];
-	*tccr = (uint8_t)((*tccr & ~(3u << shift)) | (uint8_t)(com << shift));
-}
-
-#define COM_OFF 0
-#define COM_CLEAR 2
-#define COM_SET 3
-
-/* Programs counter c's next edge at tick `at`. A late interrupt must not
- * lose an edge (the counter would drift a slot): an edge whose time has
- * passed comes right away. Only a clock fall or the end of an off channel's
- * short slot can be that close; a pulsing channel's end is >= 461 ticks
- * after its start. */
-static void servo_next(uint8_t c, volatile uint16_t *ocr, uint16_t at)
-{
-	uint16_t now = (c < 3) ? TCNT3 : TCNT1;
-	if ((int16_t)(at - now) < 4) {
-		at = now + 4;
+	if (steps & SERVO_REST) {
+		*tccr &= (uint8_t)~(3u << com0);
+		return;
+	}
+	*tccr ^= flip;          /* clear -> set: the next rise */
+	uint16_t at = *ocr + dur;
+	uint16_t now = *tcnt;
+	if ((int16_t)(at - now) < (int16_t)SERVO_AHEAD) {
+		at = now + SERVO_AHEAD;
 	}
 	*ocr = at;
 }
 
-/* A counter's compare matched: program its next edge. */
-static void servo_counter_edge(uint8_t c)
-{
-	volatile uint16_t *ocr = servo_ocr(c);
-	uint16_t t = *ocr;
-	const servo_sched_t *s = &s4.sched[s4.cur];
-	uint16_t now = (c < 3) ? TCNT3 : TCNT1;
+ISR(TIMER3_COMPA_vect) { servo_rise(0, &OCR3A, &TCNT3, &TCCR3A, COM3A0, &TCCR3C, _BV(FOC3A)); }
+ISR(TIMER3_COMPB_vect) { servo_rise(1, &OCR3B, &TCNT3, &TCCR3A, COM3B0, &TCCR3C, _BV(FOC3B)); }
+ISR(TIMER3_COMPC_vect) { servo_rise(2, &OCR3C, &TCNT3, &TCCR3A, COM3C0, &TCCR3C, _BV(FOC3C)); }
+ISR(TIMER1_COMPC_vect) { servo_rise(3, &OCR1C, &TCNT1, &TCCR1A, COM1C0, &TCCR1C, _BV(FOC1C)); }
 
-	if ((int16_t)(now - t) < 0) {
-		return;  /* a flag left from before this compare was set: not yet */
-	}
+#define UNITS_ALL (_BV(OCIE3A) | _BV(OCIE3B) | _BV(OCIE3C) | _BV(OCIE1C))
+#define COM3_ALL (_BV(COM3A1) | _BV(COM3A0) | _BV(COM3B1) | _BV(COM3B0) | _BV(COM3C1) | _BV(COM3C0))
+#define COM1C_ALL (_BV(COM1C1) | _BV(COM1C0))
 
-	if (!s4.high[c]) {
-		/* A rising edge: counter moved on; fall after SERVO_HIGH. */
-		s4.high[c] = 1;
-		s4.rise_at[c] = t;
-		s4.rises[c]++;
-		servo_com(c, COM_CLEAR);
-		servo_next(c, ocr, t + SERVO_HIGH);
-		return;
-	}
-	s4.high[c] = 0;
-	uint8_t slot = (uint8_t)(s4.rises[c] - 1);
-	if (slot == SERVO_SLOTS) {
-		servo_com(c, COM_OFF);  /* in Q9 until the next frame's reset */
-		return;
-	}
-	servo_com(c, COM_SET);
-	servo_next(c, ocr, s4.rise_at[c] + s->dur[c][slot]);
-}
-
-ISR(TIMER3_COMPA_vect) { servo_counter_edge(0); }
-ISR(TIMER3_COMPB_vect) { servo_counter_edge(1); }
-ISR(TIMER3_COMPC_vect) { servo_counter_edge(2); }
-ISR(TIMER1_COMPC_vect) { servo_counter_edge(3); }
-
-static const __flash uint8_t ocie_bit[SERVO_COUNTERS] = {
-	_BV(OCIE3A), _BV(OCIE3B), _BV(OCIE3C), _BV(OCIE1C),
-};
-
-/* Frame start (Timer1 compare A): reset the counters, start the active ones. */
+/* Frame start (Timer1 compare A): reset the counters, start the active
+ * ones. Everything it writes was worked out by servo_hw_apply(). */
 ISR(TIMER1_COMPA_vect)
 {
 	uint16_t f = OCR1A;
@@ -145,24 +151,27 @@ ISR(TIMER1_COMPA_vect)
 		s4.pending = 0;
 	}
 	const servo_sched_t *s = &s4.sched[s4.cur];
+	/* Counters 0-2 count on Timer3, counter 3 on Timer1. An idle unit's
+	 * OCR is written too: with its COM bits off it does nothing. */
+	uint16_t f3 = f + s4.t3_offset;
+	OCR3A = f3 + s->first[0];
+	OCR3B = f3 + s->first[1];
+	OCR3C = f3 + s->first[2];
+	OCR1C = f + s->first[3];
 	for (uint8_t c = 0; c < SERVO_COUNTERS; c++) {
-		s4.rises[c] = 0;
-		s4.high[c] = 0;
-		if (s->active & (1u << c)) {
-			/* Counters 0-2 count on Timer3, counter 3 on Timer1. */
-			*servo_ocr(c) = f + SERVO_LEAD + (c < 3 ? s4.t3_offset : 0);
-			servo_com(c, COM_SET);
-			ETIMSK |= ocie_bit[c];
-		} else {
-			servo_com(c, COM_OFF);
-			ETIMSK &= (uint8_t)~ocie_bit[c];
-		}
+		s4.next[c] = s->step[c];
 	}
+	TCCR3A = (uint8_t)((TCCR3A & (uint8_t)~COM3_ALL) | s->com3);
+	TCCR1A = (uint8_t)((TCCR1A & (uint8_t)~COM1C_ALL) | s->com1);
+	/* A match from before (the unit idled, or the last frame) must not
+	 * count as this frame's first rise. */
+	ETIFR = s->units;
+	ETIMSK = (uint8_t)((ETIMSK & (uint8_t)~UNITS_ALL) | s->units);
 	/* Reset pulse, well before the first clock: CD4017 needs 0.3 us at
 	 * 5 V; this is about 2.5 us. */
 	*s4.rst_port |= s4.rst_mask;
 	__builtin_avr_delay_cycles(16);
-	if (!s->active) {
+	if (!s->units) {
 		/* Nothing pulses: counters held in reset, interrupts off. */
 		s4.running = 0;
 		TIMSK &= (uint8_t)~_BV(OCIE1A);
@@ -177,7 +186,7 @@ void servo_hw_init(void)
 	s4.running = 0;
 	s4.pending = 0;
 	s4.cur = 0;
-	s4.sched[0].active = 0;
+	s4.sched[0].units = 0;
 	/* Clock lines low, reset held high: all outputs quiet. */
 	for (uint8_t c = 0; c < SERVO_COUNTERS; c++) {
 		uint8_t pin = board_pin(BF_SERVO_CLK, c);
@@ -226,33 +235,83 @@ void servo_hw_release(uint8_t ch)
 	(void)ch;
 }
 
+/* Plans counter c: its hardware rises, the off outputs passed after each
+ * and the ticks between rises. Returns the last rise's time, or 0 when no
+ * channel of the counter is on. */
+static uint16_t servo_plan(servo_sched_t *s, uint8_t c, const uint16_t *widths_us)
+{
+	servo_step_t *e = s->step[c];
+	uint16_t t = SERVO_LEAD + c * SERVO_STAGGER;
+	uint8_t k = 0;  /* the output a rise enters: slot k, Q(k+1) */
+
+	s->first[c] = t;
+	for (;;) {
+		if (k == SERVO_SLOTS) {
+			e->steps = SERVO_REST;  /* the last pulse ended in Q9 */
+			return t;
+		}
+		uint16_t us = widths_us[k];
+		if (us) {
+			e->steps = 0;
+			e->dur = (uint16_t)(((uint32_t)us * (SERVO_TICK_HZ / 100UL) + 5000UL) / 10000UL);
+			t = (uint16_t)(t + e->dur);
+			e++;
+			k++;
+			continue;
+		}
+		uint8_t m = k;  /* the run of off outputs k..m-1 */
+		while (m < SERVO_SLOTS && !widths_us[m]) {
+			m++;
+		}
+		if (m == SERVO_SLOTS) {
+			if (k == 0) {
+				return 0;  /* no channel on */
+			}
+			e->steps = (uint8_t)(SERVO_REST | (SERVO_SLOTS - k));  /* through to Q9 */
+			return t;
+		}
+		e->steps = (uint8_t)(m - k - 1u);
+		e->dur = (uint16_t)(SERVO_PASS + SERVO_PASS_STEP * e->steps);
+		t = (uint16_t)(t + e->dur);
+		e++;
+		k = m;
+	}
+}
+
 void servo_hw_apply(const uint16_t *widths_us)
 {
 	s4.pending = 0;  /* the frame interrupt must not take it half written */
 	servo_sched_t *s = &s4.sched[s4.cur ^ 1];
+	static const __flash uint8_t unit[SERVO_COUNTERS] = {
+		_BV(OCIE3A), _BV(OCIE3B), _BV(OCIE3C), _BV(OCIE1C),
+	};
+	static const __flash uint8_t com_set[SERVO_COUNTERS] = {
+		_BV(COM3A1) | _BV(COM3A0), _BV(COM3B1) | _BV(COM3B0), _BV(COM3C1) | _BV(COM3C0),
+		_BV(COM1C1) | _BV(COM1C0),
+	};
 	uint16_t frame = SERVO_FRAME;
-	s->active = 0;
+	s->units = 0;
+	s->com3 = 0;
+	s->com1 = 0;
 	for (uint8_t c = 0; c < SERVO_COUNTERS; c++) {
-		uint16_t total = SERVO_LEAD + SERVO_HIGH + 16;
-		for (uint8_t k = 0; k < SERVO_SLOTS; k++) {
-			uint16_t us = widths_us[c * SERVO_SLOTS + k];
-			uint16_t d = SERVO_GAP;
-			if (us) {
-				d = (uint16_t)(((uint32_t)us * (SERVO_TICK_HZ / 100UL) + 5000UL) / 10000UL);
-				s->active |= (uint8_t)(1u << c);
+		uint16_t last = servo_plan(s, c, widths_us + c * SERVO_SLOTS);
+		if (last) {
+			s->units |= unit[c];
+			if (c < 3) {
+				s->com3 |= com_set[c];
+			} else {
+				s->com1 |= com_set[c];
 			}
-			s->dur[c][k] = d;
-			total = (uint16_t)(total + d);
-		}
-		if ((s->active & (1u << c)) && total > frame) {
-			frame = total;
+			if ((uint16_t)(last + SERVO_TAIL) > frame) {
+				frame = (uint16_t)(last + SERVO_TAIL);
+			}
 		}
 	}
 	s->frame = frame;
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 		if (s4.running) {
 			s4.pending = 1;
-		} else if (s->active) {
+		} else if (s->units) {
 			s4.cur ^= 1;
 			s4.running = 1;
 			OCR1A = TCNT1 + 256;

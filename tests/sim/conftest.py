@@ -352,12 +352,6 @@ KNOWN_DEFECTS = [
     ("tests/sim/test_drv_servo.py::test_m32d_servo_on_an_adc_line_is_refused", False,
      "M32-D: with an ADC channel converting, servo widths come out ~24 cycles short; "
      "the firmware's own Timer0 view says its edges are exact, cause not found yet"),
-    ("tests/sim/test_drv_servo.py::*[m128s", False,
-     "M128-S: now and then a CD4017 counter misses a clock edge and skips a slot; with "
-     "several counters running an off slot then lasts up to 1.1 ms. simavr 1.6 loses "
-     "one comparator's interrupts while another comparator's interrupt of the same timer "
-     "comes often (a 20-line program with an OCR3A interrupt every 13 ticks got 21 OCR3B "
-     "interrupts instead of ~27000; without the OCR3A interrupt, all of them)"),
 ]
 
 
