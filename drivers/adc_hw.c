@@ -13,14 +13,16 @@ static struct {
 	uint8_t mask;
 	uint8_t refs;
 	uint8_t ch;        /* channel being converted */
+	uint8_t next[8];   /* the enabled channel after channel n */
 	uint8_t discard;   /* conversions to drop after a reference change */
 } adc;
 
-static uint8_t adc_next(uint8_t ch)
+/* The enabled channel after `ch`, round the 8 (mask not 0). */
+static uint8_t adc_after(uint8_t mask, uint8_t ch)
 {
 	do {
 		ch = (uint8_t)((ch + 1) & 7);
-	} while (!(adc.mask & (1u << ch)));
+	} while (!(mask & (1u << ch)));
 	return ch;
 }
 
@@ -40,7 +42,9 @@ ISR(ADC_vect)
 	} else {
 		adc.value[adc.ch] = (uint16_t)(hi << 8 | lo);
 	}
-	adc_start(adc_next(adc.ch));
+	/* Looked up, not searched: this interrupt must stay short, the M32-D
+	 * servo interrupt has a fixed budget for others running before it. */
+	adc_start(adc.next[adc.ch]);
 }
 
 void adc_hw_config(uint8_t refs, uint8_t mask)
@@ -58,8 +62,11 @@ void adc_hw_config(uint8_t refs, uint8_t mask)
 	adc.refs = refs;
 	adc.mask = mask;
 	if (mask) {
+		for (uint8_t ch = 0; ch < 8; ch++) {
+			adc.next[ch] = adc_after(mask, ch);
+		}
 		ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-			adc_start(adc_next(7));
+			adc_start(adc.next[7]);
 		}
 	} else {
 		ADMUX = 0;

@@ -349,9 +349,6 @@ KNOWN_DEFECTS = [
     ("tests/sim/test_drv_motor.py::test_pwm_duty_on_both_motors[m32d-254]", False,
      "simulator: when a PWM changes to OCR 0 (1-cycle pulses), the board model's "
      "period-end restart of Timer1 now and then loses the first pulse (a 736-cycle period)"),
-    ("tests/sim/test_drv_servo.py::test_m32d_servo_on_an_adc_line_is_refused", False,
-     "M32-D: with an ADC channel converting, servo widths come out ~24 cycles short; "
-     "the firmware's own Timer0 view says its edges are exact, cause not found yet"),
 ]
 
 
