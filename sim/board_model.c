@@ -580,9 +580,9 @@ static void bm_on_ocr_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *par
 	} else {
 		avr->data[addr] = v;
 	}
-	/* simavr's ATmega32 table files mode 14 (fast PWM, TOP = ICR1) as
-	 * avr_timer_wgm_pwm, whose OCR write does not re-plan either. */
-	if ((t->wgm_op_mode_kind != avr_timer_wgm_fast_pwm && t->wgm_op_mode_kind != avr_timer_wgm_pwm)
+	/* (avr_timer_wgm_pwm, simavr's filing of the ATmega32's mode 14, is
+	 * latched at each overflow by bm_on_pwm_overflow instead.) */
+	if (t->wgm_op_mode_kind != avr_timer_wgm_fast_pwm
 	    || !(avr->data[t->cs[0].reg] & bm_cs_mask(t)) || !t->tov_cycles
 	    || avr_cycle_timer_status(avr, bm_ocr_latch, t)) {
 		return;
@@ -592,6 +592,84 @@ static void bm_on_ocr_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *par
 	 * one race, and a period may lose its compare). */
 	avr_cycle_count_t end = t->tov_base + t->tov_cycles - 1;
 	avr_cycle_timer_register(avr, end > avr->cycle ? end - avr->cycle : 1, bm_ocr_latch, t);
+}
+
+/*
+ * A PWM timer's overflow (BOTTOM), from inside simavr's overflow timer,
+ * before it plans the period's compares. simavr 1.6 files the ATmega32's
+ * mode 14 (fast PWM, TOP = ICR1) as avr_timer_wgm_pwm and then ignores OCR
+ * writes while the timer runs; silicon takes a new OCR1x at BOTTOM (double
+ * buffer). So each compare's time is set here from the OCR registers, as
+ * simavr's own configure would. And when simavr runs the overflow timer
+ * late (after a multi-cycle instruction) it skips every compare whose time
+ * has already passed in the new period: an OCR of 0 or 1 (a 1- or 2-cycle
+ * pulse) then loses its pulse. The model makes that pulse itself.
+ */
+static void bm_on_pwm_overflow(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+	bm_pwm_timer_t *pw = param;
+	board_model_t *bm = pw->bm;
+	avr_t *avr = bm->avr;
+	avr_timer_t *t = pw->timer;
+
+	(void)irq;
+	if (!value || t->wgm_op_mode_kind != avr_timer_wgm_pwm || !t->tov_cycles) {
+		return;
+	}
+	avr_cycle_timer_slot_p slot = bm_event_slot(avr, t);
+
+	if (!slot) {
+		return;
+	}
+	uint64_t when = slot->when;
+
+	for (int c = 0; c < AVR_TIMER_COMP_COUNT; c++) {
+		if (!t->comp[c].r_ocr) {
+			continue;
+		}
+		uint32_t ocr = avr->data[t->comp[c].r_ocr] |
+			       (t->comp[c].r_ocrh ? (uint32_t)avr->data[t->comp[c].r_ocrh] << 8 : 0u);
+		uint32_t cc = ocr <= t->tov_top ? t->cs_div_value * (ocr + 1u) : 0u;
+
+		t->comp[c].comp_cycles = cc;
+		if (!cc || cc >= t->tov_cycles || cc >= avr->cycle - when) {
+			continue;	/* simavr plans this one itself */
+		}
+		int com = avr_regbit_get(avr, t->comp[c].com);
+
+		if (com != 2 && com != 3) {
+			continue;
+		}
+		for (int i = 0; i < bm->noc; i++) {
+			bm_oc_t *oc = &bm->oc[i];
+
+			if (oc->timer != t || oc->comp != c) {
+				continue;
+			}
+			oc->latch = com == 2;	/* BOTTOM: set (clear-on-match mode) */
+			oc->seq = ++bm->oc_seq;
+			bm_port_update(oc->port, when);
+			oc->latch = com != 2;	/* the match */
+			bm_port_update(oc->port, when + cc);
+		}
+	}
+}
+
+static void bm_watch_pwm(board_model_t *bm, avr_timer_t *t)
+{
+	for (int i = 0; i < bm->npwm; i++) {
+		if (bm->pwm[i].timer == t) {
+			return;
+		}
+	}
+	if (bm->npwm == (int)(sizeof(bm->pwm) / sizeof(bm->pwm[0])) || !t->overflow.vector) {
+		return;
+	}
+	bm_pwm_timer_t *pw = &bm->pwm[bm->npwm++];
+
+	pw->bm = bm;
+	pw->timer = t;
+	avr_irq_register_notify(t->overflow.irq + AVR_INT_IRQ_PENDING, bm_on_pwm_overflow, pw);
 }
 
 static void bm_hook_ocr(board_model_t *bm, avr_timer_t *t, uint16_t addr)
@@ -792,6 +870,7 @@ static void bm_find_ocs(board_model_t *bm)
 							bm_on_oc, oc);
 				bm_hook_com(bm, t->comp[c].com.reg);
 				bm_hook_ocr(bm, t, t->comp[c].r_ocr);
+				bm_watch_pwm(bm, t);
 			}
 		}
 	}

@@ -80,6 +80,12 @@ typedef struct bm_ocr_hook_t {
 	void *param;
 } bm_ocr_hook_t;
 
+/* A PWM timer whose overflow the board model watches (OCR double buffer). */
+typedef struct bm_pwm_timer_t {
+	struct board_model_t *bm;
+	avr_timer_t *timer;
+} bm_pwm_timer_t;
+
 /* A register with force-output-compare strobes (TCCR1C, TCCR3C). */
 typedef struct bm_foc_hook_t {
 	struct board_model_t *bm;
@@ -120,6 +126,8 @@ typedef struct board_model_t {
 	int nflag_regs;
 	bm_foc_hook_t foc[MCU_MAX_FOC];
 	int nfoc;
+	bm_pwm_timer_t pwm[4];
+	int npwm;
 
 	uint32_t adc_mv[8];
 	uint32_t avcc, aref;

@@ -346,9 +346,7 @@ def drv(drv_sim):
 # gone) fails the suite until the entry is removed. Not strict: the failure
 # comes and goes (timing), so it may pass.
 KNOWN_DEFECTS = [
-    ("tests/sim/test_drv_motor.py::test_pwm_duty_on_both_motors[m32d-254]", False,
-     "simulator: when a PWM changes to OCR 0 (1-cycle pulses), the board model's "
-     "period-end restart of Timer1 now and then loses the first pulse (a 736-cycle period)"),
+    # none open
 ]
 
 
