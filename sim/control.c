@@ -19,6 +19,7 @@
 #define CONTROL_OUT_MAX (4u << 20)
 #define CONTROL_MEASURE_DEFAULT 50
 #define CONTROL_MAX_ARGS 8
+#define CONTROL_RX_AHEAD (1ull << 40)	/* cycles, as for `wait` */
 
 /* --- reply buffer ---------------------------------------------------------- */
 
@@ -88,7 +89,83 @@ static int parse_mv(const char *s, uint32_t *out)
 	return 0;
 }
 
+static int hex_digit(char ch)
+{
+	if (ch >= '0' && ch <= '9') {
+		return ch - '0';
+	}
+	if (ch >= 'a' && ch <= 'f') {
+		return ch - 'a' + 10;
+	}
+	if (ch >= 'A' && ch <= 'F') {
+		return ch - 'A' + 10;
+	}
+	return -1;
+}
+
+/* Append the bytes of S (pairs of hex digits) to OUT[*N]. 0, or -1 when S is
+ * empty, odd or not hex (*N is then unchanged). */
+static int parse_hex(const char *s, uint8_t *out, size_t *n, size_t max)
+{
+	size_t len = strlen(s), k = *n;
+
+	if (!len || len % 2) {
+		return -1;
+	}
+	for (size_t i = 0; i < len; i += 2) {
+		int hi = hex_digit(s[i]), lo = hex_digit(s[i + 1]);
+
+		if (hi < 0 || lo < 0 || k == max) {
+			return -1;
+		}
+		out[k++] = (uint8_t)(hi << 4 | lo);
+	}
+	*n = k;
+	return 0;
+}
+
 /* --- commands -------------------------------------------------------------- */
+
+/* Schedule bytes on the board's receive line: `rx CYCLE HEX...`. */
+static void cmd_rx(control_t *c, reply_t *r, int argc, char **argv)
+{
+	uint8_t bytes[CONTROL_LINE / 2];
+	size_t n = 0;
+	uint64_t at, now = c->avr->cycle, free_at, room, end;
+
+	if (argc < 3 || parse_u64(argv[1], &at) < 0) {
+		rp(r, "ERR rx CYCLE HEX...: CYCLE decimal, then the bytes in hex");
+		return;
+	}
+	for (int i = 2; i < argc; i++) {
+		if (parse_hex(argv[i], bytes, &n, sizeof(bytes)) < 0) {
+			rp(r, "ERR rx: bad hex '%s' (pairs of hex digits)", argv[i]);
+			return;
+		}
+	}
+	if (at < now) {
+		rp(r, "ERR rx: cycle %" PRIu64 " is past (now %" PRIu64 ")", at, now);
+		return;
+	}
+	if (at - now > CONTROL_RX_AHEAD) {
+		rp(r, "ERR rx: cycle %" PRIu64 " is more than %" PRIu64 " cycles ahead", at,
+		   (uint64_t)CONTROL_RX_AHEAD);
+		return;
+	}
+	free_at = usart_inject_free_at(c->usart);
+	if (at < free_at) {
+		rp(r, "ERR rx: the line is busy until cycle %" PRIu64, free_at);
+		return;
+	}
+	room = usart_inject_room(c->usart);
+	if (n > room) {
+		rp(r, "ERR rx: too many bytes: %zu, room for %" PRIu64 " (at most %u scheduled)",
+		   n, room, (unsigned)USART_INJECT_QUEUE);
+		return;
+	}
+	end = usart_inject(c->usart, at, bytes, n);
+	rp(r, "%" PRIu64, end);
+}
 
 static void cmd_edges(control_t *c, reply_t *r, signal_t *s, int have_since, uint64_t since)
 {
@@ -199,7 +276,7 @@ static void cmd_spi(control_t *c, reply_t *r)
 static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
-	"stack [FROM] | peek ADDR [LEN] | signals | help";
+	"stack [FROM] | peek ADDR [LEN] | rx CYCLE HEX... | signals | help";
 
 int control_request(control_t *c, const char *line, char **out, size_t *len,
 		    size_t *cap, uint64_t *wait_until)
@@ -350,6 +427,8 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 			cmd_measure(c, &r, s, nmax > SIGNAL_RING ? SIGNAL_RING : (unsigned)nmax,
 				    argc == 4, since);
 		}
+	} else if (!strcasecmp(cmd, "rx")) {
+		cmd_rx(c, &r, argc, argv);
 	} else if (!strcasecmp(cmd, "spi") && argc == 1) {
 		cmd_spi(c, &r);
 	} else if (!strcasecmp(cmd, "spidev") && argc == 2) {
@@ -379,7 +458,8 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 
 /* --- socket ---------------------------------------------------------------- */
 
-int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm)
+int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm,
+		 usart_t *usart)
 {
 	struct sockaddr_un sa = { .sun_family = AF_UNIX };
 
@@ -387,6 +467,7 @@ int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm)
 	c->fd = -1;
 	c->avr = avr;
 	c->bm = bm;
+	c->usart = usart;
 	for (int i = 0; i < CONTROL_CLIENTS; i++) {
 		c->client[i].fd = -1;
 	}

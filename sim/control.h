@@ -14,6 +14,7 @@
 #include "sim_avr.h"
 
 #include "board_model.h"
+#include "usart.h"
 
 #define CONTROL_CLIENTS 8
 #define CONTROL_LINE 1024
@@ -34,12 +35,14 @@ typedef struct control_t {
 	char *path;
 	avr_t *avr;
 	board_model_t *bm;
+	usart_t *usart;			/* the board's serial port (`rx`) */
 	control_client_t client[CONTROL_CLIENTS];
 	uint32_t activity;		/* bumps on every request */
 } control_t;
 
 /* Listen on PATH (an existing socket file there is replaced). 0 or -1. */
-int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm);
+int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm,
+		 usart_t *usart);
 
 /* Accept, read, answer, send: never blocks. */
 void control_poll(control_t *c);

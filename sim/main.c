@@ -377,7 +377,8 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 		return 2;
 	}
 	sim->control.fd = -1;
-	if (args->control && control_open(&sim->control, args->control, sim->avr, &sim->bm) < 0) {
+	if (args->control &&
+	    control_open(&sim->control, args->control, sim->avr, &sim->bm, &sim->usart) < 0) {
 		fprintf(stderr, "orfa-sim: cannot listen on '%s': %s\n", args->control,
 			strerror(errno));
 		return 2;
@@ -389,7 +390,8 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 }
 
 /* Idle throttle: after SIM_IDLE_AFTER_S of wall time with nothing on the
- * serial line or the bus, simulated time is held to wall time. */
+ * serial line or the bus (and no `wait` or scheduled byte ahead), simulated
+ * time is held to wall time. */
 typedef struct sim_throttle_t {
 	uint32_t last_activity;
 	double t_last_activity;
@@ -402,7 +404,8 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 {
 	uint32_t act = sim_activity(sim);
 
-	if (host_bytes || act != th->last_activity || control_waiting(&sim->control)) {
+	if (host_bytes || act != th->last_activity || control_waiting(&sim->control) ||
+	    usart_inject_pending(&sim->usart)) {
 		th->last_activity = act;
 		th->t_last_activity = now;
 		th->on = 0;

@@ -110,36 +110,83 @@ static void usart_rx_deliver(usart_t *u, uint8_t byte)
 	}
 }
 
-static int usart_rx_start(usart_t *u)
+/*
+ * The wire. One timer, usart_rx_timer, is due at the end of the byte on the
+ * wire or, while the wire is idle, at the start of the next scheduled byte.
+ * A scheduled byte owns the wire from its start; a host byte goes on the
+ * idle wire only if it ends by the next scheduled start, else it waits.
+ */
+static void usart_rx_begin(usart_t *u, uint8_t byte, avr_cycle_count_t end)
 {
-	if (!u->host_len) {
-		u->rx_wire_busy = 0;
-		return 0;
-	}
-	u->rx_wire_byte = u->host_q[u->host_head];
-	u->host_head = (u->host_head + 1) % USART_HOST_QUEUE;
-	u->host_len--;
+	u->rx_wire_byte = byte;
 	u->rx_wire_busy = 1;
+	u->rx_wire_end = end;
 	u->rx_wire_valid = !!(usart_ucsrb(u) & BIT(UCSRB_RXEN));
-	return 1;
+}
+
+/* Put the next byte on the idle wire at NOW. Returns the cycle the wire
+ * timer is due next (that byte's end, or the next scheduled start), or 0
+ * when there is nothing to send. */
+static avr_cycle_count_t usart_rx_next(usart_t *u, avr_cycle_count_t now)
+{
+	const usart_inject_t *inj = u->inj_len ? &u->inj_q[u->inj_head] : NULL;
+	avr_cycle_count_t bt = usart_byte_cycles(u);
+
+	u->rx_wire_busy = 0;
+	if (inj && inj->start <= now) {
+		usart_rx_begin(u, inj->byte, inj->start + inj->cycles);
+		u->inj_head = (u->inj_head + 1) % USART_INJECT_QUEUE;
+		u->inj_len--;
+		return u->rx_wire_end;
+	}
+	if (u->host_len && (!inj || now + bt <= inj->start)) {
+		uint8_t byte = u->host_q[u->host_head];
+
+		u->host_head = (u->host_head + 1) % USART_HOST_QUEUE;
+		u->host_len--;
+		usart_rx_begin(u, byte, now + bt);
+		return u->rx_wire_end;
+	}
+	return inj ? inj->start : 0;
 }
 
 static avr_cycle_count_t usart_rx_timer(avr_t *avr, avr_cycle_count_t when,
 					void *param)
 {
 	usart_t *u = param;
+	avr_cycle_count_t next;
 
 	(void)avr;
-	if (u->rx_wire_valid && (usart_ucsrb(u) & BIT(UCSRB_RXEN))) {
-		trace_event(u->trace, when, "uart rx %02X", u->rx_wire_byte);
-		usart_rx_deliver(u, u->rx_wire_byte);
-		usart_sync(u);
+	if (u->rx_wire_busy) {
+		if (u->rx_wire_valid && (usart_ucsrb(u) & BIT(UCSRB_RXEN))) {
+			trace_event(u->trace, when, "uart rx %02X", u->rx_wire_byte);
+			usart_rx_deliver(u, u->rx_wire_byte);
+			usart_sync(u);
+		}
+		u->activity++;
 	}
-	u->activity++;
-	if (usart_rx_start(u)) {
-		return when + usart_byte_cycles(u);
+	next = usart_rx_next(u, when);
+	u->rx_timer_armed = next != 0;
+	return next;
+}
+
+/* Something new to send: if the wire is idle, (re)plan its timer now. */
+static void usart_rx_kick(usart_t *u)
+{
+	avr_t *avr = u->avr;
+	avr_cycle_count_t next;
+
+	if (u->rx_wire_busy) {
+		return;		/* the timer at the byte's end takes it from there */
 	}
-	return 0;
+	if (u->rx_timer_armed) {
+		avr_cycle_timer_cancel(avr, usart_rx_timer, u);
+	}
+	next = usart_rx_next(u, avr->cycle);
+	u->rx_timer_armed = next != 0;
+	if (next) {
+		avr_cycle_timer_register(avr, next - avr->cycle, usart_rx_timer, u);
+	}
 }
 
 size_t usart_host_room(const usart_t *u)
@@ -153,10 +200,51 @@ void usart_host_send(usart_t *u, const uint8_t *buf, size_t n)
 		u->host_q[(u->host_head + u->host_len) % USART_HOST_QUEUE] = buf[i];
 		u->host_len++;
 	}
-	if (!u->rx_wire_busy && usart_rx_start(u)) {
-		avr_cycle_timer_register(u->avr, usart_byte_cycles(u),
-					 usart_rx_timer, u);
+	usart_rx_kick(u);
+}
+
+avr_cycle_count_t usart_inject_free_at(const usart_t *u)
+{
+	avr_cycle_count_t t = u->avr->cycle;
+
+	if (u->rx_wire_busy && u->rx_wire_end > t) {
+		t = u->rx_wire_end;
 	}
+	if (u->inj_len && u->inj_end > t) {
+		t = u->inj_end;
+	}
+	return t;
+}
+
+size_t usart_inject_room(const usart_t *u)
+{
+	return USART_INJECT_QUEUE - u->inj_len;
+}
+
+size_t usart_inject_pending(const usart_t *u)
+{
+	return u->inj_len;
+}
+
+avr_cycle_count_t usart_inject(usart_t *u, avr_cycle_count_t start,
+			       const uint8_t *buf, size_t n)
+{
+	uint32_t bt = (uint32_t)usart_byte_cycles(u);
+
+	if (n == 0 || n > usart_inject_room(u) || start < usart_inject_free_at(u)) {
+		return 0;
+	}
+	for (size_t i = 0; i < n; i++) {
+		usart_inject_t *e = &u->inj_q[(u->inj_head + u->inj_len) % USART_INJECT_QUEUE];
+
+		e->start = start + i * bt;
+		e->cycles = bt;
+		e->byte = buf[i];
+		u->inj_len++;
+	}
+	u->inj_end = start + n * bt;
+	usart_rx_kick(u);
+	return u->inj_end;
 }
 
 /* --- transmitter --------------------------------------------------------- */
@@ -379,13 +467,15 @@ static void usart_reset(avr_io_t *io)
 	const mcu_usart_regs_t *r = u->regs;
 
 	/* avr_reset has wiped the cycle timers: the byte on the wire is lost
-	 * in both directions; the host queue keeps flowing (into a receiver
-	 * that is off until the firmware enables it). */
+	 * in both directions; the host queue and the scheduled bytes keep
+	 * flowing (into a receiver that is off until the firmware enables it). */
 	u->ucsra = BIT(UCSRA_UDRE);
 	u->ucsrc = BIT(UCSRC_UCSZ1) | BIT(UCSRC_UCSZ0);
 	u->ubrr = 0;
 	usart_rx_flush(u);
 	u->rx_wire_busy = 0;
+	avr_cycle_timer_cancel(avr, usart_rx_timer, u);
+	u->rx_timer_armed = 0;
 	u->tx_buf_full = 0;
 	u->tx_shift_busy = 0;
 	avr->data[r->ucsrb] = 0;
@@ -395,10 +485,7 @@ static void usart_reset(avr_io_t *io)
 		avr->data[r->ucsrc] = u->ucsrc;
 	}
 	usart_sync(u);
-	if (usart_rx_start(u)) {
-		avr_cycle_timer_register(avr, usart_byte_cycles(u),
-					 usart_rx_timer, u);
-	}
+	usart_rx_kick(u);
 }
 
 void usart_init(usart_t *u, avr_t *avr, const mcu_usart_regs_t *regs,

@@ -9,6 +9,9 @@
  *
  * Receive: bytes from the host are queued and put on the wire back to back;
  * 2-byte FIFO plus the shift register, DOR and a lost byte on overflow.
+ * Bytes can also be scheduled at chosen cycles (usart_inject, the control
+ * request `rx`); they own the wire at their cycles and host bytes wait for
+ * a gap long enough for a whole byte.
  * Transmit: UDR buffer plus shift register; a byte reaches the host at the
  * end of its stop bit.
  */
@@ -29,7 +32,17 @@
  * there is room, so a fast host is slowed by the kernel's pty buffer. */
 #define USART_HOST_QUEUE 4096
 
+/* Bytes scheduled with usart_inject and not yet on the wire, at most. */
+#define USART_INJECT_QUEUE 32768
+
 typedef void (*usart_to_host_t)(void *param, uint8_t byte);
+
+/* One scheduled byte: its start bit begins at START, it takes CYCLES. */
+typedef struct usart_inject_t {
+	avr_cycle_count_t start;
+	uint32_t cycles;
+	uint8_t byte;
+} usart_inject_t;
 
 typedef struct usart_rx_slot_t {
 	uint8_t data;
@@ -55,7 +68,12 @@ typedef struct usart_t {
 	/* host -> wire -> receiver */
 	uint8_t host_q[USART_HOST_QUEUE];
 	size_t host_head, host_len;
+	usart_inject_t inj_q[USART_INJECT_QUEUE];	/* scheduled, by start */
+	size_t inj_head, inj_len;
+	avr_cycle_count_t inj_end;	/* end of the last scheduled byte */
+	int rx_timer_armed;		/* usart_rx_timer is registered */
 	int rx_wire_busy;		/* a byte is on the wire now */
+	avr_cycle_count_t rx_wire_end;	/* ... until the end of its stop bit */
 	uint8_t rx_wire_byte;
 	int rx_wire_valid;		/* the receiver was on at its start bit */
 	usart_rx_slot_t rx_fifo[2];
@@ -84,6 +102,23 @@ size_t usart_host_room(const usart_t *u);
 
 /* Queue N bytes from the host (at most usart_host_room). */
 void usart_host_send(usart_t *u, const uint8_t *buf, size_t n);
+
+/* The first cycle at which usart_inject may start a byte: now, or the end
+ * of the byte on the wire or of the last scheduled one if later. */
+avr_cycle_count_t usart_inject_free_at(const usart_t *u);
+
+/* Room left in the schedule of usart_inject, in bytes. */
+size_t usart_inject_room(const usart_t *u);
+
+/* Bytes scheduled and not yet on the wire. */
+size_t usart_inject_pending(const usart_t *u);
+
+/* Schedule N bytes (at most usart_inject_room) on the receive line, back to
+ * back at the current byte time, the first start bit at cycle START (at or
+ * after usart_inject_free_at). Returns the cycle the last stop bit ends, or
+ * 0 when START or N break those rules (nothing is scheduled then). */
+avr_cycle_count_t usart_inject(usart_t *u, avr_cycle_count_t start,
+			       const uint8_t *buf, size_t n);
 
 /* Cycles one frame takes with the current UBRR/U2X/UCSRC settings. */
 avr_cycle_count_t usart_byte_cycles(const usart_t *u);

@@ -8,8 +8,14 @@ static RAM and measured peak stack (the simulator paints SRAM; the firmware
 is first put through every driver's requests), and servo pulse accuracy:
 width error against the commanded width and its spread (jitter) while
 requests stream over the UART back to back. Everything is counted in
-simulated CPU cycles, so every figure is exact and repeatable; wall time
-enters only the simulator-speed line.
+simulated CPU cycles; wall time enters only the simulator-speed line.
+
+Every request reaches the board at a fixed cycle after power-up: each board
+gets a fresh simulator, and the whole run is scheduled on its serial line
+at once with the control request `rx` (docs/simulator.md) before the board
+gets there, each request after the last one's reply, with the firmware idle
+in between. So the firmware is in the same state at every request and two
+runs print the same figures, cycle for cycle.
 
     python3 tools/bench.py [--boards m32d m128s] [--requests 1000]
 """
@@ -26,9 +32,18 @@ sys.path.insert(0, str(ROOT / "host"))
 import serial  # noqa: E402
 
 from orfa.sim import SimBoard, firmware_path, parse_trace  # noqa: E402
+from orfa.simctl import RX_MAX, SimControlError  # noqa: E402
 
 F_CPU = 7372800
 CYCLES_PER_BYTE = 640  # 10 bit times at 115200 baud
+#: The first request's first byte: 2.3 s simulated after power-up, far ahead
+#: of the cycle the simulator is at when the schedule is sent (about 0.1 s).
+START = 1 << 24
+#: Idle time between one request's last byte and the next request: longer
+#: than any reply here takes (129 bytes, 82560 cycles).
+GAP = 1 << 18
+#: Bytes the simulator holds scheduled at once (docs/simulator.md).
+RX_SCHEDULE = 32768
 
 LATENCY_REQUESTS = [
     ("V", "V\r", 250),
@@ -51,41 +66,53 @@ def footprint(board):
     return text + data, data + bss
 
 
-def read_trace(sim, settle=0.3):
-    time.sleep(settle)  # let the simulator flush the last trace lines
-    return parse_trace(sim.trace_path.read_text())
+class Schedule:
+    """Requests put on the board's serial line at fixed cycles, one after the
+    other, each GAP (or `gap`) cycles after the last one's last byte."""
+
+    def __init__(self, ctl, start):
+        self.ctl = ctl
+        self.at = start
+        self.bytes = 0
+
+    def send(self, data, gap=GAP):
+        """Schedules `data`; returns (cycle of its first start bit, cycle its
+        last stop bit ends)."""
+        start = end = self.at
+        for i in range(0, len(data), RX_MAX):
+            end = self.ctl.rx(end, data[i:i + RX_MAX])
+        self.at = end + gap
+        self.bytes += len(data)
+        return start, end
 
 
-def latency(sim, port, request):
-    """Cycles from the request's terminator to the first reply byte."""
-    before = len(read_trace(sim, 0))
-    port.write(request.encode())
-    reply = port.readline()
-    events = read_trace(sim)[before:]
-    rx = [e for e in events if e.kind == "uart rx"]
-    end = rx[-1].cycle
+def latency(events, window, reply):
+    """Cycles from the request's last stop bit to the first reply byte."""
+    start, end = window
+    rx = [e for e in events if e.kind == "uart rx" and start < e.cycle <= end]
+    if len(rx) != (end - start) // CYCLES_PER_BYTE or rx[-1].cycle != end:
+        raise SystemExit("bench: a request did not reach the board at its cycles: %r" % rx)
     first_tx = next(e for e in events if e.kind == "uart tx" and e.cycle > end)
     return first_tx.cycle - end, reply
 
 
-def pipeline(sim, port, count):
-    """Sends `count` requests in one write; returns (correct, cycles, replies)."""
-    expected = port_request_reply(port, PIPELINE_REQUEST)
-    before = len(read_trace(sim, 0))
-    port.write((PIPELINE_REQUEST * count).encode())
-    replies = [port.readline() for _ in range(count)]
-    events = read_trace(sim, 0.5)[before:]
-    rx = [e for e in events if e.kind == "uart rx"]
-    tx = [e for e in events if e.kind == "uart tx"]
-    start = rx[0].cycle - CYCLES_PER_BYTE        # start bit of the first request byte
+def pipeline(events, window, until, replies, expected, request_bytes):
+    """(correct replies, cycles from the first request byte's start bit to
+    the last reply byte's stop bit, request bytes on the wire)."""
+    start, _ = window
+    tx = [e for e in events if e.kind == "uart tx" and start < e.cycle < until]
     end = tx[-1].cycle + CYCLES_PER_BYTE          # stop bit of the last reply byte
     correct = sum(1 for r in replies if r == expected)
-    return correct, end - start, len(rx)
+    return correct, end - start, request_bytes
 
 
-def port_request_reply(port, request):
-    port.write(request.encode())
-    return port.readline()
+def read_replies(port, count):
+    replies = [port.readline() for _ in range(count)]
+    missing = [r for r in replies if not r.endswith(b"\n")]
+    if missing:
+        raise SystemExit("bench: the board did not answer (%d of %d replies missing)"
+                         % (len(missing), count))
+    return replies
 
 
 # Requests that reach every driver (register numbers from docs/registers.md).
@@ -105,6 +132,7 @@ SERVOS = {
                      (31, 1234, "servo31")]),
 }
 SERVO_LOAD = "S AA 00 01 S AB 06 P\r"
+SERVO_LOAD_COUNT = 400
 
 
 def servo_request(board):
@@ -112,32 +140,35 @@ def servo_request(board):
     return "S AA %02X %s P" % (reg, " ".join("%02X %04X" % (ch, us) for ch, us, _ in chans))
 
 
-def servo_figures(ctl, port, board):
-    """Worst width error (us) and width spread (cycles), quiet and under load."""
-    reg, chans = SERVOS[board]
-    port.write((servo_request(board) + "\r").encode())
-    port.readline()
-    ctl.wait(F_CPU // 5)  # 10 frames
+def pulses(ctl, sig, since, until):
+    """(high, period) of every complete pulse of SIG (rise, fall, next rise)
+    with its edges in [since, until], in cycles."""
+    edges = [(c, level) for c, level in ctl.edges(sig, since) if c <= until]
+    return [(fall - rise, nxt - rise)
+            for (rise, l0), (fall, _), (nxt, _) in zip(edges, edges[1:], edges[2:]) if l0 == 1]
 
-    def sample(since):
+
+def servo_figures(ctl, board, quiet, load):
+    """Worst width error (us), width spread and worst period error (cycles)
+    over the windows `quiet` (the servos running, the UART idle) and `load`
+    (requests arriving back to back), each (since, until) in cycles."""
+    _, chans = SERVOS[board]
+
+    def sample(window):
         err, spread, period = 0.0, 0, 0
         for _, us, sig in chans:
-            m = ctl.measure(sig, 50, since)
+            got = pulses(ctl, sig, *window)
+            if not got:
+                raise SystemExit("bench: no complete servo pulse on %s in cycles %d..%d"
+                                 % (sig, window[0], window[1]))
+            highs = [h for h, _ in got]
             want = us * F_CPU / 1e6
-            err = max(err, abs(m["high"][0] - want), abs(m["high"][1] - want))
-            spread = max(spread, m["high"][1] - m["high"][0])
-            period = max(period, abs(m["period"][0] - 147456), abs(m["period"][1] - 147456))
+            err = max(err, max(abs(h - want) for h in highs))
+            spread = max(spread, max(highs) - min(highs))
+            period = max(period, max(abs(p - 147456) for _, p in got))
         return err / F_CPU * 1e6, spread, period
 
-    quiet = sample(ctl.time() - F_CPU // 6)
-    t0 = ctl.time()
-    n = 400
-    port.write((SERVO_LOAD * n).encode())
-    ctl.wait(n * len(SERVO_LOAD) * CYCLES_PER_BYTE)
-    loaded = sample(t0)
-    for _ in range(n):
-        port.readline()
-    return quiet, loaded
+    return sample(quiet), sample(load)
 
 
 def heap_start(board):
@@ -147,20 +178,50 @@ def heap_start(board):
     return int(end, 16) - 0x800000
 
 
+def schedule_bytes(board, count):
+    """Bytes one board's run puts on the serial line."""
+    return (sum(len(r) for _, r, _ in LATENCY_REQUESTS) + len(PIPELINE_REQUEST) * count
+            + len(servo_request(board)) + 1 + len(SERVO_LOAD) * SERVO_LOAD_COUNT
+            + sum(len(r) + 1 for r in EXERCISE[board]))
+
+
 def bench_board(board, count):
     rows = {}
     wall0 = time.monotonic()
     with SimBoard(board, control=True) as sim:
-        with serial.Serial(sim.port, 115200, timeout=10) as port:
-            for name, request, _ in LATENCY_REQUESTS:
-                rows[name] = latency(sim, port, request)
-            correct, cycles, rx_bytes = pipeline(sim, port, count)
-            rows["servo"] = servo_figures(sim.control, port, board)
-            for request in EXERCISE[board]:
-                port.write((request + "\r").encode())
-                port.readline()
-        rows["stack"] = sim.control.stack(heap_start(board))
-        cycles_total = sim.control.time()
+        ctl = sim.control
+        now = ctl.time()
+        if now >= START:
+            raise SystemExit("bench: the %s simulator was at cycle %d before the schedule "
+                             "(it must start at %d); is the machine very busy?"
+                             % (board, now, START))
+        sched = Schedule(ctl, START)
+        try:
+            lat = [(name, sched.send(request.encode())) for name, request, _ in LATENCY_REQUESTS]
+            pipe = sched.send((PIPELINE_REQUEST * count).encode())
+            # the servos run 10 frames before the quiet window's end
+            servo_set = sched.send((servo_request(board) + "\r").encode(), gap=F_CPU // 5)
+            load = sched.send((SERVO_LOAD * SERVO_LOAD_COUNT).encode())
+            exercise = [sched.send((request + "\r").encode()) for request in EXERCISE[board]]
+        except SimControlError as e:
+            raise SystemExit("bench: the %s simulator refused the schedule at cycle %d: %s"
+                             % (board, sched.at, e))
+        assert sched.bytes == schedule_bytes(board, count)
+        with serial.Serial(sim.port, 115200, timeout=30) as port:
+            lat_replies = read_replies(port, len(lat))
+            pipe_replies = read_replies(port, count)
+            read_replies(port, 1 + SERVO_LOAD_COUNT + len(exercise))
+        events = parse_trace(sim.trace_text())
+        for (name, window), reply in zip(lat, lat_replies):
+            rows[name] = latency(events, window, reply)
+        # the pipelined request is one of the latency requests: its reply there
+        expected = lat_replies[[r for _, r, _ in LATENCY_REQUESTS].index(PIPELINE_REQUEST)]
+        correct, cycles, rx_bytes = pipeline(events, pipe, servo_set[0], pipe_replies,
+                                             expected, len(PIPELINE_REQUEST) * count)
+        quiet = (load[0] - F_CPU // 6, load[0])
+        rows["servo"] = servo_figures(ctl, board, quiet, load)
+        rows["stack"] = ctl.stack(heap_start(board))
+        cycles_total = ctl.time()
     wall = time.monotonic() - wall0
     wire = rx_bytes * CYCLES_PER_BYTE
     rows["pipeline"] = (correct, cycles, wire)
@@ -174,6 +235,16 @@ def main():
     ap.add_argument("--boards", nargs="+", default=["m32d", "m128s"])
     ap.add_argument("--requests", type=int, default=1000)
     args = ap.parse_args()
+    for b in args.boards:
+        if b not in SERVOS:
+            ap.error("--boards: no board %r (%s)" % (b, " ".join(SERVOS)))
+    if args.requests < 1:
+        ap.error("--requests must be at least 1")
+    for b in args.boards:
+        if schedule_bytes(b, args.requests) > RX_SCHEDULE:
+            most = (RX_SCHEDULE - schedule_bytes(b, 0)) // len(PIPELINE_REQUEST)
+            ap.error("--requests %d: the %s run would not fit the simulator's %d scheduled "
+                     "bytes; at most %d" % (args.requests, b, RX_SCHEDULE, most))
 
     results = {b: bench_board(b, args.requests) for b in args.boards}
     width = 34

@@ -11,6 +11,11 @@ import time
 from typing import Dict, List, Optional, Tuple, Union
 
 
+#: Bytes one `rx` request carries at most here: its hex fits a request line
+#: (1023 characters) with any cycle.
+RX_MAX = 480
+
+
 class SimControlError(RuntimeError):
     """The simulator refused a request (its ``ERR ...`` text)."""
 
@@ -138,6 +143,16 @@ class SimControl:
         __heap_start, minus 0x800000); 0 lets the simulator guess."""
         words = self.request("stack %d" % heap_start).split()
         return {"peak": int(words[1]), "deepest": int(words[3], 16), "ramend": int(words[5], 16)}
+
+    def rx(self, cycle: int, data: bytes) -> int:
+        """Put `data` on the board's serial receive line, the first start bit
+        at simulated `cycle`, back to back at the byte time the firmware set
+        (640 cycles at 115200 baud). Returns the cycle the last byte's stop
+        bit ends (it reaches the receiver then). At most 480 bytes a call
+        (the request line's length); see docs/simulator.md."""
+        if not 1 <= len(data) <= RX_MAX:
+            raise ValueError("rx takes 1..%d bytes, not %d" % (RX_MAX, len(data)))
+        return int(self.request("rx %d %s" % (cycle, bytes(data).hex().upper())))
 
     def peek(self, addr: int, n: int = 1) -> bytes:
         """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
