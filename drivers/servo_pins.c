@@ -35,7 +35,9 @@
 #define SERVO_NEAR   (SERVO_LEAD + 80)  /* closer than this: wait in place */
 #define SERVO_FINE   96        /* last stretch, waited on Timer0 */
 #define SERVO_EDGES  (2 * SERVO_CHANNELS)
-#define SERVO_FALL   0x80      /* edge code: channel | SERVO_FALL */
+#define SERVO_FALL   0x80      /* edge code: channel | SERVO_FALL | SERVO_LONG */
+#define SERVO_LONG   0x40      /* the edge's delta is 65536 cycles more */
+#define SERVO_CHAN   0x1F      /* the edge code's channel */
 #define SERVO_GAP    400       /* least distance between two edges, cycles */
 #define SERVO_SHIFT  32        /* unit of a channel's move, cycles */
 #define SERVO_MOVES  96        /* most units a channel moves either way */
@@ -43,11 +45,18 @@
 _Static_assert(SERVO_SLOT * (SERVO_CHANNELS - 1) + SERVO_SHIFT * SERVO_MOVES + 18432UL + 1000UL
 	       < SERVO_FRAME, "the last channel's longest pulse ends inside the frame");
 
+/* No two edges of a frame are 131072 cycles apart (SERVO_LONG covers 17
+ * bits): the latest start is the last channel's, moved late. */
+_Static_assert(SERVO_SLOT * (SERVO_CHANNELS - 1) + SERVO_SHIFT * SERVO_MOVES < 0x20000UL,
+	       "a delta fits 16 bits and SERVO_LONG");
+_Static_assert(SERVO_CHANNELS <= SERVO_CHAN + 1, "a channel fits the edge code");
+
 typedef struct {
 	uint8_t n;                        /* edges in this frame */
 	uint8_t edge[SERVO_EDGES];        /* sorted by time */
 	uint16_t delta[SERVO_EDGES];      /* cycles after the edge before (the
-					   * first: after the frame's start) */
+					   * first: after the frame's start),
+					   * + 65536 with SERVO_LONG */
 } servo_sched_t;
 
 static struct {
@@ -124,7 +133,7 @@ ISR(TIMER2_COMP_vect)
 	for (;;) {
 		const servo_sched_t *s = &sv.sched[sv.active];
 		uint8_t e = s->edge[sv.next];
-		uint8_t pin = servo_pin[e & (uint8_t)~SERVO_FALL];
+		uint8_t pin = servo_pin[e & SERVO_CHAN];
 		volatile uint8_t *reg = (volatile uint8_t *)(uint16_t)port_addr[PIN_PORT(pin)];
 		uint8_t mask = line_mask[pin & 7];
 		uint8_t lo = (uint8_t)(sv.target + sv.t0_offset);
@@ -166,6 +175,9 @@ ISR(TIMER2_COMP_vect)
 			}
 		}
 		sv.target += s->delta[sv.next];
+		if (s->edge[sv.next] & SERVO_LONG) {
+			sv.target += 0x10000;
+		}
 		if (servo_arm()) {
 			return;
 		}
@@ -235,7 +247,7 @@ static bool servo_clear_of(uint16_t t8, const uint16_t *at8, const uint8_t *edge
 {
 	for (uint8_t i = 0; i < n; i++) {
 		int16_t d = (int16_t)(t8 - at8[i]);
-		if ((edge[i] & (uint8_t)~SERVO_FALL) != self && d < SERVO_GAP8 && d > -SERVO_GAP8) {
+		if ((edge[i] & SERVO_CHAN) != self && d < SERVO_GAP8 && d > -SERVO_GAP8) {
 			return false;
 		}
 	}
@@ -306,10 +318,14 @@ void servo_hw_apply(const uint16_t *widths_us)
 	/* Exact cycles from here on: each edge after the one before. */
 	uint32_t prev = 0;
 	for (uint8_t i = 0; i < n; i++) {
-		uint8_t ch = s->edge[i] & (uint8_t)~SERVO_FALL;
+		uint8_t ch = s->edge[i] & SERVO_CHAN;
 		uint32_t t = slot_start[ch] + (int32_t)sv.move[ch] * SERVO_SHIFT;
 		if (s->edge[i] & SERVO_FALL) {
 			t += width[ch];
+		}
+		/* Channels far apart: up to 125937 cycles between two edges. */
+		if (t - prev > 0xFFFF) {
+			s->edge[i] |= SERVO_LONG;
 		}
 		s->delta[i] = (uint16_t)(t - prev);
 		prev = t;
@@ -325,6 +341,9 @@ void servo_hw_apply(const uint16_t *widths_us)
 			sv.next = 0;
 			sv.frame = ((uint32_t)servo_ticks() << 3) + 4096;
 			sv.target = sv.frame + s->delta[0];
+			if (s->edge[0] & SERVO_LONG) {
+				sv.target += 0x10000;
+			}
 			servo_arm();
 			sv.running = 1;
 			/* (No TIFR write: simavr 1.6 clears every flag on one.) */

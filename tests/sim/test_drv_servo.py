@@ -102,6 +102,24 @@ def test_m32d_pulse_start_offsets(drv):
         assert abs(rises[0] - rise0 - 8191 * ch) <= WIDTH_TOL, (ch, rises[0] - rise0)
 
 
+@pytest.mark.parametrize("widths", [{0: 1000, 13: 1500}, {1: 1096, 10: 1500}])
+def test_m32d_long_gaps_keep_the_starts(drv, widths):
+    """M32-D: more than 65535 cycles between two edges (channels far apart)
+    still start each channel n x 8191 cycles into the frame. {1: 1096,
+    10: 1500}: channel 1 ends 65638 cycles before channel 10 starts, so an
+    edge time kept to 16 bits would come 102 cycles after it."""
+    if drv.board != "m32d":
+        pytest.skip("M32-D only")
+    set_widths(drv, widths)
+    since = settle(drv)
+    first, last = sorted(widths)
+    rise = drv.highs(drv.lay["servo_pins"][first], since)[0][0]
+    later = [r for r, _, _ in drv.highs(drv.lay["servo_pins"][last], rise)]
+    assert abs(later[0] - rise - 8191 * (last - first)) <= WIDTH_TOL, (later[0] - rise)
+    for ch, us in widths.items():
+        check_pulses(drv, drv.lay["servo_pins"][ch], us, since)
+
+
 def test_m128s_long_counter_frame_stretches(drv):
     """M128-S: eight 2500 us widths on one counter (20 ms > 19.8 ms) stretch
     that frame to fit them; the widths stay exact."""
