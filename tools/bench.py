@@ -105,6 +105,38 @@ SERVOS = {
                      (31, 1234, "servo31")]),
 }
 SERVO_LOAD = "S AA 00 01 S AB 06 P\r"
+# Servo writes timed like the latencies above (request end to reply start):
+# 16 channels pulse (M128-S: every other channel, all four counters), then
+# one-triple writes, spaced as a host writes them ("S AA 13 03 05 DC P"),
+# and 16-triple writes, packed to fit a request ("SAA13" + 96 digits + "P").
+# Widths near 1111 us x k end where another channel starts: those channels
+# must move. The figure is the slowest write of each kind.
+SERVO_WRITE_START = lambda k: 1000 + 100 * (k % 8)
+SERVO_WRITE_1 = [(3, 1500), (7, 1111), (0, 2222), (15, 2500), (3, 1600), (8, 1000)]
+SERVO_WRITE_16 = [lambda k: 1111, lambda k: 1500, lambda k: 2000 - 41 * k, SERVO_WRITE_START]
+
+
+def servo_write_figures(sim, port, board):
+    """Slowest 1-triple and 16-triple SP write (cycles) and their wire times."""
+    reg = SERVOS[board][0]
+    step = 2 if board == "m128s" else 1
+    chans = [step * k for k in range(16)]
+
+    def write(req):
+        cycles, reply = latency(sim, port, req + "\r")
+        assert reply.startswith(b"SW") and b"ERROR" not in reply, (req, reply)
+        return cycles, (len(req) + 1) * CYCLES_PER_BYTE
+
+    def write16(width):
+        return write("SAA%02X%sP" % (reg, "".join("%02X%04X" % (ch, width(k))
+                                                  for k, ch in enumerate(chans))))
+
+    write16(SERVO_WRITE_START)
+    one = max(write("S AA %02X %02X %02X %02X P" % (reg, step * k, us >> 8, us & 0xFF))
+              for k, us in SERVO_WRITE_1)
+    sixteen = max(write16(w) for w in SERVO_WRITE_16)
+    write16(lambda k: 0)
+    return one, sixteen
 
 
 def servo_request(board):
@@ -156,6 +188,7 @@ def bench_board(board, count):
                 rows[name] = latency(sim, port, request)
             correct, cycles, rx_bytes = pipeline(sim, port, count)
             rows["servo"] = servo_figures(sim.control, port, board)
+            rows["servo write"] = servo_write_figures(sim, port, board)
             for request in EXERCISE[board]:
                 port.write((request + "\r").encode())
                 port.readline()
@@ -196,6 +229,12 @@ def main():
     print("%-*s" % (width, "pipelined: % of wire") + "".join(
         "%14.2f" % (100.0 * results[b]["pipeline"][2] / results[b]["pipeline"][1]) for b in args.boards)
         + "%10s" % ">= 99")
+    for i, label in enumerate(("servo write, 1 triple (cycles)", "servo write, 16 triples (cycles)")):
+        print("%-*s" % (width, label) + "".join(
+            "%14d" % results[b]["servo write"][i][0] for b in args.boards)
+            + "%10s" % ("<= 10000" if i == 0 else "< wire"))
+    print("%-*s" % (width, "  wire time of the 16-triple write") + "".join(
+        "%14d" % results[b]["servo write"][1][1] for b in args.boards))
     print("%-*s" % (width, "flash (B)") + "".join("%14d" % results[b]["footprint"][0] for b in args.boards)
           + "%10s%12d" % ("<= %d" % BUDGET_FLASH, BUDGET_FLASH))
     print("%-*s" % (width, "static RAM (B)") + "".join("%14d" % results[b]["footprint"][1] for b in args.boards)
