@@ -1,0 +1,279 @@
+/*
+ * The M32-D servo planner (drivers/servo_plan.c) on the host, step by step
+ * against a model of what docs/registers.md ("Servos") and servo_plan.h
+ * promise: every pulsing channel once a frame with its width, channel n
+ * starting n x 8191 cycles into the frame unless it must move, moves in
+ * 32-cycle units, at most 96 either way, never before the frame's start,
+ * the nearest place first (earlier before later at the same distance), no
+ * edge within 400 cycles of another channel's edge (counted as the planner
+ * counts: 50 apart in 8-cycle units), channels whose width stays the same
+ * never move. Prints "servo plan: N passed, N failed".
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "drivers/servo_plan.h"
+
+#define NCH SERVO_CHANNELS
+#define SLOT 8191L
+#define SHIFT 32L
+#define MOVES 96
+#define GAP8 50
+#define FRAME 147456L
+
+static int passed, failed;
+
+static void check(int ok, const char *what, long step)
+{
+	if (ok) {
+		passed++;
+	} else {
+		failed++;
+		if (failed <= 20) {
+			printf("FAIL servo plan, step %ld: %s\n", step, what);
+		}
+	}
+}
+
+/* Cycles for a width: us x 7.3728 to the nearest cycle, as a 16.16
+ * product (the planner's arithmetic; checked below against the exact
+ * product: at most 0.51 cycles off). */
+static long cycles(unsigned us)
+{
+	return us ? (long)(((unsigned long)us * 483184UL + 32768UL) >> 16) : 0;
+}
+
+/* What the model knows of the last plan: each channel's width (cycles, 0 =
+ * off) and move (SHIFT units; an off channel keeps its last one). */
+static long m_width[NCH];
+static int m_move[NCH];
+
+static long rise_of(int ch, int move)
+{
+	return SLOT * ch + SHIFT * move;
+}
+
+static long floor8(long t)
+{
+	return t >= 0 ? t / 8 : -((-t + 7) / 8);
+}
+
+/* Whether channel ch at `move` keeps GAP8 from every channel in `with`. */
+static int clear(int ch, int move, const int *with)
+{
+	long r = rise_of(ch, move), f = r + m_width[ch];
+	for (int c = 0; c < NCH; c++) {
+		if (!with[c] || c == ch) {
+			continue;
+		}
+		long cr = rise_of(c, m_move[c]), cf = cr + m_width[c];
+		long mine[2] = { floor8(r), floor8(f) }, theirs[2] = { floor8(cr), floor8(cf) };
+		for (int i = 0; i < 2; i++) {
+			for (int j = 0; j < 2; j++) {
+				if (labs(mine[i] - theirs[j]) < GAP8) {
+					return 0;
+				}
+			}
+		}
+	}
+	return 1;
+}
+
+static long fallbacks, moves_seen;
+
+/* The model's plan of `us`: channels whose width changes are placed in
+ * channel order, each at the nearest clear place (0, -1, +1, -2, ...) among
+ * the channels that keep theirs and those placed before it; a channel with
+ * no clear place keeps its last one. `unplaced` gets those channels. */
+static void model(const uint16_t *us, int *unplaced)
+{
+	int changed[NCH], placed[NCH];
+	for (int ch = 0; ch < NCH; ch++) {
+		long w = cycles(us[ch]);
+		changed[ch] = w != m_width[ch];
+		m_width[ch] = w;
+		placed[ch] = w && !changed[ch];
+		unplaced[ch] = 0;
+	}
+	for (int ch = 0; ch < NCH; ch++) {
+		if (!changed[ch] || !m_width[ch]) {
+			continue;
+		}
+		int k;
+		for (k = 0; k <= 2 * MOVES; k++) {
+			int move = (k & 1) ? -(k + 1) / 2 : k / 2;
+			if (rise_of(ch, move) >= 0 && clear(ch, move, placed)) {
+				m_move[ch] = move;
+				moves_seen += move != 0;
+				break;
+			}
+		}
+		if (k > 2 * MOVES) {
+			unplaced[ch] = 1;
+			fallbacks++;
+		}
+		placed[ch] = 1;
+	}
+}
+
+/* Decodes a schedule into each channel's rise and fall (-1: none) and checks
+ * its form: times in order, each pulsing channel once, nothing else. */
+static void decode(const servo_sched_t *s, long *rise, long *fall, long step)
+{
+	long t = 0, prev = -1;
+	int ok_order = 1, ok_code = 1;
+	for (int ch = 0; ch < NCH; ch++) {
+		rise[ch] = fall[ch] = -1;
+	}
+	for (int i = 0; i < s->n; i++) {
+		uint8_t e = s->edge[i];
+		int ch = e & SERVO_CHAN;
+		t += s->delta[i] + ((e & SERVO_LONG) ? 65536L : 0);
+		ok_order &= t > prev;
+		prev = t;
+		long *slot = (e & SERVO_FALL) ? &fall[ch] : &rise[ch];
+		ok_code &= ch < NCH && !(e & (uint8_t)~(SERVO_CHAN | SERVO_FALL | SERVO_LONG))
+			   && *slot < 0;
+		if (ch < NCH) {
+			*slot = t;
+		}
+	}
+	check(ok_order, "edges in time order", step);
+	check(ok_code, "each edge once, a known code", step);
+	check(prev < FRAME, "the last edge inside the frame", step);
+}
+
+/* One write of `us` (all channels); `exact`: the planner must place as the
+ * model does (else: only the rules every plan keeps). */
+static void step(servo_sched_t *s, const uint16_t *us, int exact, long n)
+{
+	int unplaced[NCH];
+	long rise[NCH], fall[NCH];
+	char what[200];
+
+	model(us, unplaced);
+	servo_plan(s, us);
+	decode(s, rise, fall, n);
+	int count = 0, ok_width = 1, ok_move = 1, ok_same = 1;
+	for (int ch = 0; ch < NCH; ch++) {
+		if (!us[ch]) {
+			ok_width &= rise[ch] < 0 && fall[ch] < 0;
+			continue;
+		}
+		count++;
+		ok_width &= rise[ch] >= 0 && fall[ch] - rise[ch] == m_width[ch];
+		long off = rise[ch] - SLOT * ch;
+		ok_move &= off % SHIFT == 0 && labs(off / SHIFT) <= MOVES && rise[ch] >= 0;
+		if (exact && rise[ch] != rise_of(ch, m_move[ch])) {
+			ok_same = 0;
+			snprintf(what, sizeof what, "channel %d at %ld, the model has %ld", ch,
+				 rise[ch], rise_of(ch, m_move[ch]));
+		}
+		if (!exact) {
+			m_move[ch] = (int)(off / SHIFT);  /* the model follows the planner */
+		}
+	}
+	check(s->n == 2 * count, "two edges a pulsing channel", n);
+	check(ok_width, "widths as planned, off channels silent", n);
+	check(ok_move, "moves in 32-cycle units, at most 96, not before the frame", n);
+	check(ok_same, ok_same ? "placed as the model" : what, n);
+	/* Edges of different channels 50 apart in 8-cycle units, unless one of
+	 * the two had no clear place. */
+	int ok_gap = 1;
+	for (int a = 0; a < NCH; a++) {
+		for (int b = a + 1; b < NCH; b++) {
+			if (!us[a] || !us[b] || unplaced[a] || unplaced[b]) {
+				continue;
+			}
+			long ta[2] = { floor8(rise[a]), floor8(fall[a]) };
+			long tb[2] = { floor8(rise[b]), floor8(fall[b]) };
+			for (int i = 0; i < 2; i++) {
+				for (int j = 0; j < 2; j++) {
+					if (labs(ta[i] - tb[j]) < GAP8) {
+						ok_gap = 0;
+						snprintf(what, sizeof what, "channels %d and %d too close", a, b);
+					}
+				}
+			}
+		}
+	}
+	check(ok_gap, ok_gap ? "edges apart" : what, n);
+}
+
+static unsigned long rng = 12345;
+
+static unsigned rnd(unsigned n)
+{
+	rng = rng * 6364136223846793005UL + 1442695040888963407UL;
+	return (unsigned)((rng >> 33) % n);
+}
+
+/* A width that often puts a fall near another channel's start. */
+static uint16_t some_width(void)
+{
+	switch (rnd(6)) {
+	case 0:
+		return 0;
+	case 1:
+		return (uint16_t)(1111 - 60 + rnd(121));
+	case 2:
+		return (uint16_t)(2222 - 60 + rnd(121));
+	default:
+		return (uint16_t)(500 + rnd(2001));
+	}
+}
+
+int main(void)
+{
+	static servo_sched_t s;
+	uint16_t us[NCH];
+	long n = 0;
+
+	/* The width: within 0.51 cycles of us x 7.3728 over the whole range. */
+	int ok = 1;
+	for (unsigned u = 500; u <= 2500; u++) {
+		ok &= labs(cycles(u) * 10000 - (long)u * 73728) <= 5100;
+	}
+	check(ok, "cycles(us) within 0.51 cycles", 0);
+
+	/* Every channel at 1000 us: all at their slots. */
+	for (int ch = 0; ch < NCH; ch++) {
+		us[ch] = 1000;
+	}
+	step(&s, us, 1, ++n);
+	check(moves_seen == 0, "16 x 1000 us: nobody moves", n);
+	/* One channel ends where the next starts: the one written moves. */
+	us[6] = 1111;
+	step(&s, us, 1, ++n);
+	check(m_move[6] != 0 && m_move[7] == 0, "channel 6 moves off channel 7's start", n);
+	memset(us, 0, sizeof us);
+	step(&s, us, 1, ++n);
+	check(s.n == 0, "all off: an empty schedule", n);
+	/* Far apart: more than 65535 cycles between channel 1's fall and
+	 * channel 10's rise. */
+	us[1] = 1096;
+	us[10] = 1500;
+	step(&s, us, 1, ++n);
+	check(s.n == 4 && (s.edge[2] & SERVO_LONG) && !(s.edge[3] & SERVO_LONG),
+	      "a long gap flagged", n);
+
+	/* Random writes: one triple mostly, some of several, some of all 16. */
+	for (int i = 0; i < 20000; i++) {
+		unsigned kind = rnd(10), count = kind < 7 ? 1 : kind < 9 ? 2 + rnd(6) : NCH;
+		int changes = 0;
+		uint16_t before[NCH];
+		memcpy(before, us, sizeof us);
+		for (unsigned k = 0; k < count; k++) {
+			unsigned ch = count == NCH ? k : rnd(NCH);
+			us[ch] = some_width();
+		}
+		for (int ch = 0; ch < NCH; ch++) {
+			changes += us[ch] != before[ch];
+		}
+		step(&s, us, changes <= 1, ++n);
+	}
+	printf("servo plan: %d passed, %d failed (%ld channels moved, %ld without a place)\n",
+	       passed, failed, moves_seen, fallbacks);
+	return failed ? 1 : 0;
+}
