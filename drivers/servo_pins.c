@@ -188,9 +188,15 @@ void servo_hw_release(uint8_t ch)
 
 void servo_hw_apply(const uint16_t *widths_us)
 {
-	sv.pending = 0;  /* the interrupt must not take the buffer half written */
+	uint8_t newer;
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		/* The interrupt must not take the buffer half written. */
+		newer = sv.pending;
+		sv.pending = 0;
+	}
+	/* The last plan: the buffer not taken over yet, else the running one. */
 	servo_sched_t *s = &sv.sched[sv.active ^ 1];
-	servo_plan(s, widths_us);
+	servo_plan(s, newer ? s : &sv.sched[sv.active], widths_us);
 	uint8_t n = s->n;
 
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {

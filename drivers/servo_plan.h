@@ -37,7 +37,11 @@ typedef struct {
 					   * + 65536 with SERVO_LONG */
 } servo_sched_t;
 
-/* Plans channel widths in microseconds (0 = off, else 500..2500) into `s`. */
-void servo_plan(servo_sched_t *s, const uint16_t *widths_us);
+/* Plans channel widths in microseconds (0 = off, else 500..2500) into `s`
+ * from `last`, the schedule planned before (empty at first; it may be `s`
+ * itself). A channel whose width is the same as before stays where it was;
+ * the others are placed in channel order, each at the nearest place clear
+ * of those placed before it. */
+void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us);
 
 #endif
