@@ -3,10 +3,10 @@
  *
  * A write changes a few widths, so the plan is changed, not made afresh:
  * the channels that keep their width keep their place and their order in
- * the last schedule; each changed channel is taken out, placed among the
- * others and put back in order. Placing looks at the edges in time order
- * and skips past every edge in the way at once, instead of trying one
- * place after the other.
+ * the last schedule (their times are its deltas added up); each changed
+ * channel is taken out, placed among the others and put back in order.
+ * Placing looks at the edges in time order and skips past every edge in the
+ * way at once, instead of trying one place after the other.
  */
 #include "drivers/servo_plan.h"
 
@@ -47,130 +47,147 @@ static uint16_t servo_cycles(uint16_t us)
 			  + (((uint32_t)us * (uint16_t)SERVO_CYCLES_PER_US_Q16 + 32768UL) >> 16));
 }
 
-/* An edge's cycle in the frame, from its channel's place and width. */
-static uint32_t servo_time(uint8_t e)
-{
-	uint8_t ch = e & SERVO_CHAN;
-	uint32_t t = slot_start[ch] + (int16_t)(pl.move[ch] * SERVO_SHIFT);
-	if (e & SERVO_FALL) {
-		t += pl.width[ch];
-	}
-	return t;
-}
-
-/* Edges are spaced in 8-cycle units, 16 bits (a frame is 18432 of them):
- * two edges at least SERVO_GAP8 apart so counted are 393 cycles or more
- * apart. A move is 4 units, so a pulse's rise at move m is at r8 + 4m. */
-#define SERVO_GAP8 (SERVO_GAP / 8)
-_Static_assert(SERVO_SHIFT == 32, "a move is 4 units of 8 cycles");
-
 /* The first move from 0 on in direction `dir` (1: later, -1: earlier; the
- * move's size is returned, > SERVO_MOVES if there is none) at which a
- * pulse whose rise and fall are at b8[0] and b8[1] at move 0 keeps
- * SERVO_GAP8 from every edge in at8[0..n), sorted. For dir -1 every time
- * is mirrored (negated, the edges taken from the last): the same search.
- * An edge that blocks one end pushes the move to just past it; edges passed
- * stay passed, so each end looks at each edge once. */
-static int16_t servo_free(const int16_t *b8, const uint16_t *at8, uint8_t n, int8_t dir)
+ * move's size is returned, > SERVO_MOVES if there is none) at which a pulse
+ * whose rise and fall are at b[0] and b[1] at move 0 keeps SERVO_GAP cycles
+ * from every edge at at[0..n), sorted. For dir -1 every time is mirrored
+ * (the caller negates b, the edges are taken from the last, negated): the
+ * same search. An edge that blocks one end pushes the move just past it;
+ * edges passed stay passed, so each end looks at each edge once. */
+static int16_t servo_free(const int32_t *b, const int32_t *at, uint8_t n, int8_t dir)
 {
-	uint8_t next[2] = { 0, 0 };  /* each end's first edge not yet passed */
+	const int32_t *next[2];  /* each end's first edge not yet passed */
+	const int32_t *stop = dir > 0 ? at + n : at - 1;
+	next[0] = next[1] = dir > 0 ? at : at + n - 1;
 	int16_t m = 0;
-	for (;;) {
-		uint8_t k;
-		int16_t a = 0;
-		for (k = 0; k < 2; k++) {
-			int16_t b = (int16_t)(dir * b8[k]);
-			int16_t t = (int16_t)(b + 4 * m);
-			for (; next[k] < n; next[k]++) {
-				a = (int16_t)(dir * (int16_t)at8[dir > 0 ? next[k] : n - 1 - next[k]]);
-				if (a > t - SERVO_GAP8) {
-					break;
+	uint8_t k = 0, clear = 0;  /* ends found clear at this move */
+	do {
+		int32_t end = b[k] + (int16_t)(m * SERVO_SHIFT);
+		const int32_t *q = next[k];
+		int16_t in = 0;  /* how far the edge in the way reaches past the end */
+		for (; q != stop; q += dir) {
+			int32_t d = (dir > 0 ? *q : -*q) - end;
+			if (d > -SERVO_GAP) {
+				if (d < SERVO_GAP) {
+					in = (int16_t)(d + SERVO_GAP);
 				}
-			}
-			if (next[k] < n && a < t + SERVO_GAP8) {
-				/* Blocked: the first move with b + 4m >= a + SERVO_GAP8. */
-				m = (int16_t)((a + SERVO_GAP8 - b + 3) >> 2);
 				break;
 			}
 		}
-		if (k == 2 || m > SERVO_MOVES) {
-			return m;
+		next[k] = q;
+		if (in) {
+			/* The first move that takes this end SERVO_GAP past it;
+			 * then this end again (the next edge), and the other. */
+			m = (int16_t)(m + (uint16_t)(in + SERVO_SHIFT - 1) / SERVO_SHIFT);
+			clear = 0;
+		} else {
+			clear++;
+			k ^= 1;
 		}
-	}
+	} while (clear < 2 && m <= SERVO_MOVES);
+	return m;
 }
 
-/* Puts edge e into s->edge[0..n) and at8 (its time in 8-cycle units) in
- * time order; returns the new count. */
-static uint8_t servo_insert(servo_sched_t *s, uint16_t *at8, uint8_t n, uint8_t e)
+/* Channel ch (its width changed, not 0) at the nearest place clear of the
+ * edges at[0..n) of s: 0, -1, +1, -2, ... SERVO_SHIFTs from its slot, never
+ * before the frame's start; where none is clear, it stays where it was (and
+ * the interrupt makes its edges as near their cycles as it can). Its two
+ * edges go into the order; returns the new count. (A function of its own:
+ * a small frame keeps avr-gcc's locals in reach of its pointer registers.) */
+static __attribute__((noinline)) uint8_t servo_place(servo_sched_t *s, int32_t *at, uint8_t n,
+						     uint8_t ch)
 {
-	uint32_t t = servo_time(e);
-	uint16_t t8 = (uint16_t)(t >> 3);
-	uint8_t i = n;
-	while (i && (at8[i - 1] > t8 || (at8[i - 1] == t8 && servo_time(s->edge[i - 1]) > t))) {
-		s->edge[i] = s->edge[i - 1];
-		at8[i] = at8[i - 1];
-		i--;
+	uint16_t w = pl.width[ch];
+	int32_t b[2] = { (int32_t)slot_start[ch], (int32_t)slot_start[ch] + w };
+	int16_t m = servo_free(b, at, n, 1);
+	if (m && ch) {
+		b[0] = -b[0];
+		b[1] = -b[1];
+		int16_t earlier = servo_free(b, at, n, -1);
+		if (earlier <= m) {
+			m = (int16_t)-earlier;
+		}
 	}
-	s->edge[i] = e;
-	at8[i] = t8;
-	return (uint8_t)(n + 1);
+	if (m >= -SERVO_MOVES && m <= SERVO_MOVES) {
+		pl.move[ch] = (int8_t)m;
+	}
+	/* Its fall, then its rise into the order from the end: the edges after
+	 * the fall move up two places, those between one. */
+	int32_t r = (int32_t)slot_start[ch] + (int16_t)(pl.move[ch] * SERVO_SHIFT);
+	int32_t t = r + w;
+	uint8_t code = (uint8_t)(ch | SERVO_FALL);
+	int32_t *from = at + n, *to = at + n + 2;
+	uint8_t *efrom = s->edge + n, *eto = s->edge + n + 2;
+	for (;;) {
+		while (from != at && from[-1] > t) {
+			*--to = *--from;
+			*--eto = *--efrom;
+		}
+		*--to = t;
+		*--eto = code;
+		if (code == ch) {
+			return (uint8_t)(n + 2);
+		}
+		code = ch;
+		t = r;
+	}
 }
 
 void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us)
 {
-	uint16_t at8[SERVO_EDGES];
-	uint16_t changed = 0;
-	uint8_t n = 0;
+	int32_t at[SERVO_EDGES];  /* each edge's cycle in the frame */
+	uint8_t changed[SERVO_CHANNELS];
+	uint8_t n;
 
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
 		uint16_t w = widths_us[ch] ? servo_cycles(widths_us[ch]) : 0;
-		if (w != pl.width[ch]) {
-			pl.width[ch] = w;
-			changed |= (uint16_t)(1u << ch);
-		}
+		changed[ch] = w != pl.width[ch];
+		pl.width[ch] = w;
 	}
-	/* The others stay where they were, in their order. */
-	for (uint8_t i = 0; i < last->n; i++) {
-		uint8_t e = last->edge[i] & (uint8_t)~SERVO_LONG;
-		if (!(changed & (1u << (e & SERVO_CHAN)))) {
-			s->edge[n] = e;
-			at8[n++] = (uint16_t)(servo_time(e) >> 3);
-		}
-	}
-	/* Each changed channel, in channel order, at the nearest place clear of
-	 * those placed: 0, -1, +1, -2, ... SERVO_SHIFTs from its slot, never
-	 * before the frame's start. Where none is clear, it stays where it was
-	 * (and the interrupt makes its edges as near their cycles as it can). */
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		uint16_t w = pl.width[ch];
-		if (!(changed & (1u << ch)) || !w) {
-			continue;
-		}
-		uint32_t r = slot_start[ch];
-		int16_t b8[2] = { (int16_t)(r >> 3), (int16_t)((r + w) >> 3) };
-		int16_t m = servo_free(b8, at8, n, 1);
-		if (m && ch) {
-			int16_t earlier = servo_free(b8, at8, n, -1);
-			if (earlier <= m) {
-				m = (int16_t)-earlier;
+	/* The others stay where they were, in their order; their cycles are
+	 * the last plan's deltas added up. */
+	{
+		const uint8_t *e = last->edge;
+		const uint16_t *d = last->delta;
+		uint8_t *to = s->edge;
+		int32_t *t = at;
+		int32_t now = 0;
+		for (uint8_t i = last->n; i; i--) {
+			uint8_t code = *e++;
+			now += *d++;
+			if (code & SERVO_LONG) {
+				now += 0x10000L;
+				code &= (uint8_t)~SERVO_LONG;
+			}
+			if (!changed[code & SERVO_CHAN]) {
+				*to++ = code;
+				*t++ = now;
 			}
 		}
-		if (m >= -SERVO_MOVES && m <= SERVO_MOVES) {
-			pl.move[ch] = (int8_t)m;
-		}
-		n = servo_insert(s, at8, n, ch);
-		n = servo_insert(s, at8, n, (uint8_t)(ch | SERVO_FALL));
+		n = (uint8_t)(to - s->edge);
 	}
-	/* Exact cycles from here on: each edge after the one before. */
-	uint32_t prev = 0;
-	for (uint8_t i = 0; i < n; i++) {
-		uint32_t t = servo_time(s->edge[i]);
-		/* Channels far apart: up to 125937 cycles between two edges. */
-		if (t - prev > 0xFFFF) {
-			s->edge[i] |= SERVO_LONG;
+	/* The changed channels, in channel order, each clear of those placed. */
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		if (changed[ch] && pl.width[ch]) {
+			n = servo_place(s, at, n, ch);
 		}
-		s->delta[i] = (uint16_t)(t - prev);
-		prev = t;
+	}
+	/* Each edge's cycles after the one before. Channels far apart: up to
+	 * 125937 cycles between two edges. */
+	{
+		uint8_t *e = s->edge;
+		uint16_t *d = s->delta;
+		const int32_t *t = at;
+		int32_t before = 0;
+		for (uint8_t i = n; i; i--) {
+			uint32_t gap = (uint32_t)(*t - before);
+			before = *t++;
+			if (gap > 0xFFFF) {
+				*e |= SERVO_LONG;
+			}
+			e++;
+			*d++ = (uint16_t)gap;
+		}
 	}
 	s->n = n;
 }

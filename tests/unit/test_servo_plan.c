@@ -5,10 +5,9 @@
  * starting n x 8191 cycles into the frame unless it must move, moves in
  * 32-cycle units, at most 96 either way, never before the frame's start,
  * the nearest place first (earlier before later at the same distance), no
- * edge within 400 cycles of another channel's edge (counted as the planner
- * counts: 50 apart in 8-cycle units), channels whose width stays the same
- * never move; changed channels are placed in channel order, each clear of
- * the channels placed before it. Prints "servo plan: N passed, N failed".
+ * edge within 400 cycles of another channel's edge, channels whose width
+ * stays the same never move; changed channels are placed in channel order,
+ * each clear of the channels placed before it. Prints "servo plan: N passed, N failed".
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,7 +19,7 @@
 #define SLOT 8191L
 #define SHIFT 32L
 #define MOVES 96
-#define GAP8 50
+#define GAP 400
 #define FRAME 147456L
 
 static int passed, failed;
@@ -55,12 +54,7 @@ static long rise_of(int ch, int move)
 	return SLOT * ch + SHIFT * move;
 }
 
-static long floor8(long t)
-{
-	return t >= 0 ? t / 8 : -((-t + 7) / 8);
-}
-
-/* Whether channel ch at `move` keeps GAP8 from every channel in `with`. */
+/* Whether channel ch at `move` keeps GAP from every channel in `with`. */
 static int clear(int ch, int move, const int *with)
 {
 	long r = rise_of(ch, move), f = r + m_width[ch];
@@ -69,10 +63,10 @@ static int clear(int ch, int move, const int *with)
 			continue;
 		}
 		long cr = rise_of(c, m_move[c]), cf = cr + m_width[c];
-		long mine[2] = { floor8(r), floor8(f) }, theirs[2] = { floor8(cr), floor8(cf) };
+		long mine[2] = { r, f }, theirs[2] = { cr, cf };
 		for (int i = 0; i < 2; i++) {
 			for (int j = 0; j < 2; j++) {
-				if (labs(mine[i] - theirs[j]) < GAP8) {
+				if (labs(mine[i] - theirs[j]) < GAP) {
 					return 0;
 				}
 			}
@@ -186,19 +180,18 @@ static void step(const uint16_t *us, int taken, long n)
 	check(ok_width, "widths as planned, off channels silent", n);
 	check(ok_move, "moves in 32-cycle units, at most 96, not before the frame", n);
 	check(ok_same, ok_same ? "placed as the model" : what, n);
-	/* Edges of different channels 50 apart in 8-cycle units, unless one of
-	 * the two had no clear place. */
+	/* Edges of different channels GAP apart, unless one of the two had no
+	 * clear place. */
 	int ok_gap = 1;
 	for (int a = 0; a < NCH; a++) {
 		for (int b = a + 1; b < NCH; b++) {
 			if (!us[a] || !us[b] || unplaced[a] || unplaced[b]) {
 				continue;
 			}
-			long ta[2] = { floor8(rise[a]), floor8(fall[a]) };
-			long tb[2] = { floor8(rise[b]), floor8(fall[b]) };
+			long ta[2] = { rise[a], fall[a] }, tb[2] = { rise[b], fall[b] };
 			for (int i = 0; i < 2; i++) {
 				for (int j = 0; j < 2; j++) {
-					if (labs(ta[i] - tb[j]) < GAP8) {
+					if (labs(ta[i] - tb[j]) < GAP) {
 						ok_gap = 0;
 						snprintf(what, sizeof what, "channels %d and %d too close", a, b);
 					}
