@@ -114,6 +114,7 @@ SERVO_LOAD = "S AA 00 01 S AB 06 P\r"
 SERVO_WRITE_START = lambda k: 1000 + 100 * (k % 8)
 SERVO_WRITE_1 = [(3, 1500), (7, 1111), (0, 2222), (15, 2500), (3, 1600), (8, 1000)]
 SERVO_WRITE_16 = [lambda k: 1111, lambda k: 1500, lambda k: 2000 - 41 * k, SERVO_WRITE_START]
+SERVO_STREAM = 200
 
 
 def servo_write_figures(sim, port, board):
@@ -135,8 +136,30 @@ def servo_write_figures(sim, port, board):
     one = max(write("S AA %02X %02X %02X %02X P" % (reg, step * k, us >> 8, us & 0xFF))
               for k, us in SERVO_WRITE_1)
     sixteen = max(write16(w) for w in SERVO_WRITE_16)
+    stream = servo_stream(sim, port, reg, chans)
     write16(lambda k: 0)
-    return one, sixteen
+    return one, sixteen, stream
+
+
+def servo_stream(sim, port, reg, chans, count=SERVO_STREAM):
+    """`count` one-triple writes sent back to back (16 channels pulsing):
+    (correct replies, % of wire). A board slower than the wire overflows its
+    receive buffer and answers ERROR 04."""
+    reqs = []
+    for i in range(count):
+        k, us = SERVO_WRITE_1[i % len(SERVO_WRITE_1)]
+        us += 10 * (i // len(SERVO_WRITE_1) % 2)          # every write changes a width
+        reqs.append("S AA %02X %02X %02X %02X P\r" % (reg, chans[k], us >> 8, us & 0xFF))
+    before = len(read_trace(sim, 0))
+    port.write("".join(reqs).encode())
+    replies = [port.readline() for _ in range(count)]
+    events = read_trace(sim, 0.5)[before:]
+    rx = [e for e in events if e.kind == "uart rx"]
+    tx = [e for e in events if e.kind == "uart tx"]
+    start = rx[0].cycle - CYCLES_PER_BYTE
+    end = tx[-1].cycle + CYCLES_PER_BYTE
+    correct = sum(1 for r in replies if r == b"SWAAAAP\r\n")
+    return correct, 100.0 * len(rx) * CYCLES_PER_BYTE / (end - start)
 
 
 def servo_request(board):
@@ -235,6 +258,12 @@ def main():
             + "%10s" % ("<= 10000" if i == 0 else "< wire"))
     print("%-*s" % (width, "  wire time of the 16-triple write") + "".join(
         "%14d" % results[b]["servo write"][1][1] for b in args.boards))
+    label = "servo writes streamed: correct"
+    print("%-*s" % (width, label) + "".join(
+        "%14s" % ("%d/%d" % (results[b]["servo write"][2][0], SERVO_STREAM)) for b in args.boards)
+        + "%10s" % ("%d/%d" % (SERVO_STREAM, SERVO_STREAM)))
+    print("%-*s" % (width, "servo writes streamed: % of wire") + "".join(
+        "%14.2f" % results[b]["servo write"][2][1] for b in args.boards) + "%10s" % ">= 99")
     print("%-*s" % (width, "flash (B)") + "".join("%14d" % results[b]["footprint"][0] for b in args.boards)
           + "%10s%12d" % ("<= %d" % BUDGET_FLASH, BUDGET_FLASH))
     print("%-*s" % (width, "static RAM (B)") + "".join("%14d" % results[b]["footprint"][1] for b in args.boards)
