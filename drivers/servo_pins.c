@@ -90,7 +90,7 @@ ISR(TIMER2_COMP_vect)
 	}
 	for (;;) {
 		const servo_sched_t *s = &sv.sched[sv.active];
-		uint8_t e = s->edge[sv.next];
+		uint8_t e = s->edge[sv.next].code;
 		uint8_t pin = servo_pin[e & SERVO_CHAN];
 		volatile uint8_t *reg = (volatile uint8_t *)(uint16_t)port_addr[PIN_PORT(pin)];
 		uint8_t mask = line_mask[pin & 7];
@@ -120,7 +120,6 @@ ISR(TIMER2_COMP_vect)
 			/* Frame done: take a newer schedule over, start the next. */
 			sv.next = 0;
 			sv.frame += SERVO_FRAME;
-			sv.target = sv.frame;
 			if (sv.pending) {
 				sv.active ^= 1;
 				sv.pending = 0;
@@ -132,10 +131,7 @@ ISR(TIMER2_COMP_vect)
 				}
 			}
 		}
-		sv.target += s->delta[sv.next];
-		if (s->edge[sv.next] & SERVO_LONG) {
-			sv.target += 0x10000;
-		}
+		sv.target = sv.frame + servo_cycle(&s->edge[sv.next]);
 		if (servo_arm()) {
 			return;
 		}
@@ -207,10 +203,7 @@ void servo_hw_apply(const uint16_t *widths_us)
 			sv.active ^= 1;
 			sv.next = 0;
 			sv.frame = ((uint32_t)servo_ticks() << 3) + 4096;
-			sv.target = sv.frame + s->delta[0];
-			if (s->edge[0] & SERVO_LONG) {
-				sv.target += 0x10000;
-			}
+			sv.target = sv.frame + servo_cycle(&s->edge[0]);
 			servo_arm();
 			sv.running = 1;
 			/* (No TIFR write: simavr 1.6 clears every flag on one.) */

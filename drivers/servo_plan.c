@@ -3,29 +3,29 @@
  *
  * A write changes a few widths, so the plan is changed, not made afresh:
  * the channels that keep their width keep their place and their order in
- * the last schedule (their times are its deltas added up); each changed
- * channel is taken out, placed among the others and put back in order.
- * Placing looks at the edges in time order and skips past every edge in the
- * way at once, instead of trying one place after the other.
+ * the last schedule; the changed channels are placed among them one after
+ * the other and put into the order. Placing looks at the edges in time
+ * order from where a binary search finds the pulse's ends, and skips past
+ * every edge in the way at once, instead of trying one place after the
+ * other. The schedule holds each edge's cycle in the frame, so nothing
+ * needs adding up.
  */
 #include "drivers/servo_plan.h"
+
+#include <string.h>
 
 #include "firmware/flash.h"
 
 _Static_assert(SERVO_SLOT * (SERVO_CHANNELS - 1) + SERVO_SHIFT * SERVO_MOVES + 18432UL + 1000UL
 	       < SERVO_FRAME, "the last channel's longest pulse ends inside the frame");
 
-/* No two edges of a frame are 131072 cycles apart (SERVO_LONG covers 17
- * bits): the latest start is the last channel's, moved late. */
-_Static_assert(SERVO_SLOT * (SERVO_CHANNELS - 1) + SERVO_SHIFT * SERVO_MOVES < 0x20000UL,
-	       "a delta fits 16 bits and SERVO_LONG");
+_Static_assert(SERVO_FRAME <= 0x40000UL, "a cycle in the frame fits 18 bits (SERVO_HI)");
 _Static_assert(SERVO_CHANNELS <= SERVO_CHAN + 1, "a channel fits the edge code");
-_Static_assert(SERVO_CHANNELS <= 16, "a channel mask fits 16 bits");
 _Static_assert(SERVO_SLOT >= SERVO_SHIFT * SERVO_MOVES, "only channel 0 can move before the frame");
 
 static struct {
 	int8_t move[SERVO_CHANNELS];     /* each channel's place: SERVO_SHIFTs off its slot */
-	uint16_t width[SERVO_CHANNELS];  /* cycles, as last planned; 0 = off */
+	uint16_t us[SERVO_CHANNELS];     /* width as last planned; 0 = off */
 } pl;
 
 /* Frame offset of each channel's pulse start. */
@@ -47,147 +47,180 @@ static uint16_t servo_cycles(uint16_t us)
 			  + (((uint32_t)us * (uint16_t)SERVO_CYCLES_PER_US_Q16 + 32768UL) >> 16));
 }
 
-/* The first move from 0 on in direction `dir` (1: later, -1: earlier; the
- * move's size is returned, > SERVO_MOVES if there is none) at which a pulse
- * whose rise and fall are at b[0] and b[1] at move 0 keeps SERVO_GAP cycles
- * from every edge at at[0..n), sorted. For dir -1 every time is mirrored
- * (the caller negates b, the edges are taken from the last, negated): the
- * same search. An edge that blocks one end pushes the move just past it;
- * edges passed stay passed, so each end looks at each edge once. */
-static int16_t servo_free(const int32_t *b, const int32_t *at, uint8_t n, int8_t dir)
+/* Edge `code` at cycle t. */
+static servo_edge_t servo_edge(uint8_t code, uint32_t t)
 {
-	const int32_t *next[2];  /* each end's first edge not yet passed */
-	const int32_t *stop = dir > 0 ? at + n : at - 1;
-	next[0] = next[1] = dir > 0 ? at : at + n - 1;
+	servo_edge_t e = { (uint8_t)(code | (uint8_t)((uint8_t)(t >> 16) << 4)), (uint16_t)t };
+	return e;
+}
+
+/* How many of the edges e[0..n) are at cycle t or before (a binary
+ * search). */
+static uint8_t servo_count(const servo_edge_t *e, uint8_t n, int32_t t)
+{
+	if (t < 0) {
+		return 0;
+	}
+	/* Bits 16-17 and 0-15 apart: byte and word compares. */
+	uint8_t th = (uint8_t)((uint32_t)t >> 16);
+	uint16_t tl = (uint16_t)t;
+	const servo_edge_t *lo = e;
+	while (n) {
+		uint8_t half = n >> 1;
+		const servo_edge_t *mid = lo + half;
+		uint8_t h = (uint8_t)(mid->code >> 4) & 3;
+		if (h < th || (h == th && mid->at <= tl)) {
+			lo = mid + 1;
+			n = (uint8_t)(n - half - 1);
+		} else {
+			n = half;
+		}
+	}
+	return (uint8_t)(lo - e);
+}
+
+/* How far the next edge of e[0..n) from *i on in direction `dir` (1:
+ * later, -1: earlier) is in the way of a pulse end at cycle `end`: 0 if it
+ * keeps SERVO_GAP, else the cycles the end has to go on to keep it. Edges
+ * behind the end by SERVO_GAP or more are passed for good (*i moves on).
+ * *i: the next edge's index (dir 1), one more than that (dir -1). */
+static int16_t servo_in_way(const servo_edge_t *e, uint8_t n, uint8_t *i, int32_t end, int8_t dir)
+{
+	for (;;) {
+		if (dir > 0 ? *i >= n : !*i) {
+			return 0;
+		}
+		const servo_edge_t *x = e + (dir > 0 ? *i : *i - 1);
+		int32_t d = (int32_t)servo_cycle(x) - end;
+		if (dir < 0) {
+			d = -d;
+		}
+		if (d > -SERVO_GAP) {
+			return d < SERVO_GAP ? (int16_t)(d + SERVO_GAP) : 0;
+		}
+		*i = (uint8_t)(*i + dir);
+	}
+}
+
+/* The first move from 0 on in direction `dir` (its size; > SERVO_MOVES
+ * if there is none) at which a pulse whose rise and fall are at b[0] and
+ * b[1] at move 0 keeps SERVO_GAP from the edges e[0..n); each end starts
+ * at at[] (see servo_in_way) and ends where it stopped: with the move
+ * found, how many edges come before that end. An edge in the way of one end
+ * pushes the move just past it; then that end looks again, and the other.
+ * Edges passed stay passed, so each end looks at each edge once. */
+static int16_t servo_free(const servo_edge_t *e, uint8_t n, const int32_t *b, uint8_t *at,
+			  int8_t dir)
+{
 	int16_t m = 0;
 	uint8_t k = 0, clear = 0;  /* ends found clear at this move */
-	do {
-		int32_t end = b[k] + (int16_t)(m * SERVO_SHIFT);
-		const int32_t *q = next[k];
-		int16_t in = 0;  /* how far the edge in the way reaches past the end */
-		for (; q != stop; q += dir) {
-			int32_t d = (dir > 0 ? *q : -*q) - end;
-			if (d > -SERVO_GAP) {
-				if (d < SERVO_GAP) {
-					in = (int16_t)(d + SERVO_GAP);
-				}
-				break;
-			}
-		}
-		next[k] = q;
+	while (clear < 2 && m <= SERVO_MOVES) {
+		int16_t in = servo_in_way(e, n, &at[k], b[k] + dir * (int16_t)(m * SERVO_SHIFT), dir);
 		if (in) {
-			/* The first move that takes this end SERVO_GAP past it;
-			 * then this end again (the next edge), and the other. */
 			m = (int16_t)(m + (uint16_t)(in + SERVO_SHIFT - 1) / SERVO_SHIFT);
 			clear = 0;
 		} else {
 			clear++;
 			k ^= 1;
 		}
-	} while (clear < 2 && m <= SERVO_MOVES);
+	}
 	return m;
 }
 
-/* Channel ch (its width changed, not 0) at the nearest place clear of the
- * edges at[0..n) of s: 0, -1, +1, -2, ... SERVO_SHIFTs from its slot, never
+/* Channel ch (its width w changed, not 0) at the nearest place clear of the
+ * edges e[0..n): 0, -1, +1, -2, ... SERVO_SHIFTs from its slot, never
  * before the frame's start; where none is clear, it stays where it was (and
- * the interrupt makes its edges as near their cycles as it can). Its two
- * edges go into the order; returns the new count. (A function of its own:
- * a small frame keeps avr-gcc's locals in reach of its pointer registers.) */
-static __attribute__((noinline)) uint8_t servo_place(servo_sched_t *s, int32_t *at, uint8_t n,
-						     uint8_t ch)
+ * the interrupt makes its edges as near their cycles as it can). Returns
+ * its rise's cycle; at[0] and at[1]: how many edges come before its rise
+ * and before its fall. */
+static __attribute__((noinline)) uint32_t servo_move(const servo_edge_t *e, uint8_t n, uint8_t ch,
+						     uint16_t w, uint8_t *at)
 {
-	uint16_t w = pl.width[ch];
 	int32_t b[2] = { (int32_t)slot_start[ch], (int32_t)slot_start[ch] + w };
-	int16_t m = servo_free(b, at, n, 1);
+	/* Where each end starts looking at move 0: later from the first edge
+	 * not SERVO_GAP before it (at[]), earlier from the last edge not
+	 * SERVO_GAP after it (down[], one more). */
+	uint8_t down[2];
+	for (uint8_t k = 0; k < 2; k++) {
+		uint8_t i = servo_count(e, n, b[k] - SERVO_GAP);
+		at[k] = i;
+		while (i < n && (int32_t)servo_cycle(e + i) < b[k] + SERVO_GAP) {
+			i++;
+		}
+		down[k] = i;
+	}
+	int16_t m = servo_free(e, n, b, at, 1);
 	if (m && ch) {
-		b[0] = -b[0];
-		b[1] = -b[1];
-		int16_t earlier = servo_free(b, at, n, -1);
+		int16_t earlier = servo_free(e, n, b, down, -1);
 		if (earlier <= m) {
 			m = (int16_t)-earlier;
+			at[0] = down[0];
+			at[1] = down[1];
 		}
 	}
+	uint32_t r = slot_start[ch];
 	if (m >= -SERVO_MOVES && m <= SERVO_MOVES) {
 		pl.move[ch] = (int8_t)m;
+		r += (int16_t)(m * SERVO_SHIFT);
+	} else {
+		/* No clear place: where it was, among edges it may be near. */
+		r += (int16_t)(pl.move[ch] * SERVO_SHIFT);
+		at[0] = servo_count(e, n, (int32_t)r);
+		at[1] = servo_count(e, n, (int32_t)(r + w));
 	}
-	/* Its fall, then its rise into the order from the end: the edges after
-	 * the fall move up two places, those between one. */
-	int32_t r = (int32_t)slot_start[ch] + (int16_t)(pl.move[ch] * SERVO_SHIFT);
-	int32_t t = r + w;
-	uint8_t code = (uint8_t)(ch | SERVO_FALL);
-	int32_t *from = at + n, *to = at + n + 2;
-	uint8_t *efrom = s->edge + n, *eto = s->edge + n + 2;
-	for (;;) {
-		while (from != at && from[-1] > t) {
-			*--to = *--from;
-			*--eto = *--efrom;
+	return r;
+}
+
+/* Copies the edges from[0..n) whose channel has not changed to `to`
+ * (which may be `from`: it never gets ahead; the edges before the first
+ * one left out then stay as they are); returns where the copy ends. */
+static __attribute__((noinline)) servo_edge_t *servo_keep(servo_edge_t *to, const servo_edge_t *from,
+							  uint8_t n, const uint8_t *changed)
+{
+	if (to == from) {
+		while (n && !changed[to->code & SERVO_CHAN]) {
+			n--;
+			to++;
 		}
-		*--to = t;
-		*--eto = code;
-		if (code == ch) {
-			return (uint8_t)(n + 2);
-		}
-		code = ch;
-		t = r;
+		from = to;
 	}
+	for (; n; n--, from++) {
+		if (!changed[from->code & SERVO_CHAN]) {
+			*to++ = *from;
+		}
+	}
+	return to;
 }
 
 void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us)
 {
-	int32_t at[SERVO_EDGES];  /* each edge's cycle in the frame */
 	uint8_t changed[SERVO_CHANNELS];
-	uint8_t n;
 
+	const uint16_t *now = widths_us;
+	uint16_t *was = pl.us;
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, now++, was++) {
+		changed[ch] = *now != *was;
+		*was = *now;
+	}
+	/* The others stay where they were, in their order. */
+	servo_edge_t *e = s->edge;
+	uint8_t n = (uint8_t)(servo_keep(e, last->edge, last->n, changed) - e);
+	/* The changed channels in channel order, each placed among the edges
+	 * now in s, then into the order: the edges after its fall move up two
+	 * places, those between its edges one. */
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		uint16_t w = widths_us[ch] ? servo_cycles(widths_us[ch]) : 0;
-		changed[ch] = w != pl.width[ch];
-		pl.width[ch] = w;
-	}
-	/* The others stay where they were, in their order; their cycles are
-	 * the last plan's deltas added up. */
-	{
-		const uint8_t *e = last->edge;
-		const uint16_t *d = last->delta;
-		uint8_t *to = s->edge;
-		int32_t *t = at;
-		int32_t now = 0;
-		for (uint8_t i = last->n; i; i--) {
-			uint8_t code = *e++;
-			now += *d++;
-			if (code & SERVO_LONG) {
-				now += 0x10000L;
-				code &= (uint8_t)~SERVO_LONG;
-			}
-			if (!changed[code & SERVO_CHAN]) {
-				*to++ = code;
-				*t++ = now;
-			}
+		if (!changed[ch] || !pl.us[ch]) {
+			continue;
 		}
-		n = (uint8_t)(to - s->edge);
-	}
-	/* The changed channels, in channel order, each clear of those placed. */
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		if (changed[ch] && pl.width[ch]) {
-			n = servo_place(s, at, n, ch);
-		}
-	}
-	/* Each edge's cycles after the one before. Channels far apart: up to
-	 * 125937 cycles between two edges. */
-	{
-		uint8_t *e = s->edge;
-		uint16_t *d = s->delta;
-		const int32_t *t = at;
-		int32_t before = 0;
-		for (uint8_t i = n; i; i--) {
-			uint32_t gap = (uint32_t)(*t - before);
-			before = *t++;
-			if (gap > 0xFFFF) {
-				*e |= SERVO_LONG;
-			}
-			e++;
-			*d++ = (uint16_t)gap;
-		}
+		uint16_t w = servo_cycles(pl.us[ch]);
+		uint8_t at[2];
+		uint32_t r = servo_move(e, n, ch, w, at);
+		uint8_t i = at[0], j = at[1];
+		memmove(e + j + 2, e + j, (n - j) * sizeof *e);
+		memmove(e + i + 1, e + i, (j - i) * sizeof *e);
+		e[i] = servo_edge(ch, r);
+		e[j + 1] = servo_edge((uint8_t)(ch | SERVO_FALL), r + w);
+		n = (uint8_t)(n + 2);
 	}
 	s->n = n;
 }

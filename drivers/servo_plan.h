@@ -1,6 +1,6 @@
 /*
- * The M32-D servo schedule: which edge (a channel's rise or fall) comes how
- * many cycles after the one before, in every 20 ms frame. servo_plan()
+ * The M32-D servo schedule: which edge (a channel's rise or fall) comes at
+ * which cycle of every 20 ms frame, in time order. servo_plan()
  * builds it in the main loop when widths change; the Timer2 compare
  * interrupt in servo_pins.c only runs it. No hardware in here, so the host
  * unit tests run the planner as the firmware does (tests/unit).
@@ -25,17 +25,27 @@
 #define SERVO_SHIFT  32        /* unit of a channel's move, cycles */
 #define SERVO_MOVES  96        /* most units a channel moves either way */
 #define SERVO_EDGES  (2 * SERVO_CHANNELS)
-#define SERVO_FALL   0x80      /* edge code: channel | SERVO_FALL | SERVO_LONG */
-#define SERVO_LONG   0x40      /* the edge's delta is 65536 cycles more */
-#define SERVO_CHAN   0x1F      /* the edge code's channel */
+#define SERVO_FALL   0x80      /* edge code: channel | SERVO_FALL | cycle bits 16-17 */
+#define SERVO_HI     0x30      /* the edge's cycle in the frame, bits 16 and 17 */
+#define SERVO_CHAN   0x0F      /* the edge code's channel */
+
+typedef struct {
+	uint8_t code;   /* channel | SERVO_FALL | cycle bits 16-17 (SERVO_HI) */
+	uint16_t at;    /* cycle in the frame, bits 0-15 */
+} servo_edge_t;
 
 typedef struct {
 	uint8_t n;                        /* edges in this frame */
-	uint8_t edge[SERVO_EDGES];        /* sorted by time */
-	uint16_t delta[SERVO_EDGES];      /* cycles after the edge before (the
-					   * first: after the frame's start),
-					   * + 65536 with SERVO_LONG */
+	servo_edge_t edge[SERVO_EDGES];   /* in time order */
 } servo_sched_t;
+
+/* An edge's cycle in the frame. (Byte operations: avr-gcc makes a nibble
+ * swap of the shift by 4.) */
+static inline uint32_t servo_cycle(const servo_edge_t *e)
+{
+	uint8_t hi = (uint8_t)(e->code >> 4) & 3;
+	return (uint32_t)hi << 16 | e->at;
+}
 
 /* Plans channel widths in microseconds (0 = off, else 500..2500) into `s`
  * from `last`, the schedule planned before (empty at first; it may be `s`

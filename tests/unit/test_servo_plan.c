@@ -116,19 +116,19 @@ static void model(const uint16_t *us, int *unplaced)
  * its form: times in order, each pulsing channel once, nothing else. */
 static void decode(const servo_sched_t *s, long *rise, long *fall, long step)
 {
-	long t = 0, prev = -1;
+	long prev = -1;
 	int ok_order = 1, ok_code = 1;
 	for (int ch = 0; ch < NCH; ch++) {
 		rise[ch] = fall[ch] = -1;
 	}
 	for (int i = 0; i < s->n; i++) {
-		uint8_t e = s->edge[i];
+		uint8_t e = s->edge[i].code;
 		int ch = e & SERVO_CHAN;
-		t += s->delta[i] + ((e & SERVO_LONG) ? 65536L : 0);
-		ok_order &= t > prev;
+		long t = (long)servo_cycle(&s->edge[i]);
+		ok_order &= t == ((long)((e >> 4) & 3) << 16 | s->edge[i].at) && t > prev;
 		prev = t;
 		long *slot = (e & SERVO_FALL) ? &fall[ch] : &rise[ch];
-		ok_code &= ch < NCH && !(e & (uint8_t)~(SERVO_CHAN | SERVO_FALL | SERVO_LONG))
+		ok_code &= ch < NCH && !(e & (uint8_t)~(SERVO_CHAN | SERVO_FALL | SERVO_HI))
 			   && *slot < 0;
 		if (ch < NCH) {
 			*slot = t;
@@ -250,14 +250,13 @@ int main(void)
 	memset(us, 0, sizeof us);
 	step(us, 1, ++n);
 	check(buf[running ^ 1].n == 0, "all off: an empty schedule", n);
-	/* Far apart: more than 65535 cycles between channel 1's fall and
-	 * channel 10's rise. */
+	/* Channel 10 starts 81910 cycles into the frame: more than 16 bits. */
 	us[1] = 1096;
 	us[10] = 1500;
 	step(us, 1, ++n);
 	const servo_sched_t *s = &buf[running ^ 1];
-	check(s->n == 4 && (s->edge[2] & SERVO_LONG) && !(s->edge[3] & SERVO_LONG),
-	      "a long gap flagged", n);
+	check(s->n == 4 && s->edge[2].code == (0x10 | 10) && s->edge[2].at == 81910 - 65536,
+	      "cycles past 65535 kept", n);
 	/* Two channels written together where channel 5 ends 81 cycles before
 	 * channel 6 starts: 5, placed first, stays; 6 moves. */
 	memset(us, 0, sizeof us);
