@@ -120,6 +120,34 @@ def test_m32d_long_gaps_keep_the_starts(drv, widths):
         check_pulses(drv, drv.lay["servo_pins"][ch], us, since)
 
 
+def test_m32d_a_channel_not_written_keeps_its_place(drv):
+    """M32-D (docs: placing): 5 at 1100 us ends 81 cycles before 6 starts;
+    written together, 5 is placed first and 6 moves to the nearest clear
+    place, 10 x 32 cycles late. Then 5 alone gets shorter: 6, not written,
+    stays where it is; written again, it goes back to its slot."""
+    if drv.board != "m32d":
+        pytest.skip("M32-D only")
+    pins = drv.lay["servo_pins"]
+
+    def starts():
+        since = settle(drv, 2)
+        rise0 = drv.highs(pins[0], since)[0][0]
+        return {ch: drv.highs(pins[ch], rise0)[0][0] - rise0 for ch in (5, 6)}
+
+    set_widths(drv, {0: 1000, 5: 1100, 6: 1200})
+    got = starts()
+    assert abs(got[5] - 5 * 8191) <= WIDTH_TOL and abs(got[6] - (6 * 8191 + 320)) <= WIDTH_TOL, got
+    set_widths(drv, {5: 1000})
+    got = starts()
+    assert abs(got[5] - 5 * 8191) <= WIDTH_TOL and abs(got[6] - (6 * 8191 + 320)) <= WIDTH_TOL, got
+    set_widths(drv, {6: 1201})
+    got = starts()
+    assert abs(got[6] - 6 * 8191) <= WIDTH_TOL, got
+    since = settle(drv, 3)
+    for ch, us in ((0, 1000), (5, 1000), (6, 1201)):
+        check_pulses(drv, pins[ch], us, since)
+
+
 def test_m128s_long_counter_frame_stretches(drv):
     """M128-S: eight 2500 us widths on one counter (20 ms > 19.8 ms) stretch
     that frame to fit them; the widths stay exact."""
