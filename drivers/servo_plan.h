@@ -51,7 +51,7 @@ static inline uint32_t servo_cycle(const servo_edge_t *e)
  * from `last`, the schedule planned before (empty at first; it may be `s`
  * itself). A channel whose width is the same as before stays where it was;
  * the others are placed in channel order, each at the nearest place clear
- * of those placed before it. */
+ * of the channels that stayed and of those placed before it. */
 void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us);
 
 #endif
