@@ -49,15 +49,21 @@ static const __flash uint8_t port_addr[] = {
 static const __flash uint8_t line_mask[8] = { 1, 2, 4, 8, 16, 32, 64, 128 };
 
 /* Timer2 ticks (8 cycles) as a 16-bit count: edges are never more than a
- * frame (18432 ticks) ahead, so 16-bit differences order them. */
+ * frame (18432 ticks) ahead, so 16-bit differences order them. Called with
+ * interrupts off (the compare interrupt, a locked block): an overflow the
+ * overflow interrupt has not counted yet is counted here and its flag
+ * cleared. (Counting it only while TCNT2 < 128 lost it once the compare
+ * interrupt ran 1024 cycles past it; then every wait in the interrupt saw
+ * its edge recede by 256 ticks a wrap and never ended.) */
 static uint16_t servo_ticks(void)
 {
-	uint16_t w = sv.wraps;
 	uint8_t t = TCNT2;
-	if ((TIFR & _BV(TOV2)) && t < 128) {
-		w++;  /* an overflow not yet counted (interrupts are off) */
+	if (TIFR & _BV(TOV2)) {
+		TIFR = _BV(TOV2);  /* a 1 clears that flag only */
+		sv.wraps++;
+		t = TCNT2;         /* surely after the overflow */
 	}
-	return (uint16_t)(w << 8 | t);
+	return (uint16_t)(sv.wraps << 8 | t);
 }
 
 /* Ticks from now until `cycle`. */
@@ -206,7 +212,8 @@ void servo_hw_apply(const uint16_t *widths_us)
 			sv.target = sv.frame + servo_cycle(&s->edge[0]);
 			servo_arm();
 			sv.running = 1;
-			/* (No TIFR write: simavr 1.6 clears every flag on one.) */
+			/* (A stale compare flag needs no clearing: the interrupt it
+			 * wakes finds its edge far and returns.) */
 			TIMSK |= _BV(OCIE2);
 		}
 	}

@@ -148,6 +148,33 @@ def test_m32d_a_channel_not_written_keeps_its_place(drv):
         check_pulses(drv, pins[ch], us, since)
 
 
+def test_m32d_edges_in_a_row_whatever_the_timer_phase(drv):
+    """M32-D: channel 1 ends 401 cycles before channel 2 starts (moved 320
+    late by the planner) and 425 before channel 0 ends: the interrupt makes
+    the three edges in one go, about 1300 cycles. Timer2 overflows every
+    2048 cycles, at a place in the frame set when the servos start: started
+    again and again, some start puts an overflow early in that run, and the
+    tick count must not lose it (it did: the interrupt then waited forever
+    and the watchdog reset the board). Widths exact, no reset."""
+    if drv.board != "m32d":
+        pytest.skip("M32-D only")
+    pins = drv.lay["servo_pins"]
+    mark = drv.mark()
+    for attempt in range(24):
+        set_widths(drv, {0: 0, 1: 0, 2: 0})
+        drv.wait(2 * SERVO_FRAME + 61 * attempt)
+        for ch, us in ((1, 1100), (2, 1200), (0, 2323)):
+            set_widths(drv, {ch: us})
+        since = drv.now() + 2 * SERVO_FRAME
+        drv.wait(4 * SERVO_FRAME)
+        assert drv.events(mark, ["reset"]) == [], "watchdog reset at start %d" % attempt
+        for ch, us in ((0, 2323), (1, 1100), (2, 1200)):
+            check_pulses(drv, pins[ch], us, since, 1)
+    since = settle(drv, 2)
+    rise1 = drv.highs(pins[1], since)[0][0]
+    assert abs(drv.highs(pins[2], rise1)[0][0] - rise1 - (8191 + 320)) <= WIDTH_TOL
+
+
 def test_m128s_long_counter_frame_stretches(drv):
     """M128-S: eight 2500 us widths on one counter (20 ms > 19.8 ms) stretch
     that frame to fit them; the widths stay exact."""
