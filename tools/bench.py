@@ -152,7 +152,12 @@ def servo_stream(sim, port, reg, chans, count=SERVO_STREAM):
         reqs.append("S AA %02X %02X %02X %02X P\r" % (reg, chans[k], us >> 8, us & 0xFF))
     before = len(read_trace(sim, 0))
     port.write("".join(reqs).encode())
-    replies = [port.readline() for _ in range(count)]
+    replies = []
+    while len(replies) < count:
+        reply = port.readline()
+        if not reply:
+            break  # the board stopped answering (a reset): no waiting out the rest
+        replies.append(reply)
     events = read_trace(sim, 0.5)[before:]
     rx = [e for e in events if e.kind == "uart rx"]
     tx = [e for e in events if e.kind == "uart tx"]
