@@ -40,7 +40,7 @@ FW_LDFLAGS := -mmcu=$(BOARD_MCU) $(FW_OPT) -flto -Wl,--gc-sections
 DRV_HW_spi := drivers/spi_hw.c
 DRV_HW_adc := drivers/adc_hw.c
 DRV_HW_motor := drivers/motor_hw.c
-DRV_HW_servo := drivers/$(BOARD_SERVO_HW).c
+DRV_HW_servo := $(foreach f,$(BOARD_SERVO_HW),drivers/$(f).c)
 
 FW_SRC := firmware/main.c firmware/regmap.c firmware/intro.c firmware/uart.c \
 	firmware/twi_master.c firmware/twi_rate.c firmware/mcu.c firmware/pins.c \

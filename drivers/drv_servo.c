@@ -1,5 +1,8 @@
 #include "drivers/drv_servo.h"
 
+#include <stdbool.h>
+#include <string.h>
+
 #include "drivers/servo_hw.h"
 
 #define SERVO_REG_RS 0
@@ -50,34 +53,37 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 		}
 	}
 	uint16_t next[SERVO_CHANNELS];
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		next[ch] = servo.width[ch];
-	}
+	memcpy(next, servo.width, sizeof next);
 	for (uint8_t i = 0; i < len; i += 3) {
 		next[data[i]] = servo_clamp((uint16_t)(data[i + 1] << 8 | data[i + 2]));
 	}
-	/* Channels turned on take their pins. All are checked before any is
-	 * taken: a claim sets its pin up (output low) and a release cannot
-	 * bring back what GPIO had there. */
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		if (next[ch] && !servo.width[ch] && !servo_hw_can_claim(ch)) {
-			return REG_PIN_BUSY;
+	/* Only the channels written can change: the loops below go over the
+	 * triples (a channel written twice is looked at twice, to the same
+	 * effect). Channels turned on take their pins. All are checked before
+	 * any is taken: a claim sets its pin up (output low) and a release
+	 * cannot bring back what GPIO had there. */
+	bool changed = false;
+	for (uint8_t i = 0; i < len; i += 3) {
+		uint8_t ch = data[i];
+		if (next[ch] != servo.width[ch]) {
+			changed = true;
+			if (!servo.width[ch] && !servo_hw_can_claim(ch)) {
+				return REG_PIN_BUSY;
+			}
 		}
-	}
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		if (next[ch] && !servo.width[ch]) {
-			servo_hw_claim(ch);
-		}
-	}
-	uint8_t changed = 0;
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		changed |= (uint8_t)(next[ch] != servo.width[ch]);
 	}
 	if (!changed) {
 		return REG_OK;  /* the pulses already are so: no new schedule */
 	}
+	for (uint8_t i = 0; i < len; i += 3) {
+		uint8_t ch = data[i];
+		if (next[ch] && !servo.width[ch]) {
+			servo_hw_claim(ch);
+		}
+	}
 	servo_hw_apply(next);
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+	for (uint8_t i = 0; i < len; i += 3) {
+		uint8_t ch = data[i];
 		if (!next[ch] && servo.width[ch]) {
 			servo_hw_release(ch);
 		}

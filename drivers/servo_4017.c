@@ -235,6 +235,16 @@ void servo_hw_release(uint8_t ch)
 	(void)ch;
 }
 
+/* Timer ticks for a width in microseconds, rounded to the nearest: us x
+ * 0.9216 as a 16.16 product, a 16 x 16-bit multiply (the 32-bit division
+ * it replaces took about 600 cycles a channel). For every width up to
+ * 2500 us it gives what (us x 9216 + 5000) / 10000 gives. */
+#define SERVO_TICKS_PER_US_Q16 ((uint16_t)((SERVO_TICK_HZ * 65536ULL + 500000ULL) / 1000000ULL))
+static uint16_t servo_ticks_of(uint16_t us)
+{
+	return (uint16_t)(((uint32_t)us * SERVO_TICKS_PER_US_Q16 + 32768UL) >> 16);
+}
+
 /* Plans counter c: its hardware rises, the off outputs passed after each
  * and the ticks between rises. Returns the last rise's time, or 0 when no
  * channel of the counter is on. */
@@ -253,7 +263,7 @@ static uint16_t servo_plan(servo_sched_t *s, uint8_t c, const uint16_t *widths_u
 		uint16_t us = widths_us[k];
 		if (us) {
 			e->steps = 0;
-			e->dur = (uint16_t)(((uint32_t)us * (SERVO_TICK_HZ / 100UL) + 5000UL) / 10000UL);
+			e->dur = servo_ticks_of(us);
 			t = (uint16_t)(t + e->dur);
 			e++;
 			k++;

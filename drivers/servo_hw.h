@@ -1,7 +1,7 @@
 /*
  * Servo pulse hardware, one implementation per board family (picked by the
  * board file's BOARD_SERVO_HW): servo_pins.c drives one MCU pin per channel
- * (M32-D), servo_4017.c clocks CD4017 decade counters (M128-S).
+ * (M32-D; servo_plan.c plans its edges), servo_4017.c clocks CD4017 decade counters (M128-S).
  */
 #ifndef SERVO_HW_H
 #define SERVO_HW_H

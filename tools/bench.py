@@ -5,9 +5,10 @@ For each board: latency from the last request byte (end of its stop bit) to
 the first reply byte (start of its start bit) for a few requests, sustained
 throughput of back-to-back introspection reads against the wire limit, flash,
 static RAM and measured peak stack (the simulator paints SRAM; the firmware
-is first put through every driver's requests), and servo pulse accuracy:
-width error against the commanded width and its spread (jitter) while
-requests stream over the UART back to back. Everything is counted in
+is first put through every driver's requests), the cost of servo writes
+(request end to reply start, and a stream of them against the wire), and
+servo pulse accuracy: width error against the commanded width and its
+spread (jitter) while requests stream over the UART back to back. Everything is counted in
 simulated CPU cycles; wall time enters only the simulator-speed line.
 
 Every request reaches the board at a fixed cycle after power-up: each board
@@ -132,7 +133,81 @@ SERVOS = {
                      (31, 1234, "servo31")]),
 }
 SERVO_LOAD = "S AA 00 01 S AB 06 P\r"
-SERVO_LOAD_COUNT = 400
+SERVO_LOAD_COUNT = 250
+# Servo writes timed like the latencies above (request end to reply start):
+# 16 channels pulse (M128-S: every other channel, all four counters), then
+# one-triple writes, spaced as a host writes them ("S AA 13 03 05 DC P"),
+# and 16-triple writes, packed to fit a request ("SAA13" + 96 digits + "P").
+# Widths near 1111 us x k end where another channel starts: those channels
+# must move. The figure is the slowest write of each kind. Then SERVO_STREAM
+# one-triple writes back to back: a board slower than the wire overflows its
+# receive buffer and answers ERROR 04.
+SERVO_WRITE_START = lambda k: 1000 + 100 * (k % 8)
+SERVO_WRITE_1 = [(3, 1500), (7, 1111), (0, 2222), (15, 2500), (3, 1600), (8, 1000)]
+SERVO_WRITE_16 = [lambda k: 1111, lambda k: 1500, lambda k: 2000 - 41 * k, SERVO_WRITE_START]
+SERVO_STREAM = 200
+
+
+def write_reply(request):
+    """The reply to a local write request: an A for every byte after the address."""
+    body = request.replace(" ", "").strip()
+    assert body.startswith("SAA") and body.endswith("P"), request
+    return b"SW" + b"A" * ((len(body) - 4) // 2) + b"P\r\n"
+
+
+def servo_write_requests(board):
+    """The servo-write part of a run: [(kind, request)], kind "set" (the 16
+    starting widths, and all off at the end), "one", "sixteen" or "stream"
+    (SERVO_STREAM one-triple writes in one piece)."""
+    reg = SERVOS[board][0]
+    step = 2 if board == "m128s" else 1
+    chans = [step * k for k in range(16)]
+
+    def one(k, us):
+        return "S AA %02X %02X %02X %02X P\r" % (reg, chans[k], us >> 8, us & 0xFF)
+
+    def sixteen(width):
+        return "SAA%02X%sP\r" % (reg, "".join("%02X%04X" % (ch, width(k))
+                                              for k, ch in enumerate(chans)))
+
+    stream = []
+    for i in range(SERVO_STREAM):
+        k, us = SERVO_WRITE_1[i % len(SERVO_WRITE_1)]
+        stream.append(one(k, us + 10 * (i // len(SERVO_WRITE_1) % 2)))  # each write changes a width
+    return ([("set", sixteen(SERVO_WRITE_START))]
+            + [("one", one(k, us)) for k, us in SERVO_WRITE_1]
+            + [("sixteen", sixteen(w)) for w in SERVO_WRITE_16]
+            + [("stream", "".join(stream)), ("set", sixteen(lambda k: 0))])
+
+
+def servo_write_figures(events, sent, replies):
+    """((slowest 1-triple write, its wire time), (slowest 16-triple write,
+    its wire time), (stream: correct replies, % of wire)) from the scheduled
+    windows `sent` [(kind, request, window)] and their replies in order."""
+    figures = {"one": (0, 0), "sixteen": (0, 0)}
+    at = 0
+    stream = None
+    for kind, request, window in sent:
+        if kind == "stream":
+            got = replies[at:at + SERVO_STREAM]
+            at += SERVO_STREAM
+            want = write_reply(request.split("\r")[0] + "\r")
+            stream = (window, sum(1 for r in got if r == want))
+            continue
+        reply = replies[at]
+        at += 1
+        if reply != write_reply(request):
+            raise SystemExit("bench: servo write %r answered %r" % (request, reply))
+        if kind in figures:
+            cycles, _ = latency(events, window, reply)
+            figures[kind] = max(figures[kind], (cycles, len(request) * CYCLES_PER_BYTE))
+    (start, end), correct = stream
+    rx = [e for e in events if e.kind == "uart rx" and start < e.cycle <= end]
+    following = min(w[0] for k, _, w in sent if w[0] > end)
+    tx = [e for e in events if e.kind == "uart tx" and start < e.cycle < following]
+    wire_end = tx[-1].cycle + CYCLES_PER_BYTE
+    return (figures["one"], figures["sixteen"],
+            (correct, 100.0 * len(rx) * CYCLES_PER_BYTE / (wire_end - start)))
 
 
 def servo_request(board):
@@ -182,6 +257,7 @@ def schedule_bytes(board, count):
     """Bytes one board's run puts on the serial line."""
     return (sum(len(r) for _, r, _ in LATENCY_REQUESTS) + len(PIPELINE_REQUEST) * count
             + len(servo_request(board)) + 1 + len(SERVO_LOAD) * SERVO_LOAD_COUNT
+            + sum(len(r) for _, r in servo_write_requests(board))
             + sum(len(r) + 1 for r in EXERCISE[board]))
 
 
@@ -202,6 +278,8 @@ def bench_board(board, count):
             # the servos run 10 frames before the quiet window's end
             servo_set = sched.send((servo_request(board) + "\r").encode(), gap=F_CPU // 5)
             load = sched.send((SERVO_LOAD * SERVO_LOAD_COUNT).encode())
+            writes = [(kind, request, sched.send(request.encode()))
+                      for kind, request in servo_write_requests(board)]
             exercise = [sched.send((request + "\r").encode()) for request in EXERCISE[board]]
         except SimControlError as e:
             raise SystemExit("bench: the %s simulator refused the schedule at cycle %d: %s"
@@ -210,7 +288,9 @@ def bench_board(board, count):
         with serial.Serial(sim.port, 115200, timeout=30) as port:
             lat_replies = read_replies(port, len(lat))
             pipe_replies = read_replies(port, count)
-            read_replies(port, 1 + SERVO_LOAD_COUNT + len(exercise))
+            read_replies(port, 1 + SERVO_LOAD_COUNT)
+            write_replies = read_replies(port, len(writes) - 1 + SERVO_STREAM)
+            read_replies(port, len(exercise))
         events = parse_trace(sim.trace_text())
         for (name, window), reply in zip(lat, lat_replies):
             rows[name] = latency(events, window, reply)
@@ -220,6 +300,7 @@ def bench_board(board, count):
                                              expected, len(PIPELINE_REQUEST) * count)
         quiet = (load[0] - F_CPU // 6, load[0])
         rows["servo"] = servo_figures(ctl, board, quiet, load)
+        rows["servo write"] = servo_write_figures(events, writes, write_replies)
         rows["stack"] = ctl.stack(heap_start(board))
         cycles_total = ctl.time()
     wall = time.monotonic() - wall0
@@ -247,7 +328,7 @@ def main():
                      "bytes; at most %d" % (args.requests, b, RX_SCHEDULE, most))
 
     results = {b: bench_board(b, args.requests) for b in args.boards}
-    width = 34
+    width = 38
     print("ORFA benchmark (simulated CPU cycles at 7.3728 MHz; 115200 baud = 640 cycles/byte)")
     print()
     print("%-*s" % (width, "figure") + "".join("%14s" % b for b in args.boards)
@@ -267,6 +348,18 @@ def main():
     print("%-*s" % (width, "pipelined: % of wire") + "".join(
         "%14.2f" % (100.0 * results[b]["pipeline"][2] / results[b]["pipeline"][1]) for b in args.boards)
         + "%10s" % ">= 99")
+    for i, label in enumerate(("servo write, 1 triple (cycles)", "servo write, 16 triples (cycles)")):
+        print("%-*s" % (width, label) + "".join(
+            "%14d" % results[b]["servo write"][i][0] for b in args.boards)
+            + "%10s" % ("<= 10000" if i == 0 else "< wire"))
+    print("%-*s" % (width, "  wire time of the 16-triple write") + "".join(
+        "%14d" % results[b]["servo write"][1][1] for b in args.boards))
+    label = "servo writes streamed: correct"
+    print("%-*s" % (width, label) + "".join(
+        "%14s" % ("%d/%d" % (results[b]["servo write"][2][0], SERVO_STREAM)) for b in args.boards)
+        + "%10s" % ("%d/%d" % (SERVO_STREAM, SERVO_STREAM)))
+    print("%-*s" % (width, "servo writes streamed: % of wire") + "".join(
+        "%14.2f" % results[b]["servo write"][2][1] for b in args.boards) + "%10s" % ">= 99")
     print("%-*s" % (width, "flash (B)") + "".join("%14d" % results[b]["footprint"][0] for b in args.boards)
           + "%10s%12d" % ("<= %d" % BUDGET_FLASH, BUDGET_FLASH))
     print("%-*s" % (width, "static RAM (B)") + "".join("%14d" % results[b]["footprint"][1] for b in args.boards)

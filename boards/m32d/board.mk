@@ -3,5 +3,5 @@ BOARD_MCU := atmega32
 BOARD_F_CPU := 7372800UL
 # Drivers after introspection, in register order (SPEC section 1).
 BOARD_DRIVERS := gpio spi adc motor servo
-# Servo pulse hardware: one MCU pin per channel.
-BOARD_SERVO_HW := servo_pins
+# Servo pulse hardware: one MCU pin per channel, edges as planned.
+BOARD_SERVO_HW := servo_pins servo_plan

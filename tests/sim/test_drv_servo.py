@@ -102,6 +102,79 @@ def test_m32d_pulse_start_offsets(drv):
         assert abs(rises[0] - rise0 - 8191 * ch) <= WIDTH_TOL, (ch, rises[0] - rise0)
 
 
+@pytest.mark.parametrize("widths", [{0: 1000, 13: 1500}, {1: 1096, 10: 1500}])
+def test_m32d_long_gaps_keep_the_starts(drv, widths):
+    """M32-D: more than 65535 cycles between two edges (channels far apart)
+    still start each channel n x 8191 cycles into the frame. {1: 1096,
+    10: 1500}: channel 1 ends 65638 cycles before channel 10 starts, so an
+    edge time kept to 16 bits would come 102 cycles after it."""
+    if drv.board != "m32d":
+        pytest.skip("M32-D only")
+    set_widths(drv, widths)
+    since = settle(drv)
+    first, last = sorted(widths)
+    rise = drv.highs(drv.lay["servo_pins"][first], since)[0][0]
+    later = [r for r, _, _ in drv.highs(drv.lay["servo_pins"][last], rise)]
+    assert abs(later[0] - rise - 8191 * (last - first)) <= WIDTH_TOL, (later[0] - rise)
+    for ch, us in widths.items():
+        check_pulses(drv, drv.lay["servo_pins"][ch], us, since)
+
+
+def test_m32d_a_channel_not_written_keeps_its_place(drv):
+    """M32-D (docs: placing): 5 at 1100 us ends 81 cycles before 6 starts;
+    written together, 5 is placed first and 6 moves to the nearest clear
+    place, 10 x 32 cycles late. Then 5 alone gets shorter: 6, not written,
+    stays where it is; written again, it goes back to its slot."""
+    if drv.board != "m32d":
+        pytest.skip("M32-D only")
+    pins = drv.lay["servo_pins"]
+
+    def starts():
+        since = settle(drv, 2)
+        rise0 = drv.highs(pins[0], since)[0][0]
+        return {ch: drv.highs(pins[ch], rise0)[0][0] - rise0 for ch in (5, 6)}
+
+    set_widths(drv, {0: 1000, 5: 1100, 6: 1200})
+    got = starts()
+    assert abs(got[5] - 5 * 8191) <= WIDTH_TOL and abs(got[6] - (6 * 8191 + 320)) <= WIDTH_TOL, got
+    set_widths(drv, {5: 1000})
+    got = starts()
+    assert abs(got[5] - 5 * 8191) <= WIDTH_TOL and abs(got[6] - (6 * 8191 + 320)) <= WIDTH_TOL, got
+    set_widths(drv, {6: 1201})
+    got = starts()
+    assert abs(got[6] - 6 * 8191) <= WIDTH_TOL, got
+    since = settle(drv, 3)
+    for ch, us in ((0, 1000), (5, 1000), (6, 1201)):
+        check_pulses(drv, pins[ch], us, since)
+
+
+def test_m32d_edges_in_a_row_whatever_the_timer_phase(drv):
+    """M32-D: channel 1 ends 401 cycles before channel 2 starts (moved 320
+    late by the planner) and 425 before channel 0 ends: the interrupt makes
+    the three edges in one go, about 1300 cycles. Timer2 overflows every
+    2048 cycles, at a place in the frame set when the servos start: started
+    again and again, some start puts an overflow early in that run, and the
+    tick count must not lose it (it did: the interrupt then waited forever
+    and the watchdog reset the board). Widths exact, no reset."""
+    if drv.board != "m32d":
+        pytest.skip("M32-D only")
+    pins = drv.lay["servo_pins"]
+    mark = drv.mark()
+    for attempt in range(24):
+        set_widths(drv, {0: 0, 1: 0, 2: 0})
+        drv.wait(2 * SERVO_FRAME + 61 * attempt)
+        for ch, us in ((1, 1100), (2, 1200), (0, 2323)):
+            set_widths(drv, {ch: us})
+        since = drv.now() + 2 * SERVO_FRAME
+        drv.wait(4 * SERVO_FRAME)
+        assert drv.events(mark, ["reset"]) == [], "watchdog reset at start %d" % attempt
+        for ch, us in ((0, 2323), (1, 1100), (2, 1200)):
+            check_pulses(drv, pins[ch], us, since, 1)
+    since = settle(drv, 2)
+    rise1 = drv.highs(pins[1], since)[0][0]
+    assert abs(drv.highs(pins[2], rise1)[0][0] - rise1 - (8191 + 320)) <= WIDTH_TOL
+
+
 def test_m128s_long_counter_frame_stretches(drv):
     """M128-S: eight 2500 us widths on one counter (20 ms > 19.8 ms) stretch
     that frame to fit them; the widths stay exact."""
