@@ -194,23 +194,40 @@ static void bm_update_oc_ports(board_model_t *bm)
 	}
 }
 
+/* Takes over the write handler of the register at ADDR, keeping the one it
+ * had (simavr's) in PREV for bm_pass_write. */
+static void bm_take_write(avr_t *avr, uint16_t addr, avr_io_write_t fn, void *param,
+			  bm_chain_t *prev)
+{
+	avr_io_addr_t io = AVR_DATA_TO_IO(addr);
+
+	prev->w = avr->io[io].w.c;
+	prev->param = avr->io[io].w.param;
+	avr->io[io].w.c = fn;
+	avr->io[io].w.param = param;
+}
+
+/* The write as the register's own handler (or a plain store) does it. */
+static void bm_pass_write(avr_t *avr, const bm_chain_t *prev, uint16_t addr, uint8_t v)
+{
+	if (prev->w) {
+		prev->w(avr, addr, v, prev->param);
+	} else {
+		avr->data[addr] = v;
+	}
+}
+
 /* A register holding COM bits was written: the pin may change owner. */
 static void bm_on_com_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *param)
 {
 	bm_com_hook_t *h = param;
 
-	if (h->w) {
-		h->w(avr, addr, v, h->param);
-	} else {
-		avr->data[addr] = v;
-	}
+	bm_pass_write(avr, &h->prev, addr, v);
 	bm_update_oc_ports(h->bm);
 }
 
 static void bm_hook_com(board_model_t *bm, uint16_t addr)
 {
-	avr_io_addr_t io = AVR_DATA_TO_IO(addr);
-
 	for (int i = 0; i < bm->ncom; i++) {
 		if (bm->com[i].addr == addr) {
 			return;
@@ -223,10 +240,7 @@ static void bm_hook_com(board_model_t *bm, uint16_t addr)
 
 	h->bm = bm;
 	h->addr = addr;
-	h->w = bm->avr->io[io].w.c;
-	h->param = bm->avr->io[io].w.param;
-	bm->avr->io[io].w.c = bm_on_com_write;
-	bm->avr->io[io].w.param = h;
+	bm_take_write(bm->avr, addr, bm_on_com_write, h, &h->prev);
 }
 
 bm_port_t *board_model_port(board_model_t *bm, char letter)
@@ -575,11 +589,7 @@ static void bm_on_ocr_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *par
 	bm_ocr_hook_t *h = param;
 	avr_timer_t *t = h->timer;
 
-	if (h->w) {
-		h->w(avr, addr, v, h->param);
-	} else {
-		avr->data[addr] = v;
-	}
+	bm_pass_write(avr, &h->prev, addr, v);
 	/* (avr_timer_wgm_pwm, simavr's filing of the ATmega32's mode 14, is
 	 * latched at each overflow by bm_on_pwm_overflow instead.) */
 	if (t->wgm_op_mode_kind != avr_timer_wgm_fast_pwm
@@ -674,8 +684,6 @@ static void bm_watch_pwm(board_model_t *bm, avr_timer_t *t)
 
 static void bm_hook_ocr(board_model_t *bm, avr_timer_t *t, uint16_t addr)
 {
-	avr_io_addr_t io = AVR_DATA_TO_IO(addr);
-
 	if (!addr || !t->r_tcnth) {
 		return;	/* 16-bit timers only (the motor PWM) */
 	}
@@ -692,10 +700,7 @@ static void bm_hook_ocr(board_model_t *bm, avr_timer_t *t, uint16_t addr)
 	h->bm = bm;
 	h->timer = t;
 	h->addr = addr;
-	h->w = bm->avr->io[io].w.c;
-	h->param = bm->avr->io[io].w.param;
-	bm->avr->io[io].w.c = bm_on_ocr_write;
-	bm->avr->io[io].w.param = h;
+	bm_take_write(bm->avr, addr, bm_on_ocr_write, h, &h->prev);
 }
 
 /*
@@ -738,8 +743,8 @@ static void bm_add_flag(board_model_t *bm, avr_int_vector_t *vec)
 		r = &bm->flag_regs[bm->nflag_regs++];
 		r->addr = vec->raised.reg;
 		/* replaced, not chained: simavr's own handler is the bug */
-		bm->avr->io[AVR_DATA_TO_IO(r->addr)].w.c = bm_on_flag_write;
-		bm->avr->io[AVR_DATA_TO_IO(r->addr)].w.param = r;
+		bm_chain_t simavrs;
+		bm_take_write(bm->avr, r->addr, bm_on_flag_write, r, &simavrs);
 	}
 	if (r->n < BM_MAX_FLAGS) {
 		r->vec[r->n++] = vec;
@@ -775,11 +780,7 @@ static void bm_on_foc_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *par
 	for (int i = 0; i < h->n; i++) {
 		strobes |= (uint8_t)(1u << h->bit[i]);
 	}
-	if (h->w) {
-		h->w(avr, addr, (uint8_t)(v & ~strobes), h->param);
-	} else {
-		avr->data[addr] = (uint8_t)(v & ~strobes);
-	}
+	bm_pass_write(avr, &h->prev, addr, (uint8_t)(v & ~strobes));
 	for (int i = 0; i < h->n; i++) {
 		bm_oc_t *oc = h->oc[i];
 		const avr_timer_t *t = oc->timer;
@@ -820,15 +821,10 @@ static void bm_hook_foc(board_model_t *bm, const mcu_desc_t *mcu)
 			}
 		}
 		if (!h) {
-			avr_io_addr_t io = AVR_DATA_TO_IO(d->reg);
-
 			h = &bm->foc[bm->nfoc++];
 			h->bm = bm;
 			h->addr = d->reg;
-			h->w = bm->avr->io[io].w.c;
-			h->param = bm->avr->io[io].w.param;
-			bm->avr->io[io].w.c = bm_on_foc_write;
-			bm->avr->io[io].w.param = h;
+			bm_take_write(bm->avr, d->reg, bm_on_foc_write, h, &h->prev);
 		}
 		if (h->n < 3) {
 			h->oc[h->n] = oc;

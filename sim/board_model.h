@@ -64,11 +64,16 @@ typedef struct bm_port_t {
 	void *pin_read_param;
 } bm_port_t;
 
+/* simavr's write handler of a register the board model took over. */
+typedef struct bm_chain_t {
+	avr_io_write_t w;	/* NULL: a plain store */
+	void *param;
+} bm_chain_t;
+
 typedef struct bm_com_hook_t {
 	struct board_model_t *bm;
 	uint16_t addr;
-	avr_io_write_t w;
-	void *param;
+	bm_chain_t prev;
 } bm_com_hook_t;
 
 /* An OCRnx low-byte write handler chained by the board model (fast PWM). */
@@ -76,8 +81,7 @@ typedef struct bm_ocr_hook_t {
 	struct board_model_t *bm;
 	avr_timer_t *timer;
 	uint16_t addr;
-	avr_io_write_t w;
-	void *param;
+	bm_chain_t prev;
 } bm_ocr_hook_t;
 
 /* A PWM timer whose overflow the board model watches (OCR double buffer). */
@@ -90,8 +94,7 @@ typedef struct bm_pwm_timer_t {
 typedef struct bm_foc_hook_t {
 	struct board_model_t *bm;
 	uint16_t addr;
-	avr_io_write_t w;	/* simavr's handler, chained */
-	void *param;
+	bm_chain_t prev;
 	struct bm_oc_t *oc[3];	/* the unit each strobe bit acts on */
 	uint8_t bit[3];
 	int n;
