@@ -18,13 +18,17 @@
 #define MCU_UART_UDRE_vect USART_UDRE_vect
 #define MCU_RESET_FLAGS    MCUCSR
 #elif defined(__AVR_ATmega128__)
-#define MCU_UDR            UDR0
-#define MCU_UCSRA          UCSR0A
-#define MCU_UCSRB          UCSR0B
-#define MCU_UBRRL          UBRR0L
-#define MCU_UBRRH          UBRR0H
-#define MCU_UART_RX_vect   USART0_RX_vect
-#define MCU_UART_UDRE_vect USART0_UDRE_vect
+/* Two USARTs: the board file's BOARD_UART picks the PC's. */
+#include "board.h"
+#define MCU_CAT3_(a, b, c) a##b##c
+#define MCU_CAT3(a, b, c)  MCU_CAT3_(a, b, c)
+#define MCU_UDR            MCU_CAT3(UDR, BOARD_UART, )
+#define MCU_UCSRA          MCU_CAT3(UCSR, BOARD_UART, A)
+#define MCU_UCSRB          MCU_CAT3(UCSR, BOARD_UART, B)
+#define MCU_UBRRL          MCU_CAT3(UBRR, BOARD_UART, L)
+#define MCU_UBRRH          MCU_CAT3(UBRR, BOARD_UART, H)
+#define MCU_UART_RX_vect   MCU_CAT3(USART, BOARD_UART, _RX_vect)
+#define MCU_UART_UDRE_vect MCU_CAT3(USART, BOARD_UART, _UDRE_vect)
 #define MCU_RESET_FLAGS    MCUCSR
 #else
 #error "ORFA supports ATmega32 and ATmega128"

@@ -7,9 +7,9 @@
 #include "board_wiring.h"
 
 static const board_desc_t board_table[] = {
-	{ .name = "m32d", .title = "OR-AVR-M32-D", .mcu = "atmega32", .host_usart = 0,
+	{ .name = "m32d", .title = "OR-AVR-M32-D", .mcu = "atmega32",
 	  .wiring = &board_m32d_wiring },
-	{ .name = "m128s", .title = "OR-AVR-M128-S", .mcu = "atmega128", .host_usart = 0,
+	{ .name = "m128s", .title = "OR-AVR-M128-S", .mcu = "atmega128",
 	  .wiring = &board_m128s_wiring },
 };
 

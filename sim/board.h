@@ -12,7 +12,6 @@ typedef struct board_desc_t {
 	const char *name;	/* --board value: "m32d" */
 	const char *title;	/* "OR-AVR-M32-D" */
 	const char *mcu;	/* simavr MCU name */
-	uint8_t host_usart;	/* index into the MCU's USARTs */
 	const struct board_wiring_t *wiring;
 } board_desc_t;
 

@@ -11,6 +11,7 @@ const board_wiring_t board_m128s_wiring = {
 	.pins = m128s_pins,
 	.npins = sizeof(m128s_pins) / sizeof(m128s_pins[0]),
 	.adc_port = BOARD_ADC_PORT,
+	.host_usart = BOARD_UART,
 	.servo_counters = BOARD_SERVO_COUNTERS,
 	.servo_per_counter = BOARD_SERVO_PER_COUNTER,
 };

@@ -11,6 +11,7 @@ const board_wiring_t board_m32d_wiring = {
 	.pins = m32d_pins,
 	.npins = sizeof(m32d_pins) / sizeof(m32d_pins[0]),
 	.adc_port = BOARD_ADC_PORT,
+	.host_usart = BOARD_UART,
 	.servo_counters = 0,
 	.servo_per_counter = 0,
 };

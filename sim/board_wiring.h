@@ -26,6 +26,7 @@ typedef struct board_wiring_t {
 	const board_pin_t *pins;
 	int npins;
 	char adc_port;			/* port whose lines are ADC0..7 */
+	int host_usart;			/* the PC's serial port: the MCU's USART n */
 	int servo_counters;		/* CD4017s (0: servos on plain pins) */
 	int servo_per_counter;
 } board_wiring_t;

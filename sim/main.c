@@ -346,7 +346,7 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 		sim->eeprom[i].write_protect = args->eeprom_wp[i];
 		twi_bus_attach(&sim->bus, &sim->eeprom[i].dev);
 	}
-	usart_init(&sim->usart, sim->avr, &sim->mcu->usart[sim->board->host_usart],
+	usart_init(&sim->usart, sim->avr, &sim->mcu->usart[sim->board->wiring->host_usart],
 		   &sim->trace, sim_to_host, &sim->pty);
 	twi_init(&sim->twi, sim->avr, &sim->mcu->twi, &sim->bus);
 	if (board_model_init(&sim->bm, sim->avr, sim->board, sim->mcu, &sim->trace) < 0) {

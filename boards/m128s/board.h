@@ -6,8 +6,8 @@
  *   port  7     6     5     4     3     2     1     0
  *   A     IO7   IO6   IO5   IO4   IO3   IO2   IO1   IO0    GPIO port A
  *   B     CLK3  -     -     -     MISO  MOSI  SCK   SS     SPI, servo counter 3 clock (OC1C)
- *   D     -     -     -     -     -     -     SDA   SCL    TWI
- *   E     -     RST   CLK2  CLK1  CLK0  -     TXD0  RXD0   counter clocks (OC3A-C), reset, UART0
+ *   D     -     -     -     -     TXD1  RXD1  SDA   SCL    UART1 (the PC), TWI
+ *   E     -     RST   CLK2  CLK1  CLK0  -     -     -      counter clocks (OC3A-C), reset
  *   F     AD7   AD6   AD5   AD4   AD3   AD2   AD1   AD0    GPIO port F = ADC (JTAG switched off)
  *
  * Servos: 32 channels through four CD4017 decade counters. Counter c is
@@ -26,8 +26,9 @@
 #define BOARD_CLOCK_HZ  7372800UL
 #define BOARD_NPORTS    7   /* A..G */
 
-/* The gateway's serial port (USART0) and the TWI pins. */
-#define BOARD_UART      0
+/* The PC's serial port: USART1, as ORFA 0.7.5 (PE0/PE1 of USART0 are the
+ * ISP programming pins), and the TWI pins. */
+#define BOARD_UART      1
 #define BOARD_TWI_PORT  'D'
 #define BOARD_TWI_SCL   0
 #define BOARD_TWI_SDA   1
@@ -51,8 +52,8 @@
  *   SERVO_CLK c (clock of counter c), SERVO_RST (the counters' common reset).
  */
 #define BOARD_PINS(X) \
-	X('E', 0, UART_RX, 0) \
-	X('E', 1, UART_TX, 0) \
+	X('D', 2, UART_RX, 0) \
+	X('D', 3, UART_TX, 0) \
 	X('D', 0, TWI_SCL, 0) \
 	X('D', 1, TWI_SDA, 0) \
 	X('B', 0, SPI_SS, 0) \

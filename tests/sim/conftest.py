@@ -190,7 +190,7 @@ DRV_LAYOUT = {
         "servo_channels": 32, "adc_port": "F",
         "spi_pins": {"SS": "B0", "SCK": "B1", "MOSI": "B2", "MISO": "B3"},
         "servo_pins": ["servo%d" % n for n in range(32)],
-        "fixed_pins": {"E0": "UART", "E1": "UART", "D0": "TWI", "D1": "TWI",
+        "fixed_pins": {"D2": "UART", "D3": "UART", "D0": "TWI", "D1": "TWI",
                        "B0": "SPI", "B1": "SPI", "B2": "SPI", "B3": "SPI",
                        "E3": "SERVO", "E4": "SERVO", "E5": "SERVO", "B7": "SERVO",
                        "E6": "SERVO"},
