@@ -117,8 +117,10 @@ static void test_gpio(void)
 static void test_fixed_pins(void)
 {
 	boot();
-	CHECK_EQ(pins_owner(PIN(PE, 0)), PIN_UART);
-	CHECK_EQ(pins_owner(PIN(PE, 1)), PIN_UART);
+	CHECK_EQ(pins_owner(PIN(PD, 2)), PIN_UART);  /* USART1 */
+	CHECK_EQ(pins_owner(PIN(PD, 3)), PIN_UART);
+	CHECK_EQ(pins_owner(PIN(PE, 0)), 0);  /* ISP pins: no function */
+	CHECK_EQ(pins_owner(PIN(PE, 1)), 0);
 	CHECK_EQ(pins_owner(PIN(PD, 0)), PIN_TWI);
 	CHECK_EQ(pins_owner(PIN(PD, 1)), PIN_TWI);
 	for (unsigned l = 0; l < 4; l++) {
