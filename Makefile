@@ -15,15 +15,37 @@ BAUD ?= 115200
 ADDR ?= 0x10
 
 BOARDS := m32d m128s
-MODES := gate
+MODES := gate slave
 
+ifeq ($(wildcard boards/$(BOARD)/board.mk),)
+$(error BOARD=$(BOARD): no such board (boards/: $(notdir $(wildcard boards/*))))
+endif
 include boards/$(BOARD)/board.mk
+
+# The slave's bus address, 8-bit form (SPEC section 4): even, and not one of
+# the 7-bit addresses I2C reserves (8-bit 0x00-0x0F and 0xF0-0xFE).
+ifeq ($(MODE),slave)
+ADDR_NUM := $(shell v=$$(printf '%d' '$(ADDR)' 2>/dev/null) && echo $$v)
+ifeq ($(ADDR_NUM),)
+$(error ADDR=$(ADDR) is not a number: give the 8-bit bus address, e.g. ADDR=0x10)
+endif
+ifneq ($(shell test $(ADDR_NUM) -ge 0 -a $(ADDR_NUM) -le 255 && echo ok),ok)
+$(error ADDR=$(ADDR) is not an 8-bit bus address (0x10..0xEE, even))
+endif
+ifneq ($(shell expr $(ADDR_NUM) % 2),0)
+$(error ADDR=$(ADDR) is odd: give the 8-bit form, whose bit 0 is the R/W bit (e.g. ADDR=0x10 for 7-bit 0x08))
+endif
+ifneq ($(shell test $(ADDR_NUM) -ge 16 -a $(ADDR_NUM) -le 239 && echo ok),ok)
+$(error ADDR=$(ADDR) is reserved by I2C (8-bit 0x00-0x0F and 0xF0-0xFE): use 0x10..0xEE)
+endif
+endif
 
 # Drivers linked into the register table, in register order. Leave drivers out
 # with DRIVERS="..." (introspection is always in: it owns registers 0x00-0x01).
 DRIVERS ?= $(BOARD_DRIVERS)
 
-BUILD := build/$(BOARD)-$(MODE)
+# BUILD=dir puts one more build elsewhere (the test robot's slaves at their addresses).
+BUILD ?= build/$(BOARD)-$(MODE)
 FW_OPT ?= -Os
 CC := avr-gcc
 OBJCOPY := avr-objcopy
@@ -42,15 +64,16 @@ DRV_HW_adc := drivers/adc_hw.c
 DRV_HW_motor := drivers/motor_hw.c
 DRV_HW_servo := $(foreach f,$(BOARD_SERVO_HW),drivers/$(f).c)
 
-FW_SRC := firmware/main.c firmware/regmap.c firmware/intro.c firmware/uart.c \
-	firmware/twi_master.c firmware/twi_rate.c firmware/mcu.c firmware/pins.c \
-	firmware/board_pins.c firmware/port_io_avr.c \
+FW_SRC := firmware/main.c firmware/regmap.c firmware/xact.c firmware/intro.c \
+	firmware/mcu.c firmware/pins.c firmware/board_pins.c firmware/port_io_avr.c \
 	$(foreach d,$(DRIVERS),drivers/drv_$(d).c $(DRV_HW_$(d)))
 ifeq ($(MODE),gate)
-FW_SRC += serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
-endif
-ifeq ($(MODE),slave)
-FW_SRC += i2c_slave/i2c_slave.c
+FW_SRC += firmware/uart.c firmware/twi_master.c firmware/twi_rate.c \
+	serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
+else ifeq ($(MODE),slave)
+FW_SRC += i2c_slave/slave_fsm.c i2c_slave/i2c_slave.c
+else
+$(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at ADDR))
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 

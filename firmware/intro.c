@@ -1,6 +1,7 @@
 #include "firmware/intro.h"
 
-/* 0: the next read gives the driver count; n: it gives driver n. */
+/* 0: reads give the driver count (and stay there, as in ORFA 0.7.5, whose
+ * hosts read the count again); n: the next read gives driver n. */
 static uint8_t intro_cursor;
 
 void drv_intro_init(void)
@@ -29,7 +30,6 @@ uint8_t drv_intro_read(uint8_t reg, uint8_t *dst, uint8_t max)
 	(void)reg;
 	if (intro_cursor == 0) {
 		dst[0] = regmap_driver_count();
-		intro_cursor = 1;
 		return 1;
 	}
 	if (intro_cursor > regmap_driver_count()) {

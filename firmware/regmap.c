@@ -84,6 +84,11 @@ bool regmap_select(uint8_t reg)
 	return true;
 }
 
+bool regmap_status_selected(void)
+{
+	return rm.reg == REGMAP_STATUS_REG;
+}
+
 reg_status_t regmap_write(const uint8_t *data, uint8_t len)
 {
 	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
@@ -98,30 +103,29 @@ reg_status_t regmap_write(const uint8_t *data, uint8_t len)
 	return st;
 }
 
-reg_status_t regmap_read(uint8_t *dst, uint8_t n)
+void regmap_read_start(void)
+{
+	if (rm.reg != REGMAP_STATUS_REG) {
+		rm.status = REG_OK;
+	}
+}
+
+uint8_t regmap_read(uint8_t *dst, uint8_t max)
 {
 	if (rm.reg == REGMAP_STATUS_REG) {
 		/* Reading the status leaves it as it is. */
-		for (uint8_t i = 0; i < n; i++) {
+		for (uint8_t i = 0; i < max; i++) {
 			dst[i] = rm.status;
 		}
-		return REG_OK;
+		return max;
 	}
 	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
-	uint8_t (*read)(uint8_t, uint8_t *, uint8_t) = e->read;
-	uint8_t reg = (uint8_t)(rm.reg - regmap_starts[rm.entry]);
-
-	rm.status = REG_OK;
-	while (n) {
-		uint8_t got = read(reg, dst, n);
-		if (got == 0 || got > n) {
-			rm.status = REG_NOT_READABLE;
-			return REG_NOT_READABLE;
-		}
-		dst += got;
-		n = (uint8_t)(n - got);
+	uint8_t got = e->read((uint8_t)(rm.reg - regmap_starts[rm.entry]), dst, max);
+	if (got == 0 || got > max) {
+		rm.status = REG_NOT_READABLE;
+		return 0;
 	}
-	return REG_OK;
+	return got;
 }
 
 void regmap_set_status(reg_status_t status)

@@ -21,6 +21,7 @@ typedef enum {
 	REG_NOT_READABLE = 0x05,
 	REG_READ_WRAPPED = 0x06,
 	REG_NOT_BOUND = 0x07,
+	REG_NO_REGISTER = 0x08,
 } reg_status_t;
 
 #define REGMAP_INTRO_REG   0x00
@@ -48,12 +49,20 @@ void regmap_init(void);
  * changes, if no driver maps it. */
 bool regmap_select(uint8_t reg);
 
+/* True when the selected register is the status register. */
+bool regmap_status_selected(void);
+
 /* Delivers one write frame's data to the selected register. */
 reg_status_t regmap_write(const uint8_t *data, uint8_t len);
 
-/* Fills `n` bytes from the selected register, asking its driver as often as
- * needed. REG_NOT_READABLE if it cannot be read (nothing is filled then). */
-reg_status_t regmap_read(uint8_t *dst, uint8_t n);
+/* A read of the selected register begins: the status becomes OK (a read of
+ * the status register leaves it as it is). */
+void regmap_read_start(void);
+
+/* One answer of the selected register: up to `max` (>= 1) bytes at `dst`,
+ * how many. 0: it cannot be read (status REG_NOT_READABLE). Asking again
+ * gives the driver's next answer (xact.h asks when one is used up). */
+uint8_t regmap_read(uint8_t *dst, uint8_t max);
 
 /* For drivers: record a status that does not fail the operation. */
 void regmap_set_status(reg_status_t status);

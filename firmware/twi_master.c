@@ -9,6 +9,14 @@
 #include "firmware/mcu.h"
 #include "firmware/twi_rate.h"
 
+/* Cycles of one twi_wait() polling loop at least (avr-gcc 5.4 -Os: 9 on
+ * the ATmega32, 10 on the ATmega128, more with interrupts). */
+#define TWI_LOOP_CYCLES 9
+/* The longest SCL stretch a slave is waited for: an ORFA M32-D slave's
+ * longest register write (16 servo triples) takes about 5.5 ms. */
+#define TWI_STRETCH_MAX_US 8000UL
+#define TWI_STRETCH_LOOPS (TWI_STRETCH_MAX_US * (F_CPU / 1000000UL) / TWI_LOOP_CYCLES)
+
 static struct {
 	uint32_t timeout;  /* polling loops before a step counts as hung */
 } twi;
@@ -24,9 +32,10 @@ uint16_t twi_set_khz(uint16_t khz)
 	twi_rate_t r = twi_rate_for_khz(F_CPU, khz);
 	TWBR = r.twbr;
 	TWSR = r.twps;  /* only the prescaler bits are writable */
-	/* A polling loop takes at least 6 cycles: 3 periods of loops cover a
-	 * whole byte (9 periods) twice over. */
-	twi.timeout = 3 * r.period + 256;
+	/* A polling loop takes at least TWI_LOOP_CYCLES: 3 periods of loops
+	 * cover a whole byte (9 periods) twice over; on top, the time a slave
+	 * may stretch SCL (an ORFA slave applies a write while it holds SCL). */
+	twi.timeout = 3 * r.period + 256 + TWI_STRETCH_LOOPS;
 	return r.khz;
 }
 

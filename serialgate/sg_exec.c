@@ -5,6 +5,7 @@
 #include "firmware/flash.h"
 #include "firmware/regmap.h"
 #include "firmware/twi_master.h"
+#include "firmware/xact.h"
 
 static struct {
 	uint8_t local;  /* local address, bit 0 clear */
@@ -34,22 +35,36 @@ static void out_error(uint8_t err)
 	out_end();
 }
 
-/* A frame to the board itself: the register map, never the bus. */
+/* A frame to the board itself: the register map through the transaction
+ * module, byte by byte as a TWI slave sees it, never the bus. The frame's
+ * bytes stay where the parser put them: a write's data are handed over in
+ * place and a read's answers land where the reply is made from. */
 static uint8_t run_local(uint8_t addr, uint8_t *data, uint8_t n)
 {
+	uint8_t err = SG_OK;
+
 	if (addr & 1) {
-		return regmap_read(data, n) == REG_OK ? SG_OK : SG_ERR_ADDR_NACK;
+		if (!xact_read_requested(data, n)) {
+			err = SG_ERR_ADDR_NACK;
+		}
+		for (uint8_t k = 0; k < n && err == SG_OK; k++) {
+			if (!xact_read_processed(&data[k])) {
+				err = SG_ERR_ADDR_NACK;
+			}
+		}
+		xact_frame_end();
+		return err;
 	}
-	if (n == 0) {
-		return SG_OK;  /* address probe */
+	xact_write_requested(data + 1, n ? (uint8_t)(n - 1) : 0);
+	for (uint8_t k = 0; k < n && err == SG_OK; k++) {
+		if (!xact_write_received(data[k])) {
+			err = SG_ERR_DATA_NACK;
+		}
 	}
-	if (!regmap_select(data[0])) {
-		return SG_ERR_DATA_NACK;
+	if (xact_frame_end() != REG_OK) {
+		err = SG_ERR_DATA_NACK;
 	}
-	if (n > 1 && regmap_write(data + 1, (uint8_t)(n - 1)) != REG_OK) {
-		return SG_ERR_DATA_NACK;
-	}
-	return SG_OK;
+	return err;
 }
 
 static uint8_t run_bus(uint8_t addr, uint8_t *data, uint8_t n)
@@ -129,6 +144,7 @@ void sg_exec_lost(const sg_parser_t *p)
 
 void sg_exec_init(void)
 {
+	xact_init();
 	gate.local = SG_LOCAL_DEFAULT;
 	gate.khz = twi_set_khz(SG_KHZ_DEFAULT);
 }

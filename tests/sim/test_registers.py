@@ -42,10 +42,16 @@ def test_auto_increment_over_all_records(board):
     assert reply == b"SWAASR" + singles[:6 * k].hex().upper().encode() + b"P\r\n"
 
 
-def test_count_is_followed_by_driver_1(board):
+def test_count_read_moves_nothing(board):
+    """SPEC 3: reading the count moves nothing; every later read frame (and
+    every further byte of a longer one) gives the count again, as ORFA 0.7.5
+    does, until another number is written."""
     n = board.driver_count()
-    reply = board.ask("S AA 00 00 S AB 07 P")
-    assert reply == b"SWAASR%02X%sP\r\n" % (n, board.record(1).hex().upper().encode())
+    assert board.ask("S AA 00 00 S AB 03 P") == b"SWAASR%02X%02X%02XP\r\n" % (n, n, n)
+    assert board.ask("S AB 01 P") == b"SR%02XP\r\n" % n
+    assert board.ask("S AB 01 S AB 01 P") == b"SR%02XSR%02XP\r\n" % (n, n)
+    assert board.ask("S AA 00 01 S AB 06 P") == b"SWAASR%sP\r\n" % (
+        board.record(1).hex().upper().encode())
 
 
 def test_reading_past_the_last_driver_wraps(board):

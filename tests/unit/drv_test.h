@@ -37,6 +37,9 @@ extern const board_t B;
 /* Each board's own tests (test_drv_<board>.c). */
 void board_tests(void);
 
+/* The transaction module with these drivers (test_xact.c). */
+void xact_tests(void);
+
 /* Power-on: fakes reset, pins_init(), regmap_init() as main() does. */
 void boot(void);
 

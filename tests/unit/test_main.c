@@ -304,8 +304,9 @@ static void test_registers(void)
 	expect("S AA 00 01 S AB 0C P\r", "SWAASR0000010000020F0F02030203P\r\n", "");
 	/* status after a clean read */
 	expect("S AA 01 S AB 01 P\r", "SWASR00P\r\n", "");
-	/* count, then driver 1 */
-	expect("S AA 00 00 S AB 07 P\r", "SWAASR02000001000002P\r\n", "");
+	/* the count read moves nothing: every byte and frame gives it again */
+	expect("S AA 00 00 S AB 03 P\r", "SWAASR020202P\r\n", "");
+	expect("S AB 01 S AB 01 P\r", "SR02SR02P\r\n", "");
 	/* reading past the last driver goes on with driver 1, status 06 */
 	expect("S AA 00 02 S AB 0C P\r", "SWAASR0F0F02030203000001000002P\r\n", "");
 	expect("S AA 01 S AB 01 P\r", "SWASR06P\r\n", "");
@@ -344,7 +345,10 @@ static void test_registers(void)
 	expect("S AA 00 00 S A0 00 S AB 01 P\r", "SWAASWASR02P\r\n", "S A0+ W00+ P ");
 	/* local probe */
 	expect("S AA P\r", "SWP\r\n", "");
-	expect("S AB 01 P\r", "SR00P\r\n", "");  /* the count read moved on to driver 1 */
+	expect("S AB 01 P\r", "SR02P\r\n", "");  /* the count read moved nothing */
+	/* an unmapped register: ERROR 07, and the status register says why */
+	expect("S AA 7F P\r", "ERROR 07\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR08P\r\n", "");
 }
 
 /* Random input must never crash, hang or break the one-reply-per-line rule. */

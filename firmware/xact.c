@@ -1,0 +1,127 @@
+#include "firmware/xact.h"
+
+typedef enum {
+	XACT_IDLE = 0,
+	XACT_SELECT,    /* write frame: the register byte comes next */
+	XACT_DATA,      /* write frame: data bytes */
+	XACT_REFUSED,   /* write frame refused: the rest is refused too */
+	XACT_READ,      /* read frame */
+	XACT_NO_DATA,   /* read frame of a register that gives nothing */
+} xact_state_t;
+
+static struct {
+	uint8_t state;
+	uint8_t refusal;  /* why a refused write frame was refused */
+	uint8_t *buf;
+	uint8_t cap;
+	uint8_t len;      /* write: data bytes held; read: bytes answered */
+	uint8_t pos;      /* read: bytes given to the master */
+} xact;
+
+void xact_init(void)
+{
+	xact.state = XACT_IDLE;
+}
+
+void xact_write_requested(uint8_t *buf, uint8_t cap)
+{
+	xact.state = XACT_SELECT;
+	xact.buf = buf;
+	xact.cap = cap;
+	xact.len = 0;
+}
+
+static bool xact_refuse(reg_status_t why)
+{
+	xact.state = XACT_REFUSED;
+	xact.refusal = why;
+	regmap_set_status(why);
+	return false;
+}
+
+bool xact_write_received(uint8_t byte)
+{
+	switch (xact.state) {
+	case XACT_SELECT:
+		if (!regmap_select(byte)) {
+			return xact_refuse(REG_NO_REGISTER);
+		}
+		xact.state = XACT_DATA;
+		return true;
+	case XACT_DATA:
+		/* Refused as early as it is known, so a TWI slave can refuse
+		 * the byte after it. */
+		if (regmap_status_selected()) {
+			return xact_refuse(REG_NOT_WRITABLE);
+		}
+		if (xact.len >= xact.cap) {
+			return xact_refuse(REG_BAD_LENGTH);
+		}
+		xact.buf[xact.len++] = byte;
+		return true;
+	default:
+		return false;
+	}
+}
+
+/* The driver's next answer goes after the bytes already answered, so a
+ * front end that knows its read length can hand in the very bytes it
+ * replies from; a full buffer starts over. */
+static bool xact_refill(void)
+{
+	if (xact.len >= xact.cap) {
+		xact.len = 0;
+		xact.pos = 0;
+	}
+	uint8_t got = regmap_read(xact.buf + xact.len, (uint8_t)(xact.cap - xact.len));
+	if (got == 0) {
+		xact.state = XACT_NO_DATA;
+		return false;
+	}
+	xact.len = (uint8_t)(xact.len + got);
+	return true;
+}
+
+bool xact_read_requested(uint8_t *buf, uint8_t cap)
+{
+	xact.state = XACT_READ;
+	xact.buf = buf;
+	xact.cap = cap;
+	xact.len = 0;
+	xact.pos = 0;
+	regmap_read_start();
+	return cap > 0 && xact_refill();
+}
+
+bool xact_read_processed(uint8_t *byte)
+{
+	if (xact.state != XACT_READ || (xact.pos >= xact.len && !xact_refill())) {
+		*byte = 0xFF;
+		return false;
+	}
+	*byte = xact.buf[xact.pos++];
+	return true;
+}
+
+bool xact_write_pending(void)
+{
+	return xact.state == XACT_DATA && xact.len > 0;
+}
+
+bool xact_read_buffered(void)
+{
+	return xact.state != XACT_READ || xact.pos < xact.len;
+}
+
+reg_status_t xact_frame_end(void)
+{
+	reg_status_t st = REG_OK;
+
+	if (xact.state == XACT_DATA && xact.len > 0) {
+		st = regmap_write(xact.buf, xact.len);
+	} else if (xact.state == XACT_REFUSED) {
+		st = (reg_status_t)xact.refusal;
+	}
+	xact.state = XACT_IDLE;
+	return st;
+}

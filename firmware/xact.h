@@ -1,0 +1,66 @@
+/*
+ * xact: register transactions one byte at a time (SPEC section 3), shared by
+ * both front ends. The serial gateway's local path and the TWI slave call the
+ * same five events, in the shape of Zephyr's I2C target callbacks:
+ *
+ *   xact_write_requested  a write frame begins (own address + W acknowledged)
+ *   xact_write_received   one byte of it: the register byte, then data
+ *   xact_read_requested   a read frame begins (own address + R acknowledged)
+ *   xact_read_processed   the next byte the master reads
+ *   xact_frame_end        repeated START or STOP: a write frame's data are
+ *                         delivered to the driver now, all or nothing
+ *
+ * The front end owns the bytes: it hands in the buffer a frame's data go to
+ * (a write's data wait there until the frame ends; a read's driver answers
+ * are put there). A driver is asked for read data only when the bytes it gave
+ * last are used up, so a read never moves a driver's cursor (introspection)
+ * further than the bytes the master really takes, give or take the rest of
+ * one answer.
+ *
+ * Pure register logic over regmap.h: compiled and fuzzed on the host too.
+ */
+#ifndef ORFA_XACT_H
+#define ORFA_XACT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "firmware/regmap.h"
+
+/* Forget any frame in progress (reset, bus error). */
+void xact_init(void);
+
+/* A write frame begins; its data may use `cap` bytes at `buf`. */
+void xact_write_requested(uint8_t *buf, uint8_t cap);
+
+/* One byte of the write frame. False: refused (a register byte no driver
+ * maps, data beyond `cap`, data for the status register); the frame then
+ * changes nothing and later bytes are refused too. The status register
+ * tells why. */
+bool xact_write_received(uint8_t byte);
+
+/* A read frame begins; driver answers go to `cap` bytes at `buf` (at least
+ * REGMAP_READ_MAX for a front end that does not know the read length).
+ * False when the selected register cannot be read (status tells). */
+bool xact_read_requested(uint8_t *buf, uint8_t cap);
+
+/* The next byte of the read frame. False, and *byte = 0xFF, when the
+ * register gives nothing (cannot be read). */
+bool xact_read_processed(uint8_t *byte);
+
+/* True when a write frame holds data that xact_frame_end() will deliver to
+ * a driver (a front end that must not call drivers from an interrupt defers
+ * that frame end). */
+bool xact_write_pending(void);
+
+/* True when xact_read_processed() can answer from the buffer, without asking
+ * a driver. */
+bool xact_read_buffered(void);
+
+/* The frame ends (repeated START or STOP). A write frame with data is
+ * delivered to its driver now: returns REG_OK, or why it was rejected (also
+ * for a frame refused byte by byte). Read frames and register selections
+ * return REG_OK. */
+reg_status_t xact_frame_end(void);
+
+#endif

@@ -1,0 +1,76 @@
+/*
+ * The I2C slave front end (MODE=slave): the TWI answers at ORFA_ADDR and
+ * slave_fsm.c decides; this file only moves its decisions into TWCR/TWDR.
+ * The interrupt does byte moves only; work that reaches a driver runs in
+ * front_poll() while TWINT stays set, so the TWI holds SCL low (clock
+ * stretching) and the master waits for it.
+ */
+#include "firmware/front.h"
+
+#include <avr/interrupt.h>
+#include <avr/io.h>
+#include <util/twi.h>
+
+#include "i2c_slave/slave_fsm.h"
+
+#ifndef ORFA_ADDR
+#error "ORFA_ADDR: the slave's 8-bit bus address (make ADDR=0x10)"
+#endif
+
+_Static_assert((ORFA_ADDR & 1) == 0, "ADDR is the 8-bit form: even");
+_Static_assert(ORFA_ADDR >= 0x10 && ORFA_ADDR < 0xF0, "ADDR is an I2C reserved address");
+
+/* Interrupt on, acknowledging: the TWI's resting state as a slave. */
+#define SLAVE_TWCR (_BV(TWEN) | _BV(TWIE) | _BV(TWEA))
+
+static volatile uint8_t slave_deferred;
+
+static void slave_apply(slave_action_t act, uint8_t byte)
+{
+	switch (act) {
+	case SLAVE_SEND:
+		TWDR = byte;
+		TWCR = _BV(TWINT) | SLAVE_TWCR;
+		break;
+	case SLAVE_NACK:
+		TWCR = _BV(TWINT) | _BV(TWEN) | _BV(TWIE);
+		break;
+	case SLAVE_DEFER:
+		/* TWINT not written: it stays set and SCL stays low. */
+		slave_deferred = 1;
+		TWCR = _BV(TWEN) | _BV(TWEA);
+		break;
+	case SLAVE_RECOVER:
+		TWCR = _BV(TWINT) | _BV(TWSTO) | SLAVE_TWCR;
+		break;
+	default:
+		TWCR = _BV(TWINT) | SLAVE_TWCR;
+		break;
+	}
+}
+
+ISR(TWI_vect)
+{
+	uint8_t byte = TWDR;
+	slave_action_t act = slave_fsm_event(TW_STATUS, &byte);
+	slave_apply(act, byte);
+}
+
+void front_init(void)
+{
+	slave_fsm_init();
+	TWAR = ORFA_ADDR;  /* TWGCE (bit 0) off: no general call */
+	TWCR = SLAVE_TWCR;
+}
+
+void front_poll(void)
+{
+	if (!slave_deferred) {
+		return;
+	}
+	/* The interrupt is off until slave_apply() turns it on again. */
+	slave_deferred = 0;
+	uint8_t byte = 0xFF;
+	slave_action_t act = slave_fsm_work(&byte);
+	slave_apply(act, byte);
+}

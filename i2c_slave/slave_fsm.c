@@ -1,0 +1,106 @@
+#include "i2c_slave/slave_fsm.h"
+
+#include <util/twi.h>
+
+#include "firmware/xact.h"
+
+typedef enum {
+	WORK_NONE = 0,
+	WORK_FRAME_END,   /* apply a write frame's data */
+	WORK_READ_START,  /* a read frame's first driver answer */
+	WORK_READ_MORE,   /* the driver's next answer */
+} slave_work_t;
+
+static struct {
+	uint8_t buf[SLAVE_BUF_SIZE];
+	uint8_t work;      /* slave_work_t deferred to the main loop */
+	uint8_t in_write;  /* a write frame is open (TW_SR_STOP ends it) */
+} slave;
+
+void slave_fsm_init(void)
+{
+	xact_init();
+	slave.work = WORK_NONE;
+	slave.in_write = 0;
+}
+
+static slave_action_t slave_defer(slave_work_t work)
+{
+	slave.work = work;
+	return SLAVE_DEFER;
+}
+
+/* Ends an open write frame: a write with data needs its driver (deferred);
+ * a bare register selection or a refused frame ends at once. */
+static slave_action_t slave_end_write(void)
+{
+	slave.in_write = 0;
+	if (xact_write_pending()) {
+		return slave_defer(WORK_FRAME_END);
+	}
+	xact_frame_end();
+	return SLAVE_ACK;
+}
+
+slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
+{
+	switch (status) {
+	case TW_SR_SLA_ACK:
+	case TW_SR_ARB_LOST_SLA_ACK:
+		xact_write_requested(slave.buf, sizeof slave.buf);
+		slave.in_write = 1;
+		return SLAVE_ACK;
+	case TW_SR_DATA_ACK:
+		return xact_write_received(*byte) ? SLAVE_ACK : SLAVE_NACK;
+	case TW_SR_DATA_NACK:
+		/* Refused byte: the TWI is no longer addressed, and no STOP
+		 * event will come for this frame. */
+		return slave_end_write();
+	case TW_SR_STOP:
+		if (slave.in_write) {
+			return slave_end_write();
+		}
+		xact_frame_end();
+		return SLAVE_ACK;
+	case TW_ST_SLA_ACK:
+	case TW_ST_ARB_LOST_SLA_ACK:
+		return slave_defer(WORK_READ_START);
+	case TW_ST_DATA_ACK:
+		if (!xact_read_buffered()) {
+			return slave_defer(WORK_READ_MORE);
+		}
+		xact_read_processed(byte);
+		return SLAVE_SEND;
+	case TW_ST_DATA_NACK:
+	case TW_ST_LAST_DATA:
+		xact_frame_end();
+		return SLAVE_ACK;
+	case TW_BUS_ERROR:
+		slave_fsm_init();
+		return SLAVE_RECOVER;
+	default:
+		/* General call is off (TWGCE = 0); nothing else is ours. */
+		return SLAVE_ACK;
+	}
+}
+
+slave_action_t slave_fsm_work(uint8_t *byte)
+{
+	slave_work_t work = (slave_work_t)slave.work;
+
+	slave.work = WORK_NONE;
+	switch (work) {
+	case WORK_FRAME_END:
+		xact_frame_end();
+		return SLAVE_ACK;
+	case WORK_READ_START:
+		xact_read_requested(slave.buf, sizeof slave.buf);
+		xact_read_processed(byte);
+		return SLAVE_SEND;
+	case WORK_READ_MORE:
+		xact_read_processed(byte);
+		return SLAVE_SEND;
+	default:
+		return SLAVE_ACK;
+	}
+}

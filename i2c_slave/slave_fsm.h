@@ -1,0 +1,49 @@
+/*
+ * The TWI slave's decisions (SPEC section 4), free of hardware: one call per
+ * TWI event with its status code (avr-libc's TW_* names), one action back
+ * for the thin interrupt layer in i2c_slave.c to put into TWCR/TWDR. Host
+ * unit tests drive it with status sequences as the AVR TWI produces them.
+ *
+ * What the hardware decides first, and what follows here:
+ *  - a received byte is acknowledged before its value is seen, so a refusal
+ *    (xact_write_received() false) clears TWEA: the byte AFTER it is not
+ *    acknowledged, and the status register tells;
+ *  - the own read address is always acknowledged: a register that cannot
+ *    be read sends FF bytes, and the status register tells;
+ *  - a write is applied when its frame ends (TW_SR_STOP: STOP or repeated
+ *    START), all or nothing; a rejection then is told by the status only.
+ *
+ * Work that calls a driver (applying a write, a driver's read answer) is
+ * never done in the interrupt: the event returns SLAVE_DEFER, TWINT stays
+ * set so the TWI stretches SCL, and the main loop calls slave_fsm_work().
+ * Everything else is a few byte moves.
+ */
+#ifndef SLAVE_FSM_H
+#define SLAVE_FSM_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* Bytes a write frame may carry and a driver may answer at once. */
+#define SLAVE_BUF_SIZE 64
+
+typedef enum {
+	SLAVE_ACK = 0,  /* clear TWINT with TWEA: acknowledge what comes next */
+	SLAVE_NACK,     /* clear TWINT without TWEA: refuse the next byte */
+	SLAVE_SEND,     /* TWDR = *byte, then clear TWINT with TWEA */
+	SLAVE_DEFER,    /* keep TWINT (SCL held low), turn the interrupt off;
+			 * the main loop calls slave_fsm_work() */
+	SLAVE_RECOVER,  /* bus error: TWSTO releases the lines, then as ACK */
+} slave_action_t;
+
+void slave_fsm_init(void);
+
+/* A TWI event: `status` is TW_STATUS; `*byte` holds TWDR for received
+ * data and receives the byte to send for SLAVE_SEND. */
+slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte);
+
+/* The deferred work of the last SLAVE_DEFER; returns SLAVE_ACK or
+ * SLAVE_SEND (with *byte) to release the bus with. */
+slave_action_t slave_fsm_work(uint8_t *byte);
+
+#endif

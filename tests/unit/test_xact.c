@@ -1,0 +1,344 @@
+/*
+ * The transaction module (firmware/xact.c) with this board's real drivers:
+ * byte-at-a-time frames as a TWI slave makes them (no read length known,
+ * a 64-byte buffer) must give exactly what the gateway's frames give (the
+ * read length known, the request's own bytes as the buffer), for random
+ * frame sequences; and the refusals SPEC section 4 describes land where it
+ * says.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <util/twi.h>
+
+#include "drv_test.h"
+#include "firmware/xact.h"
+#include "i2c_slave/slave_fsm.h"
+
+#define SLAVE_BUF 64
+
+typedef struct {
+	uint8_t reg;
+	uint8_t read;        /* read frame of n bytes, else write frame */
+	uint8_t n;           /* read count, or data bytes after the register */
+	uint8_t data[SLAVE_BUF];
+} frame_t;
+
+/* What a frame gave: acknowledges, bytes read, the result at its end. */
+typedef struct {
+	uint8_t acks;        /* bytes acknowledged, register byte included */
+	uint8_t got[SLAVE_BUF];
+	uint8_t ok;          /* read: register could be read */
+	uint8_t end;         /* xact_frame_end() */
+	uint8_t status;      /* the status register afterwards */
+} result_t;
+
+static uint8_t status_read(void)
+{
+	uint8_t buf[SLAVE_BUF], st = 0xEE;
+	xact_write_requested(buf, sizeof buf);
+	xact_write_received(REGMAP_STATUS_REG);
+	xact_frame_end();
+	xact_read_requested(buf, sizeof buf);
+	xact_read_processed(&st);
+	xact_frame_end();
+	return st;
+}
+
+/* The gateway's way (serialgate/sg_exec.c run_local): the frame's bytes are
+ * the buffer, the read length is known. A write frame is [reg][data], so its
+ * select is part of it; a read frame reads the selected register. */
+static void run_gateway(const frame_t *f, result_t *r)
+{
+	uint8_t bytes[1 + SLAVE_BUF];
+	memset(r, 0, sizeof *r);
+	if (f->read) {
+		r->ok = xact_read_requested(r->got, f->n);
+		for (uint8_t k = 0; k < f->n && r->ok; k++) {
+			r->ok = xact_read_processed(&r->got[k]);
+		}
+		if (!r->ok) {
+			memset(r->got, 0, sizeof r->got);
+		}
+	} else {
+		bytes[0] = f->reg;
+		memcpy(bytes + 1, f->data, f->n);
+		xact_write_requested(bytes + 1, f->n);
+		for (uint8_t k = 0; k <= f->n && xact_write_received(bytes[k]); k++) {
+			r->acks++;
+		}
+	}
+	r->end = xact_frame_end();
+	r->status = status_read();
+}
+
+/* The slave's way (i2c_slave/): its own 64-byte buffer, bytes one at a time
+ * with no length known; the master stops after n. */
+static void run_slave(const frame_t *f, result_t *r)
+{
+	static uint8_t buf[SLAVE_BUF];
+	memset(r, 0, sizeof *r);
+	if (f->read) {
+		r->ok = xact_read_requested(buf, sizeof buf);
+		for (uint8_t k = 0; k < f->n && r->ok; k++) {
+			r->ok = xact_read_processed(&r->got[k]);
+		}
+		if (!r->ok) {
+			memset(r->got, 0, sizeof r->got);
+		}
+	} else {
+		xact_write_requested(buf, sizeof buf);
+		if (xact_write_received(f->reg)) {
+			r->acks++;
+			for (uint8_t k = 0; k < f->n && xact_write_received(f->data[k]); k++) {
+				r->acks++;
+			}
+		}
+	}
+	r->end = xact_frame_end();
+	r->status = status_read();
+}
+
+/* The whole slave (i2c_slave/slave_fsm.c) under a model of the AVR TWI: the
+ * status codes the hardware gives for a master's frame, TWEA deciding the
+ * next byte's acknowledge, deferred work done as the main loop would. */
+static slave_action_t twi_event(uint8_t status, uint8_t *byte)
+{
+	slave_action_t act = slave_fsm_event(status, byte);
+	if (act == SLAVE_DEFER) {
+		act = slave_fsm_work(byte);
+	}
+	return act;
+}
+
+static void run_twi(const frame_t *f, result_t *r)
+{
+	uint8_t b = 0;
+	memset(r, 0, sizeof *r);
+	if (f->read) {
+		int sent_ok = twi_event(TW_ST_SLA_ACK, &b) == SLAVE_SEND;
+		r->got[0] = b;
+		for (uint8_t k = 1; k < f->n; k++) {
+			sent_ok &= twi_event(TW_ST_DATA_ACK, &b) == SLAVE_SEND;
+			r->got[k] = b;
+		}
+		sent_ok &= twi_event(TW_ST_DATA_NACK, &b) == SLAVE_ACK;
+		CHECK(sent_ok);
+		r->status = status_read();
+		r->ok = r->status != REG_NOT_READABLE;
+		if (!r->ok) {
+			/* SPEC 4: the read address is acknowledged anyway, FF */
+			for (uint8_t k = 0; k < f->n; k++) {
+				CHECK_EQ(r->got[k], 0xFF);
+			}
+			memset(r->got, 0, sizeof r->got);
+		}
+		return;
+	}
+	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	int twea = 1, addressed = 1;
+	for (uint8_t k = 0; k <= f->n && addressed; k++) {
+		b = k ? f->data[k - 1] : f->reg;
+		if (!twea) {
+			/* the byte after a refusal is not acknowledged, and the
+			 * TWI leaves the frame */
+			CHECK_EQ(twi_event(TW_SR_DATA_NACK, &b), SLAVE_ACK);
+			addressed = 0;
+			break;
+		}
+		twea = twi_event(TW_SR_DATA_ACK, &b) == SLAVE_ACK;
+		r->acks = (uint8_t)(r->acks + twea);
+	}
+	if (addressed) {
+		CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	}
+	r->status = status_read();
+}
+
+static uint32_t rng_state;
+
+static uint32_t rnd(uint32_t n)
+{
+	rng_state = rng_state * 1103515245u + 12345u;
+	return (rng_state >> 8) % n;
+}
+
+/* Mostly plausible frames for this board's registers, some garbage. */
+static void random_frame(frame_t *f)
+{
+	memset(f, 0, sizeof *f);
+	f->reg = (uint8_t)(rnd(4) ? rnd(B.nregs) : rnd(256));
+	f->read = (uint8_t)(rnd(2));
+	if (f->read) {
+		f->n = (uint8_t)(1 + (rnd(3) ? rnd(16) : rnd(SLAVE_BUF)));
+		return;
+	}
+	f->n = (uint8_t)(rnd(3) ? rnd(8) : rnd(SLAVE_BUF + 1));
+	for (uint8_t k = 0; k < f->n; k++) {
+		f->data[k] = (uint8_t)(rnd(3) ? rnd(4) : rnd(256));
+	}
+	if (f->reg == B.servo_sp && rnd(2)) {
+		/* whole triples: channel, width */
+		f->n = (uint8_t)(3 * (1 + rnd(5)));
+		for (uint8_t k = 0; k < f->n; k += 3) {
+			uint16_t w = (uint16_t)(rnd(3000));
+			f->data[k] = (uint8_t)rnd(B.servo_channels + 1);
+			f->data[k + 1] = (uint8_t)(w >> 8);
+			f->data[k + 2] = (uint8_t)w;
+		}
+	}
+}
+
+/* A read frame of the register written last needs it selected: run the
+ * select as a write frame of its own first, as both front ends would. */
+static void run_seq(const frame_t *seq, unsigned n, result_t *out,
+		    void (*run)(const frame_t *, result_t *))
+{
+	boot();
+	xact_init();
+	slave_fsm_init();
+	for (unsigned i = 0; i < n; i++) {
+		run(&seq[i], &out[i]);
+	}
+}
+
+static void test_equal_to_frames(void)
+{
+	enum { ROUNDS = 300, FRAMES = 40 };
+	static frame_t seq[FRAMES];
+	static result_t a[FRAMES], b[FRAMES], c[FRAMES];
+	int bad = 0;
+
+	rng_state = 12345;
+	for (int round = 0; round < ROUNDS; round++) {
+		for (unsigned i = 0; i < FRAMES; i++) {
+			random_frame(&seq[i]);
+		}
+		run_seq(seq, FRAMES, a, run_gateway);
+		run_seq(seq, FRAMES, b, run_slave);
+		run_seq(seq, FRAMES, c, run_twi);
+		for (unsigned i = 0; i < FRAMES && !bad; i++) {
+			if (memcmp(&a[i], &b[i], sizeof a[i]) != 0) {
+				printf("xact fuzz round %d frame %u (%s reg %02X n %u): gateway "
+				       "acks %u end %02X st %02X ok %u got %02X.., slave acks %u "
+				       "end %02X st %02X ok %u got %02X..\n",
+				       round, i, seq[i].read ? "read" : "write", seq[i].reg,
+				       seq[i].n, a[i].acks, a[i].end, a[i].status, a[i].ok,
+				       a[i].got[0], b[i].acks, b[i].end, b[i].status, b[i].ok,
+				       b[i].got[0]);
+				bad = 1;
+			}
+		}
+		for (unsigned i = 0; i < FRAMES && !bad; i++) {
+			a[i].end = 0;  /* the TWI run has no frame-end result: */
+			c[i].end = 0;  /* the status register carries it */
+			if (memcmp(&a[i], &c[i], sizeof a[i]) != 0) {
+				printf("twi fuzz round %d frame %u (%s reg %02X n %u): gateway acks %u "
+				       "st %02X ok %u, twi slave acks %u st %02X ok %u\n", round, i,
+				       seq[i].read ? "read" : "write", seq[i].reg, seq[i].n, a[i].acks,
+				       a[i].status, a[i].ok, c[i].acks, c[i].status, c[i].ok);
+				bad = 1;
+			}
+		}
+	}
+	CHECK(!bad);
+}
+
+static void test_refusals(void)
+{
+	uint8_t buf[4], byte;
+
+	boot();
+	xact_init();
+	/* An unmapped register byte: refused, so is the rest; status 08. */
+	xact_write_requested(buf, sizeof buf);
+	CHECK(!xact_write_received(B.nregs));
+	CHECK(!xact_write_received(0x00));
+	CHECK_EQ(xact_frame_end(), REG_NO_REGISTER);
+	CHECK_EQ(status_read(), REG_NO_REGISTER);
+	/* Data for the status register: the first data byte is refused. */
+	xact_write_requested(buf, sizeof buf);
+	CHECK(xact_write_received(REGMAP_STATUS_REG));
+	CHECK(!xact_write_received(0x00));
+	CHECK_EQ(xact_frame_end(), REG_NOT_WRITABLE);
+	CHECK_EQ(status_read(), REG_NOT_WRITABLE);
+	/* More data than the buffer: refused at the first byte beyond it,
+	 * and nothing applied (the servo SP write of two triples = 6 bytes). */
+	xact_write_requested(buf, sizeof buf);
+	CHECK(xact_write_received(B.servo_sp));
+	CHECK(xact_write_received(0x00));
+	CHECK(xact_write_received(0x05));
+	CHECK(xact_write_received(0xDC));
+	CHECK(xact_write_received(0x01));
+	CHECK(!xact_write_received(0x05));
+	CHECK_EQ(xact_frame_end(), REG_BAD_LENGTH);
+	READ(B.servo_sp, 4, "00 00 00 00");
+	/* A write the driver rejects at the frame's end: acknowledged byte by
+	 * byte, rejected at the end, status tells. */
+	xact_write_requested(buf, sizeof buf);
+	CHECK(xact_write_received(B.servo_sp));
+	CHECK(xact_write_received(B.servo_channels));
+	CHECK(xact_write_received(0x05));
+	CHECK(xact_write_received(0xDC));
+	CHECK_EQ(xact_frame_end(), REG_BAD_VALUE);
+	CHECK_EQ(status_read(), REG_BAD_VALUE);
+	/* A register that cannot be read (SPI DATA before any exchange):
+	 * nothing, FF bytes, status 05. */
+	xact_write_requested(buf, sizeof buf);
+	CHECK(xact_write_received(B.spi_data));
+	CHECK_EQ(xact_frame_end(), REG_OK);
+	xact_read_requested(buf, sizeof buf);
+	CHECK(!xact_read_processed(&byte));
+	CHECK_EQ(byte, 0xFF);
+	CHECK_EQ(xact_frame_end(), REG_OK);
+	CHECK_EQ(status_read(), REG_NOT_READABLE);
+	/* Bytes outside a frame: refused, FF. */
+	CHECK(!xact_write_received(0x00));
+	CHECK(!xact_read_processed(&byte));
+	CHECK_EQ(byte, 0xFF);
+}
+
+/* Introspection through a slave's buffer: the count stays, records move
+ * one per record given, never more than the master takes plus one. */
+static void test_intro_cursor(void)
+{
+	uint8_t buf[SLAVE_BUF], b, cnt;
+	boot();
+	xact_init();
+	xact_read_requested(buf, sizeof buf);
+	CHECK(xact_read_processed(&cnt));
+	CHECK_EQ(cnt, B.ndrivers);
+	CHECK(xact_read_processed(&b));
+	CHECK_EQ(b, B.ndrivers);
+	xact_frame_end();
+	xact_read_requested(buf, sizeof buf);
+	CHECK(xact_read_processed(&b));
+	CHECK_EQ(b, B.ndrivers);
+	xact_frame_end();
+	/* driver 2, 3 bytes of it; the next read starts at driver 3 */
+	uint8_t sel[1];
+	xact_write_requested(sel, sizeof sel);
+	xact_write_received(0x00);
+	xact_write_received(0x02);
+	CHECK_EQ(xact_frame_end(), REG_OK);
+	xact_read_requested(buf, sizeof buf);
+	for (int i = 0; i < 3; i++) {
+		xact_read_processed(&b);
+	}
+	xact_frame_end();
+	xact_read_requested(buf, sizeof buf);
+	uint8_t rec[6];
+	for (int i = 0; i < 6; i++) {
+		xact_read_processed(&rec[i]);
+	}
+	xact_frame_end();
+	CHECK_EQ(rec[4], 0x02 + B.gpio_nports * 2);  /* driver 3 = SPI starts after GPIO */
+}
+
+void xact_tests(void)
+{
+	test_refusals();
+	test_intro_cursor();
+	test_equal_to_frames();
+}
