@@ -2,6 +2,7 @@
 #
 #   make [BOARD=m32d|m128s] [MODE=gate|slave] [BAUD=115200] [ADDR=0x10] [DRIVERS="..."]
 #   make all-boards     every board and mode
+#   make robot          the slave boards of the simulated test robot
 #   make size           flash and static RAM of every build in build/
 #   make sim            build/sim/orfa-sim
 #   make unit           host-compiled unit tests of the parser and register logic
@@ -77,7 +78,7 @@ $(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 
-.PHONY: firmware all-boards size sim unit test bench demo clean setup
+.PHONY: firmware all-boards robot size sim unit test bench demo clean setup
 .DEFAULT_GOAL := firmware
 
 firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
@@ -99,6 +100,16 @@ $(BUILD)/orfa.hex: $(BUILD)/orfa.elf
 all-boards:
 	@set -e; for b in $(BOARDS); do for m in $(MODES); do \
 		$(MAKE) --no-print-directory BOARD=$$b MODE=$$m firmware; done; done
+
+# The slave boards of the simulated test robot (tests/sim, tools/bench.py):
+# BOARD:ADDR, each built into build/robot/<board>-<addr>/orfa.elf.
+ROBOT_SLAVES := m128s:0x10 m32d:0x12 m128s:0x14 m32d:0x16 m128s:0x18 m32d:0x1A \
+	m128s:0x1C m32d:0x1E
+
+robot:
+	@set -e; for s in $(ROBOT_SLAVES); do b=$${s%%:*}; a=$${s#*:}; \
+		$(MAKE) --no-print-directory BOARD=$$b MODE=slave ADDR=$$a \
+			BUILD=build/robot/$$b-$$a firmware; done
 
 size:
 	@tools/size.sh build
@@ -123,12 +134,12 @@ setup:
 	@tools/setup.sh
 
 test: setup
-	@$(MAKE) --no-print-directory all-boards sim
+	@$(MAKE) --no-print-directory all-boards robot sim
 	@$(MAKE) --no-print-directory unit
 	python3 -m pytest -q tests
 
 bench: setup
-	@$(MAKE) --no-print-directory all-boards sim
+	@$(MAKE) --no-print-directory all-boards robot sim
 	python3 tools/bench.py
 
 demo: setup
