@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "control.h"
+#include "srf08_ctl.h"
 
 #define CONTROL_OUT_MAX (4u << 20)
 #define CONTROL_MEASURE_DEFAULT 50
@@ -276,7 +277,8 @@ static void cmd_spi(control_t *c, reply_t *r)
 static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
-	"stack [FROM] | peek ADDR [LEN] | rx CYCLE HEX... | signals | help";
+	"stack [FROM] | peek ADDR [LEN] | rx CYCLE HEX... | signals | "
+	"srf08 ADDR [range MM [MM2] | light N] | help";
 
 int control_request(control_t *c, const char *line, char **out, size_t *len,
 		    size_t *cap, uint64_t *wait_until)
@@ -448,6 +450,11 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 		for (int i = 0; i < bm->signals.count; i++) {
 			rp(&r, "%s%s", i ? " " : "", bm->signals.sig[i]->name);
 		}
+	} else if (!strcasecmp(cmd, "srf08")) {
+		char text[256];
+
+		srf08_control(c->srf08, c->srf08_count, avr->cycle, argc, argv, text, sizeof(text));
+		rp(&r, "%s", text);
 	} else if (!strcasecmp(cmd, "help") && argc == 1) {
 		rp(&r, "%s", control_help);
 	} else {

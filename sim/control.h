@@ -16,6 +16,8 @@
 #include "board_model.h"
 #include "usart.h"
 
+struct srf08_t;
+
 #define CONTROL_CLIENTS 8
 #define CONTROL_LINE 1024
 
@@ -38,6 +40,8 @@ typedef struct control_t {
 	usart_t *usart;			/* the board's serial port (`rx`) */
 	control_client_t client[CONTROL_CLIENTS];
 	uint32_t activity;		/* bumps on every request */
+	struct srf08_t *srf08;		/* the --srf08 devices (`srf08`), set */
+	int srf08_count;		/* by main.c after control_open */
 } control_t;
 
 /* Listen on PATH (an existing socket file there is replaced). 0 or -1. */

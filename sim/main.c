@@ -31,9 +31,11 @@
 #include "twi_bus.h"
 #include "usart.h"
 #include "parts/eeprom24.h"
+#include "parts/srf08.h"
 
 #define SIM_FREQUENCY 7372800u
 #define SIM_MAX_EEPROMS 8
+#define SIM_MAX_SRF08 16	/* as many as it has addresses */
 #define SIM_BATCH_CYCLES (SIM_FREQUENCY / 1000)	/* 1 ms simulated */
 #define SIM_IDLE_AFTER_S 0.5
 #define SIM_BOOT_MAX_CYCLES (SIM_FREQUENCY / 10)	/* 100 ms simulated */
@@ -50,6 +52,7 @@ typedef struct sim_t {
 	twi_bus_t bus;
 	twi_t twi;
 	eeprom24_t eeprom[SIM_MAX_EEPROMS];
+	srf08_t srf08[SIM_MAX_SRF08];
 	board_model_t bm;
 	control_t control;
 	int idle_throttle;
@@ -67,6 +70,7 @@ static void sim_usage(void)
 {
 	fprintf(stderr,
 		"usage: orfa-sim --board %s --link PATH [--eeprom ADDR[:wp]]...\n"
+		"                [--srf08 ADDR]...\n"
 		"                [--trace FILE] [--no-idle-throttle] [--control PATH]\n"
 		"                [--vcd FILE] [--spi KIND@PIN[:mode=N][:lsb]]...\n"
 		"                [--adc CH=MV]... [--avcc MV] [--aref MV] FIRMWARE.elf\n",
@@ -166,6 +170,8 @@ typedef struct sim_args_t {
 	uint8_t eeprom_addr[SIM_MAX_EEPROMS];
 	uint8_t eeprom_wp[SIM_MAX_EEPROMS];
 	int eeprom_count;
+	uint8_t srf08_addr[SIM_MAX_SRF08];
+	int srf08_count;
 	const char *spi[SIM_MAX_SPI];
 	int spi_count;
 	uint32_t adc_mv[8];
@@ -194,6 +200,7 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		{ "board", required_argument, NULL, 'b' },
 		{ "link", required_argument, NULL, 'l' },
 		{ "eeprom", required_argument, NULL, 'e' },
+		{ "srf08", required_argument, NULL, 'S' },
 		{ "trace", required_argument, NULL, 't' },
 		{ "no-idle-throttle", no_argument, NULL, 'n' },
 		{ "control", required_argument, NULL, 'c' },
@@ -252,6 +259,25 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 			args->eeprom_count++;
 			break;
 		}
+		case 'S': {
+			/* the 16 addresses an SRF08 can be set to: E0, E2 .. FE */
+			uint8_t a;
+
+			if (args->srf08_count == SIM_MAX_SRF08 || sim_parse_addr(optarg, &a) < 0 ||
+			    a < 0xE0) {
+				fprintf(stderr, "orfa-sim: bad or too many --srf08 '%s'"
+					" (0xE0, 0xE2 .. 0xFE)\n", optarg);
+				return 2;
+			}
+			for (int i = 0; i < args->srf08_count; i++) {
+				if (args->srf08_addr[i] == a) {
+					fprintf(stderr, "orfa-sim: two SRF08s at %s\n", optarg);
+					return 2;
+				}
+			}
+			args->srf08_addr[args->srf08_count++] = a;
+			break;
+		}
 		case 't':
 			args->trace = optarg;
 			break;
@@ -297,6 +323,15 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		default:
 			sim_usage();
 			return 2;
+		}
+	}
+	for (int i = 0; i < args->srf08_count; i++) {
+		for (int j = 0; j < args->eeprom_count; j++) {
+			if (args->srf08_addr[i] == args->eeprom_addr[j]) {
+				fprintf(stderr, "orfa-sim: an EEPROM and an SRF08 at 0x%02X\n",
+					args->srf08_addr[i]);
+				return 2;
+			}
 		}
 	}
 	if (!sim->board || !args->link || optind != argc - 1) {
@@ -346,6 +381,10 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 		sim->eeprom[i].write_protect = args->eeprom_wp[i];
 		twi_bus_attach(&sim->bus, &sim->eeprom[i].dev);
 	}
+	for (int i = 0; i < args->srf08_count; i++) {
+		srf08_init(&sim->srf08[i], args->srf08_addr[i], SIM_FREQUENCY, &sim->bus);
+		twi_bus_attach(&sim->bus, &sim->srf08[i].dev);
+	}
 	usart_init(&sim->usart, sim->avr, &sim->mcu->usart[sim->board->wiring->host_usart],
 		   &sim->trace, sim_to_host, &sim->pty);
 	twi_init(&sim->twi, sim->avr, &sim->mcu->twi, &sim->bus);
@@ -383,6 +422,8 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 			strerror(errno));
 		return 2;
 	}
+	sim->control.srf08 = sim->srf08;	/* control_open clears control_t */
+	sim->control.srf08_count = args->srf08_count;
 	sim->reset_watch.kind = "orfa-reset";
 	sim->reset_watch.reset = sim_reset_hook;
 	mcu_register_io_last(sim->avr, &sim->reset_watch);

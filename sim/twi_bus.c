@@ -13,6 +13,7 @@ void twi_bus_init(twi_bus_t *bus, trace_t *trace)
 	bus->busy = 0;
 	bus->trace = trace;
 	bus->activity = 0;
+	bus->now = 0;
 }
 
 void twi_bus_attach(twi_bus_t *bus, twi_dev_t *dev)
@@ -37,6 +38,7 @@ void twi_bus_start(twi_bus_t *bus, uint64_t cycle)
 int twi_bus_address(twi_bus_t *bus, uint64_t cycle, uint8_t addr8)
 {
 	bus->selected = NULL;
+	bus->now = cycle;
 	for (twi_dev_t *d = bus->devs; d; d = d->next) {
 		if (d->ops->start(d, addr8) && !bus->selected) {
 			bus->selected = d;
@@ -50,6 +52,7 @@ int twi_bus_address(twi_bus_t *bus, uint64_t cycle, uint8_t addr8)
 
 int twi_bus_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte)
 {
+	bus->now = cycle;
 	int ack = bus->selected ? bus->selected->ops->write(bus->selected, byte) : 0;
 
 	bus->activity++;
@@ -61,6 +64,7 @@ uint8_t twi_bus_read(twi_bus_t *bus, uint64_t cycle, int master_acks)
 {
 	uint8_t byte = 0xff;
 
+	bus->now = cycle;
 	if (bus->selected) {
 		byte = bus->selected->ops->read(bus->selected, master_acks);
 	}
@@ -72,6 +76,7 @@ uint8_t twi_bus_read(twi_bus_t *bus, uint64_t cycle, int master_acks)
 
 void twi_bus_stop(twi_bus_t *bus, uint64_t cycle)
 {
+	bus->now = cycle;
 	for (twi_dev_t *d = bus->devs; d; d = d->next) {
 		d->ops->stop(d);
 	}

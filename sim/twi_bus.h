@@ -43,6 +43,8 @@ typedef struct twi_bus_t {
 	int busy;		/* between START and STOP */
 	trace_t *trace;
 	uint32_t activity;	/* bumps on every bus event */
+	uint64_t now;		/* cycle of the event being delivered, for
+				 * devices that keep time (SRF08 ranging) */
 } twi_bus_t;
 
 void twi_bus_init(twi_bus_t *bus, trace_t *trace);

@@ -70,7 +70,9 @@ class SimBoard:
     Gateway); `.trace_path` the trace file (if trace=True). With control=True
     `.control` is a SimControl on the board's control socket; vcd=True writes
     `.vcd_path`; spi=["eeprom25@B4", "mcp3008@B3:mode=0"], adc={0: 1000},
-    avcc/aref (mV) set the board's SPI devices and analog inputs.
+    avcc/aref (mV) set the board's SPI devices and analog inputs; srf08=[0xE0]
+    puts SRF08 range finders on the I2C bus (their `srf08` control request
+    sets what they sense).
     """
 
     def __init__(self, board: str = "m32d", eeproms: Sequence[int] = (),
@@ -78,11 +80,12 @@ class SimBoard:
                  start_timeout: float = 15.0, extra_args: Sequence[str] = (),
                  control: bool = False, vcd: bool = False, spi: Sequence[str] = (),
                  adc: Optional[Dict[int, int]] = None, avcc: Optional[int] = None,
-                 aref: Optional[int] = None):
+                 aref: Optional[int] = None, srf08: Sequence[int] = ()):
         if board not in BOARDS:
             raise ValueError("board must be one of %s" % (BOARDS,))
         self.board = board
         self.eeproms = tuple(eeproms)
+        self.srf08 = tuple(srf08)
         self.firmware = Path(firmware) if firmware else firmware_path(board)
         self.start_timeout = start_timeout
         self.extra_args = tuple(extra_args)
@@ -107,6 +110,8 @@ class SimBoard:
         cmd = [str(sim_path()), "--board", self.board, "--link", self.port]
         for addr in self.eeproms:
             cmd += ["--eeprom", "0x%02X" % addr]
+        for addr in self.srf08:
+            cmd += ["--srf08", "0x%02X" % addr]
         if self.trace_path is not None:
             cmd += ["--trace", str(self.trace_path)]
         if self.control_path is not None:

@@ -157,3 +157,21 @@ class SimControl:
     def peek(self, addr: int, n: int = 1) -> bytes:
         """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
         return bytes.fromhex(self.request("peek %d %d" % (addr, n)))
+
+    def srf08_range(self, addr: int, mm: int, mm2: Optional[int] = None) -> None:
+        """What the SRF08 at 8-bit address `addr` sees at its next ping: a
+        target `mm` millimetres away (0: none), optionally a second one."""
+        self.request("srf08 %02X range %d" % (addr, mm) +
+                     ("" if mm2 is None else " %d" % mm2))
+
+    def srf08_light(self, addr: int, level: int) -> None:
+        """The light level (0..255) its sensor reads at the next ping."""
+        self.request("srf08 %02X light %d" % (addr, level))
+
+    def srf08(self, addr: int) -> Dict[str, object]:
+        """Its state: {"addr", "range": (mm, mm2), "light", "gain",
+        "rangereg", "busy", "rangings"}."""
+        w = self.request("srf08 %02X" % addr).split()
+        return {"addr": int(w[1], 16), "range": (int(w[3]), int(w[4])),
+                "light": int(w[6]), "gain": int(w[8]), "rangereg": int(w[10]),
+                "busy": int(w[12]), "rangings": int(w[14])}
