@@ -27,6 +27,9 @@ include boards/$(BOARD)/board.mk
 # the 7-bit addresses I2C reserves (8-bit 0x00-0x0F and 0xF0-0xFE).
 ifeq ($(MODE),slave)
 ADDR_NUM := $(shell v=$$(printf '%d' '$(ADDR)' 2>/dev/null) && echo $$v)
+ifeq ($(strip $(ADDR)),)
+ADDR_NUM :=
+endif
 ifeq ($(ADDR_NUM),)
 $(error ADDR=$(ADDR) is not a number: give the 8-bit bus address, e.g. ADDR=0x10)
 endif

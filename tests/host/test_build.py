@@ -1,0 +1,41 @@
+"""The build's own checks: a slave's bus address (SPEC section 4), the mode."""
+
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def make(*args, tmp_path):
+    return subprocess.run(["make", "--no-print-directory", "-n", "BUILD=%s" % tmp_path] + list(args),
+                          cwd=ROOT, capture_output=True, text=True, timeout=60)
+
+
+@pytest.mark.parametrize("addr,why", [
+    ("0x11", "is odd"), ("0xFF", "is odd"), ("0x00", "reserved"), ("0x0E", "reserved"),
+    ("0xF0", "reserved"), ("0xFE", "reserved"), ("0x100", "not an 8-bit"),
+    ("foo", "not a number"), ("", "not a number"),
+])
+@pytest.mark.parametrize("board", ["m32d", "m128s"])
+def test_bad_slave_address_stops_the_build(board, addr, why, tmp_path):
+    r = make("BOARD=" + board, "MODE=slave", "ADDR=" + addr, tmp_path=tmp_path)
+    assert r.returncode != 0
+    assert why in r.stderr and "ADDR=" + addr in r.stderr, r.stderr
+    assert "avr-gcc" not in r.stdout        # stopped before compiling anything
+
+
+@pytest.mark.parametrize("addr", ["0x10", "0x12", "0xEE", "16"])
+def test_good_slave_address_builds(addr, tmp_path):
+    r = make("BOARD=m32d", "MODE=slave", "ADDR=" + addr, tmp_path=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "i2c_slave/i2c_slave.c" in r.stdout and "serialgate" not in r.stdout
+    assert "firmware/uart.c" not in r.stdout   # the slave has no serial port
+
+
+def test_unknown_mode_and_board(tmp_path):
+    r = make("MODE=master", tmp_path=tmp_path)
+    assert r.returncode != 0 and "MODE=master" in r.stderr
+    r = make("BOARD=m64", tmp_path=tmp_path)
+    assert r.returncode != 0 and "BOARD=m64" in r.stderr
