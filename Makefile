@@ -60,7 +60,9 @@ FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) -DORFA_BAUD=$(BAUD) \
 	-std=gnu99 $(FW_OPT) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
 	-fshort-enums -I. -Iboards/$(BOARD) \
 	'-DORFA_DRIVER_LIST=$(foreach d,$(DRIVERS),X($(d)))'
-FW_LDFLAGS := -mmcu=$(BOARD_MCU) $(FW_OPT) -flto -Wl,--gc-sections
+# -mrelax: the linker turns calls and jumps within reach into rcall/rjmp
+# (about 200 bytes less on the M32-D gateway).
+FW_LDFLAGS := -mmcu=$(BOARD_MCU) $(FW_OPT) -flto -mrelax -Wl,--gc-sections
 
 # Each driver's hardware part, where it has one.
 DRV_HW_spi := drivers/spi_hw.c
@@ -92,10 +94,10 @@ $(BUILD)/%.o: %.c $(BUILD)/flags
 
 # Rebuild when the configuration changes (DRIVERS, BAUD, ADDR).
 $(BUILD)/flags: FORCE
-	$(shell mkdir -p $(BUILD))$(file >$@.new,$(FW_CFLAGS))@cmp -s $@.new $@ || mv $@.new $@
+	$(shell mkdir -p $(BUILD))$(file >$@.new,$(FW_CFLAGS) $(FW_LDFLAGS))@cmp -s $@.new $@ || mv $@.new $@
 
-$(BUILD)/orfa.elf: $(FW_OBJ)
-	$(CC) $(FW_LDFLAGS) $^ -o $@
+$(BUILD)/orfa.elf: $(FW_OBJ) $(BUILD)/flags
+	$(CC) $(FW_LDFLAGS) $(FW_OBJ) -o $@
 
 $(BUILD)/orfa.hex: $(BUILD)/orfa.elf
 	$(OBJCOPY) -O ihex -R .eeprom $< $@
