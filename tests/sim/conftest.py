@@ -7,6 +7,7 @@ sees another's state. Each simulator has its own temp dir and link path.
 """
 
 import time
+from pathlib import Path
 
 import pytest
 
@@ -14,6 +15,7 @@ from orfa import protocol as p
 from orfa.gateway import Gateway
 from orfa.sim import BOARDS, BUILD_HINT, SimBoard, missing_builds
 
+ROOT = Path(__file__).resolve().parents[2]
 EEPROM = 0xA0
 EEPROM_WP = 0xA6         # write-protected 24C02: acknowledges its address and
                          # the word address, not the data bytes
@@ -31,13 +33,15 @@ def require_builds(boards=BOARDS):
 class Bench:
     """A running simulated board, the open serial port, and helpers."""
 
-    def __init__(self, sim: SimBoard):
+    def __init__(self, sim: SimBoard, gw: Gateway = None):
         self.sim = sim
         self.board = sim.board
-        self.gw = Gateway(sim.port, timeout=REPLY_TIMEOUT)
+        self.own_gw = gw is None
+        self.gw = gw if gw is not None else Gateway(sim.port, timeout=REPLY_TIMEOUT)
 
     def close(self):
-        self.gw.close()
+        if self.own_gw:
+            self.gw.close()
 
     # --- raw bytes ------------------------------------------------------------
     def read_lines(self, count: int, timeout: float = REPLY_TIMEOUT) -> bytes:
@@ -203,33 +207,84 @@ def us_to_cycles(us: float) -> float:
 
 
 class DrvBench(Bench):
-    """A Bench with the simulator's control socket and register helpers."""
+    """A Bench with the simulator's control socket and register helpers,
+    aimed at one board's drivers: the gateway's own (local address AA), or
+    a slave board's at its bus address (`addr`), through the gateway. The
+    helpers and `ctl` (pins, analog inputs, SPI log) then reach that board,
+    so a driver test runs unchanged against either."""
 
-    def __init__(self, sim: SimBoard):
-        super().__init__(sim)
-        self.ctl = sim.control
-        self.lay = DRV_LAYOUT[sim.board]
+    def __init__(self, sim: SimBoard, board: str = None, addr: int = None,
+                 gw: Gateway = None):
+        super().__init__(sim, gw)
+        self.board = board or sim.board
+        self.slave = addr is not None
+        self.addr = addr if self.slave else 0xAA
+        #: the write and read address as the protocol writes them: "AA", "AB"
+        self.wa = "%02X" % self.addr
+        self.ra = "%02X" % (self.addr | 1)
+        self.ctl = sim.control.slave(addr) if self.slave else sim.control
+        self.lay = DRV_LAYOUT[self.board]
         self.driven = set()
 
     # --- registers ------------------------------------------------------------
+    def req(self, text: str) -> str:
+        """A request written for the local address, aimed at this board:
+        "S AA 02 S AB 01 P" -> "S 12 02 S 13 01 P" on the slave at 0x12."""
+        return text.replace("AA", self.wa).replace("AB", self.ra)
+
+    def driver_count(self) -> int:
+        reply = self.ask(self.req("S AA 00 00 S AB 01 P"))
+        assert reply[:6] == b"SWAASR" and reply[8:] == b"P\r\n", reply
+        return int(reply[6:8], 16)
+
+    def record(self, n: int) -> bytes:
+        reply = self.ask(self.req("S AA 00 %02X S AB 06 P" % n))
+        assert reply[:6] == b"SWAASR" and reply[18:] == b"P\r\n", (n, reply)
+        return bytes.fromhex(reply[6:18].decode())
+
+    def status(self) -> int:
+        reply = self.ask(self.req("S AA 01 S AB 01 P"))
+        assert reply[:5] == b"SWASR" and reply[7:] == b"P\r\n", reply
+        return int(reply[5:7], 16)
+
     def wr(self, reg: int, data: bytes = b"") -> None:
         """A register write the driver must accept."""
         data = bytes(data)
-        req = "SAA%02X%sP" % (reg, data.hex().upper())
+        req = "S%s%02X%sP" % (self.wa, reg, data.hex().upper())
         reply = self.ask(req)
         assert reply == b"SW" + b"A" * (1 + len(data)) + b"P\r\n", (req, reply)
+        if self.slave:
+            # a slave acknowledges before its driver decides: ask it
+            assert self.status() == 0, req
 
     def wr_refused(self, reg: int, data: bytes, status: int) -> None:
-        """A register write the driver must reject with `status`."""
+        """A register write the driver must reject with `status`: the gateway
+        replies ERROR 07 for its own drivers; a slave applies a write when
+        the frame ends, after every byte was acknowledged (SPEC section 4),
+        so there only the status register tells (docs/registers.md)."""
         data = bytes(data)
-        req = "SAA%02X%sP" % (reg, data.hex().upper())
+        req = "S%s%02X%sP" % (self.wa, reg, data.hex().upper())
         reply = self.ask(req)
-        assert reply == b"ERROR 07\r\n", (req, reply)
+        if self.slave:
+            assert reply == b"SW" + b"A" * (1 + len(data)) + b"P\r\n", (req, reply)
+        else:
+            assert reply == b"ERROR 07\r\n", (req, reply)
         assert self.status() == status, req
+
+    def unreadable(self, reg: int, count: int = 1) -> None:
+        """A register that cannot be read: the gateway refuses the read
+        (ERROR 06); a slave acknowledges its read address anyway and sends
+        FF (SPEC section 4). The status register says 05 either way."""
+        reply = self.ask(self.req("S AA %02X S AB %02X P" % (reg, count)))
+        if self.slave:
+            assert reply == b"SWASR" + b"FF" * count + b"P\r\n", reply
+        else:
+            assert reply == b"ERROR 06\r\n", reply
+        assert self.status() == 0x05
 
     def rd(self, reg: int, count: int) -> bytes:
         """Select `reg`, read `count` bytes; the reply must be a good one."""
-        req = "S AA %02X S AB %02X P" % (reg, count)
+        req = "S %s %02X S %s %02X P" % (self.wa, reg, self.ra, count)
         reply = self.ask(req)
         assert reply[:5] == b"SWASR" and reply[-3:] == b"P\r\n", (req, reply)
         data = bytes.fromhex(reply[5:-3].decode())
@@ -300,18 +355,63 @@ class DrvBench(Bench):
             self.wr(lay["gpio_val"] + i, b"\x00\xff")
 
 
+#: Where the driver suites run: each board's own drivers behind its gateway
+#: (the local address AA), and each board as a slave of an M32-D gateway at
+#: its bus address ("m128s@10": the M128-S slave at 0x10). The slaves are the
+#: test robot's (Makefile `robot`: build/robot/<board>-<addr>/orfa.elf).
+SLAVE_ADDR = {"m128s": 0x10, "m32d": 0x12}
+DRV_TARGETS = list(BOARDS) + ["%s@%02X" % (b, SLAVE_ADDR[b]) for b in BOARDS]
+GATEWAY_OF_SLAVES = "m32d"
+
+
+def target(name: str):
+    """"m128s@10" -> ("m128s", 0x10); "m32d" -> ("m32d", None)."""
+    board, _, addr = name.partition("@")
+    return board, (int(addr, 16) if addr else None)
+
+
+def slave_firmware(board: str, addr: int) -> Path:
+    return ROOT / "build" / "robot" / ("%s-0x%02X" % (board, addr)) / "orfa.elf"
+
+
+def require_slave(board: str, addr: int) -> Path:
+    elf = slave_firmware(board, addr)
+    if not elf.is_file():
+        pytest.fail("missing %s: build the test robot with `make robot`" % elf, pytrace=False)
+    return elf
+
+
 #: Simulator options of the driver test modules: a module sets
 #: `DRV_SIM_OPTIONS = {"m32d": {...}, "m128s": {...}}` (SimBoard keyword
 #: arguments such as spi=[...], adc={...}, aref=...) and
-#: `DRV_BOARDS = ("m32d",)` to run on some boards only.
+#: `DRV_BOARDS = ("m32d",)` to run on some boards only; `DRV_LOCAL_ONLY =
+#: True` keeps a module on the gateways' own drivers.
 @pytest.fixture(scope="module")
 def drv_sim(request):
-    board_name = request.param
-    require_builds([board_name])
-    options = getattr(request.module, "DRV_SIM_OPTIONS", {}).get(board_name, {})
-    sim = SimBoard(board_name, trace=True, control=True, **options)
+    board_name, addr = target(request.param)
+    options = dict(getattr(request.module, "DRV_SIM_OPTIONS", {}).get(board_name, {}))
+    if addr is None:
+        require_builds([board_name])
+        sim = SimBoard(board_name, trace=True, control=True, **options)
+    else:
+        require_builds([GATEWAY_OF_SLAVES])
+        elf = require_slave(board_name, addr)
+        # the target board's devices and inputs go to the slave
+        slave_opts = {k: options.pop(k) for k in ("spi",) if k in options}
+        sim = SimBoard(GATEWAY_OF_SLAVES, trace=True, control=True,
+                       slaves=[(board_name, addr, elf)],
+                       extra_args=tuple(a for spec in slave_opts.get("spi", [])
+                                        for a in ("--spi", "%02X/%s" % (addr, spec))))
     sim.start()
-    b = DrvBench(sim)
+    b = DrvBench(sim, board_name, addr)
+    if addr is not None:
+        analog = options
+        for ch, mv in sorted(analog.get("adc", {}).items()):
+            b.ctl.adc(ch, mv)
+        if analog.get("avcc") is not None:
+            b.ctl.avcc(analog["avcc"])
+        if analog.get("aref") is not None:
+            b.ctl.aref(analog["aref"])
     try:
         yield b
     finally:
@@ -323,7 +423,10 @@ def drv_sim(request):
 def pytest_generate_tests(metafunc):
     if "drv_sim" in metafunc.fixturenames:
         boards = getattr(metafunc.module, "DRV_BOARDS", BOARDS)
-        metafunc.parametrize("drv_sim", boards, indirect=True, scope="module")
+        local_only = getattr(metafunc.module, "DRV_LOCAL_ONLY", False)
+        targets = [t for t in DRV_TARGETS
+                   if target(t)[0] in boards and not (local_only and "@" in t)]
+        metafunc.parametrize("drv_sim", targets, indirect=True, scope="module")
 
 
 @pytest.fixture

@@ -56,15 +56,15 @@ RESET_DDR = {
 
 def test_introspection_lists_exactly_the_boards_drivers(drv):
     want = [record_bytes(r) for r in RECORDS[drv.board]]
-    assert drv.ask("S AA 00 00 S AB 01 P") == b"SWAASR%02XP\r\n" % len(want)
+    assert drv.ask(drv.req("S AA 00 00 S AB 01 P")) == b"SWAASR%02XP\r\n" % len(want)
     for n, rec in enumerate(want, 1):
-        assert drv.ask("S AA 00 %02X S AB 06 P" % n) == (
+        assert drv.ask(drv.req("S AA 00 %02X S AB 06 P" % n)) == (
             b"SWAASR" + rec.hex().upper().encode() + b"P\r\n"), n
     # all of them in one read, then driver 1 again
     allrec = b"".join(want) + want[0]
-    assert drv.ask("S AA 00 01 S AB %02X P" % len(allrec)) == (
+    assert drv.ask(drv.req("S AA 00 01 S AB %02X P" % len(allrec))) == (
         b"SWAASR" + allrec.hex().upper().encode() + b"P\r\n")
-    assert drv.ask("S AA 00 %02X P" % (len(want) + 1)) == b"ERROR 07\r\n"
+    drv.wr_refused(0x00, bytes([len(want) + 1]), 0x02)     # BAD_VALUE
 
 
 def test_servo_outputs_are_silent(drv):
@@ -129,8 +129,7 @@ def test_spi_pins_and_config(drv):
 
 
 def test_spi_data_unreadable_before_any_exchange(drv):
-    assert drv.ask("S AA %02X S AB 01 P" % drv.lay["spi"]) == b"ERROR 06\r\n"
-    assert drv.status() == 0x05                     # NOT_READABLE
+    drv.unreadable(drv.lay["spi"])                  # status 05 NOT_READABLE
 
 
 @pytest.mark.parametrize("channel", [0, 1, 2, 3])

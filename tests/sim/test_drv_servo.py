@@ -199,16 +199,16 @@ def load_requests(drv, count, w0):
     for i in range(count):
         k = i % 5
         if k == 0:
-            reqs.append(b"S AA %02X S AB 02 P" % sp(drv))
+            reqs.append(drv.req("S AA %02X S AB 02 P" % sp(drv)).encode())
             replies.append(b"SWASR%04XP\r\n" % w0)
         elif k == 1:
-            reqs.append(b"S AA %02X 00 %02X %02X P" % (sp(drv), w0 >> 8, w0 & 0xFF))
+            reqs.append(drv.req("S AA %02X 00 %02X %02X P" % (sp(drv), w0 >> 8, w0 & 0xFF)).encode())
             replies.append(b"SWAAAAP\r\n")
         elif k == 2:
-            reqs.append(b"S AA %02X 00 P" % rs(drv))
+            reqs.append(drv.req("S AA %02X 00 P" % rs(drv)).encode())
             replies.append(b"SWAAP\r\n")
         elif k == 3:
-            reqs.append(b"S AA %02X S AB 01 P" % lay["gpio_mode"])
+            reqs.append(drv.req("S AA %02X S AB 01 P" % lay["gpio_mode"]).encode())
             replies.append(None)
         else:
             reqs.append(b"V    ")

@@ -30,7 +30,7 @@ def layout(drv):
 def servo_write(drv, widths):
     sp = drv.lay["servo"] + 1
     body = "".join("%02X%04X" % (ch, us) for ch, us in widths.items())
-    return "SAA%02X%sP" % (sp, body), b"SW" + b"A" * (1 + 3 * len(widths)) + b"P\r\n"
+    return "S%s%02X%sP" % (drv.wa, sp, body), b"SW" + b"A" * (1 + 3 * len(widths)) + b"P\r\n"
 
 
 def garbage(rng):
@@ -70,7 +70,7 @@ def test_garbage_and_requests_with_every_driver_busy(drv):
                 chunk.append(req.encode())
                 expected.append(reply)
             elif kind < 0.85:
-                chunk.append(b"S AA %02X S AB 08 P" % (drv.lay["adc"] + 1))
+                chunk.append(drv.req("S AA %02X S AB 08 P" % (drv.lay["adc"] + 1)).encode())
                 expected.append(None)
             else:
                 chunk.append(b"V")
@@ -83,7 +83,7 @@ def test_garbage_and_requests_with_every_driver_busy(drv):
             assert reply.endswith(b"\r\n"), (line, reply)
             if want is not None:
                 assert reply == want, (line, reply)
-            elif line.startswith(b"S AA"):
+            elif line.startswith(drv.req("S AA").encode()):
                 assert reply.startswith(b"SWASR") and len(reply) == 5 + 16 + 3, (line, reply)
         lines += len(chunk)
     assert drv.events(mark, ["reset"]) == []

@@ -1,0 +1,31 @@
+/*
+ * isr_watch.h: how long an interrupt handler runs, in cycles, from the
+ * moment the CPU takes the vector to its RETI (simavr raises the vector's
+ * AVR_INT_IRQ_RUNNING with 1, then 0). Keeps the longest, the count and the
+ * total, for `make bench` (the slave's TWI interrupt) and the control
+ * request `isr`.
+ */
+#ifndef SIM_ISR_WATCH_H
+#define SIM_ISR_WATCH_H
+
+#include <stdint.h>
+
+#include "sim_avr.h"
+#include "sim_interrupts.h"
+
+typedef struct isr_watch_t {
+	avr_t *avr;
+	uint64_t entered;	/* cycle the running handler was entered at */
+	int inside;
+	uint64_t longest;	/* cycles */
+	uint64_t count;
+	uint64_t total;
+} isr_watch_t;
+
+/* Watch VECT's handler on AVR. */
+void isr_watch_init(isr_watch_t *w, avr_t *avr, avr_int_vector_t *vect);
+
+/* Forget what was measured (the counts start again). */
+void isr_watch_clear(isr_watch_t *w);
+
+#endif
