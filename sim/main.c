@@ -1,10 +1,11 @@
 /*
  * main.c: orfa-sim, an ORFA board under simavr 1.6 (docs/simulator.md).
  *
- * Single-threaded: avr_run() in batches of about a millisecond of simulated
- * time; between batches the pty is serviced, the idle throttle decides
- * whether to wait for wall time, and signals are noticed. The pty is never
- * serviced from cycle timers because a watchdog reset wipes them.
+ * Single-threaded: the world (world.h: the boards in lock-step, the bus)
+ * runs in batches of about a millisecond of simulated time; between batches
+ * the pty is serviced, the idle throttle decides whether to wait for wall
+ * time, and signals are noticed. The pty is never serviced from cycle
+ * timers because a watchdog reset wipes them.
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -19,38 +20,25 @@
 #include <time.h>
 
 #include "sim_avr.h"
-#include "sim_elf.h"
 
 #include "board.h"
-#include "board_model.h"
 #include "control.h"
-#include "mcu.h"
 #include "pty.h"
+#include "sim_board.h"
 #include "trace.h"
-#include "twi.h"
-#include "twi_bus.h"
-#include "usart.h"
-#include "parts/eeprom24.h"
+#include "world.h"
 
-#define SIM_FREQUENCY 7372800u
-#define SIM_MAX_EEPROMS 8
+#define SIM_MAX_EEPROMS WORLD_MAX_EEPROMS
 #define SIM_BATCH_CYCLES (SIM_FREQUENCY / 1000)	/* 1 ms simulated */
 #define SIM_IDLE_AFTER_S 0.5
 #define SIM_BOOT_MAX_CYCLES (SIM_FREQUENCY / 10)	/* 100 ms simulated */
 #define SIM_UCSRB_RXEN 0x10
 
 typedef struct sim_t {
-	const board_desc_t *board;
-	const mcu_desc_t *mcu;
-	avr_t *avr;
-	avr_io_t reset_watch;		/* traces "reset" on a watchdog reset */
-	trace_t trace;
+	const board_desc_t *board;	/* the gateway's */
+	world_t world;
+	sim_board_t gateway;
 	pty_t pty;
-	usart_t usart;
-	twi_bus_t bus;
-	twi_t twi;
-	eeprom24_t eeprom[SIM_MAX_EEPROMS];
-	board_model_t bm;
 	control_t control;
 	int idle_throttle;
 } sim_t;
@@ -71,31 +59,6 @@ static void sim_usage(void)
 		"                [--vcd FILE] [--spi KIND@PIN[:mode=N][:lsb]]...\n"
 		"                [--adc CH=MV]... [--avcc MV] [--aref MV] FIRMWARE.elf\n",
 		board_names());
-}
-
-/* simavr chatters on stdout (the ELF loader's "Loaded ..."); the contract
- * allows one line there. Errors go to stderr, the rest nowhere. */
-static void sim_logger(avr_t *avr, const int level, const char *fmt, va_list ap)
-{
-	(void)avr;
-	if (level <= LOG_ERROR) {
-		vfprintf(stderr, fmt, ap);
-	}
-}
-
-/* The firmware never sleeps; should it, simavr would usleep() to wall time.
- * Simulated time must not depend on wall time, so sleeping costs nothing. */
-static void sim_sleep(avr_t *avr, avr_cycle_count_t how_long)
-{
-	(void)avr;
-	(void)how_long;
-}
-
-static void sim_reset_hook(avr_io_t *io)
-{
-	sim_t *sim = (sim_t *)((char *)io - offsetof(sim_t, reset_watch));
-
-	trace_event(&sim->trace, io->avr->cycle, "reset");
 }
 
 static void sim_to_host(void *param, uint8_t byte)
@@ -123,31 +86,30 @@ static int sim_parse_addr(const char *s, uint8_t *out)
 	return 0;
 }
 
-/* Run about a millisecond of simulated time and hand the firmware's output
- * to the pty. 0, or 1 when the firmware crashed or stopped for good. */
+/* Run about a millisecond of simulated time and hand the gateway's output
+ * to the pty. 0, or 1 when a firmware crashed or stopped for good. */
 static int sim_batch(sim_t *sim)
 {
-	avr_cycle_count_t target = sim->avr->cycle + SIM_BATCH_CYCLES;
+	world_t *w = &sim->world;
+	uint64_t target = world_cycle(w) + SIM_BATCH_CYCLES;
 	uint64_t deadline = control_deadline(&sim->control);
-	int state = cpu_Running;
+	int rc;
 
 	/* a control client's `wait` ends near its cycle, not a batch later */
 	if (deadline < target) {
 		target = deadline;
 	}
-
-	while (sim->avr->cycle < target) {
-		state = avr_run(sim->avr);
-		if (state == cpu_Done || state == cpu_Crashed) {
-			break;
-		}
-	}
+	rc = world_run(w, target);
 	pty_flush(&sim->pty);
-	signals_vcd_flush(&sim->bm.signals, sim->avr->cycle, 0);
-	if (state == cpu_Done || state == cpu_Crashed) {
-		fprintf(stderr, "orfa-sim: firmware %s at pc 0x%04x, cycle %" PRIu64 "\n",
-			state == cpu_Crashed ? "crashed" : "stopped (sleep with interrupts off)",
-			sim->avr->pc, (uint64_t)sim->avr->cycle);
+	signals_vcd_flush(&sim->gateway.bm.signals, world_cycle(w), 0);
+	if (rc) {
+		sim_board_t *b = w->boards[w->dead];
+
+		fprintf(stderr, "orfa-sim: %s%sfirmware %s at pc 0x%04x, cycle %" PRIu64 "\n",
+			b->prefix, b->prefix[0] ? ": " : "",
+			w->dead_state == cpu_Crashed ? "crashed" :
+			"stopped (sleep with interrupts off)",
+			b->avr->pc, (uint64_t)b->avr->cycle);
 		return 1;
 	}
 	return 0;
@@ -155,8 +117,7 @@ static int sim_batch(sim_t *sim)
 
 static uint32_t sim_activity(const sim_t *sim)
 {
-	return sim->usart.activity + sim->bus.activity + sim->bm.spi.activity +
-	       sim->bm.activity + sim->control.activity;
+	return world_activity(&sim->world) + sim->control.activity;
 }
 
 #define SIM_MAX_SPI 8
@@ -307,54 +268,31 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 	return 0;
 }
 
-/* Load the firmware into a fresh MCU and wire up the board's parts. 0, or
- * the exit status. */
+/* Build the world: the bus and its EEPROMs, the gateway board with its
+ * options, the control socket. 0, or the exit status. */
 static int sim_build(sim_t *sim, const sim_args_t *args)
 {
-	elf_firmware_t fw;
+	world_t *w = &sim->world;
+	sim_board_t *gw = &sim->gateway;
+	int rc;
 
-	avr_global_logger_set(sim_logger);
-	memset(&fw, 0, sizeof(fw));
-	if (elf_read_firmware(args->firmware, &fw) != 0 || !fw.flash || !fw.flashsize) {
-		fprintf(stderr, "orfa-sim: cannot load firmware '%s'\n", args->firmware);
-		return 2;
-	}
-	sim->mcu = mcu_find(sim->board->mcu);
-	sim->avr = avr_make_mcu_by_name(sim->board->mcu);
-	if (!sim->mcu || !sim->avr) {
-		fprintf(stderr, "orfa-sim: simavr lacks MCU '%s'\n", sim->board->mcu);
-		return 2;
-	}
-	avr_init(sim->avr);
-	if (fw.flashsize > sim->avr->flashend + 1u) {
-		fprintf(stderr, "orfa-sim: '%s' does not fit the %s's flash\n",
-			args->firmware, sim->board->mcu);
-		return 2;
-	}
-	avr_load_firmware(sim->avr, &fw);
-	sim->avr->frequency = SIM_FREQUENCY;	/* our ELFs carry no .mmcu */
-	sim->avr->sleep = sim_sleep;
-
-	if (args->trace && trace_open(&sim->trace, args->trace) < 0) {
+	world_init(w);
+	if (args->trace && trace_open(&w->trace, args->trace) < 0) {
 		fprintf(stderr, "orfa-sim: cannot write trace '%s': %s\n",
 			args->trace, strerror(errno));
 		return 2;
 	}
-	twi_bus_init(&sim->bus, &sim->trace);
 	for (int i = 0; i < args->eeprom_count; i++) {
-		eeprom24_init(&sim->eeprom[i], args->eeprom_addr[i]);
-		sim->eeprom[i].write_protect = args->eeprom_wp[i];
-		twi_bus_attach(&sim->bus, &sim->eeprom[i].dev);
+		world_add_eeprom(w, args->eeprom_addr[i], args->eeprom_wp[i]);
 	}
-	usart_init(&sim->usart, sim->avr, &sim->mcu->usart[sim->board->wiring->host_usart],
-		   &sim->trace, sim_to_host, &sim->pty);
-	twi_init(&sim->twi, sim->avr, &sim->mcu->twi, &sim->bus);
-	if (board_model_init(&sim->bm, sim->avr, sim->board, sim->mcu, &sim->trace) < 0) {
-		fprintf(stderr, "orfa-sim: cannot build the %s board model\n", sim->board->name);
-		return 2;
+	rc = sim_board_init(gw, sim->board, args->firmware, 0, &w->bus, &w->trace,
+			    sim_to_host, &sim->pty);
+	if (rc) {
+		return rc;
 	}
+	w->boards[w->nboards++] = gw;
 	for (int i = 0; i < args->spi_count; i++) {
-		const char *err = board_model_add_spi(&sim->bm, args->spi[i]);
+		const char *err = board_model_add_spi(&gw->bm, args->spi[i]);
 
 		if (err) {
 			fprintf(stderr, "orfa-sim: bad --spi '%s': %s\n", args->spi[i], err);
@@ -363,29 +301,26 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	}
 	for (int ch = 0; ch < 8; ch++) {
 		if (args->adc_set & (1u << ch)) {
-			board_model_set_adc(&sim->bm, ch, args->adc_mv[ch]);
+			board_model_set_adc(&gw->bm, ch, args->adc_mv[ch]);
 		}
 	}
 	if (args->avcc) {
-		board_model_set_avcc(&sim->bm, args->avcc);
+		board_model_set_avcc(&gw->bm, args->avcc);
 	}
 	if (args->aref) {
-		board_model_set_aref(&sim->bm, args->aref);
+		board_model_set_aref(&gw->bm, args->aref);
 	}
-	if (args->vcd && signals_vcd_open(&sim->bm.signals, args->vcd, SIM_FREQUENCY) < 0) {
+	if (args->vcd && signals_vcd_open(&gw->bm.signals, args->vcd, SIM_FREQUENCY) < 0) {
 		fprintf(stderr, "orfa-sim: cannot write VCD '%s': %s\n", args->vcd, strerror(errno));
 		return 2;
 	}
 	sim->control.fd = -1;
 	if (args->control &&
-	    control_open(&sim->control, args->control, sim->avr, &sim->bm, &sim->usart) < 0) {
+	    control_open(&sim->control, args->control, gw->avr, &gw->bm, &gw->usart) < 0) {
 		fprintf(stderr, "orfa-sim: cannot listen on '%s': %s\n", args->control,
 			strerror(errno));
 		return 2;
 	}
-	sim->reset_watch.kind = "orfa-reset";
-	sim->reset_watch.reset = sim_reset_hook;
-	mcu_register_io_last(sim->avr, &sim->reset_watch);
 	return 0;
 }
 
@@ -405,7 +340,7 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 	uint32_t act = sim_activity(sim);
 
 	if (host_bytes || act != th->last_activity || control_waiting(&sim->control) ||
-	    usart_inject_pending(&sim->usart)) {
+	    usart_inject_pending(&sim->gateway.usart)) {
 		th->last_activity = act;
 		th->t_last_activity = now;
 		th->on = 0;
@@ -413,10 +348,10 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 		   now - th->t_last_activity > SIM_IDLE_AFTER_S) {
 		th->on = 1;
 		th->wall0 = now;
-		th->cycle0 = sim->avr->cycle;
+		th->cycle0 = world_cycle(&sim->world);
 	}
 	if (th->on) {
-		double ahead = (double)(sim->avr->cycle - th->cycle0) / SIM_FREQUENCY -
+		double ahead = (double)(world_cycle(&sim->world) - th->cycle0) / SIM_FREQUENCY -
 			       (now - th->wall0);
 		if (ahead > 0.0005) {
 			/* Wait for wall time, or for the PC or a control
@@ -442,27 +377,27 @@ static int sim_run(sim_t *sim)
 	th.t_last_activity = t_start;
 	while (!sim_stop && rc == 0) {
 		uint8_t buf[512];
-		size_t room = usart_host_room(&sim->usart);
+		size_t room = usart_host_room(&sim->gateway.usart);
 		size_t n = pty_read(&sim->pty, buf, room < sizeof(buf) ? room : sizeof(buf));
 
 		if (n) {
-			usart_host_send(&sim->usart, buf, n);
+			usart_host_send(&sim->gateway.usart, buf, n);
 		}
 		control_poll(&sim->control);
 		double t0 = sim_now();
-		avr_cycle_count_t c0 = sim->avr->cycle;
+		avr_cycle_count_t c0 = world_cycle(&sim->world);
 		rc = sim_batch(sim);
 		double now = sim_now();
 		if (!th.on) {
 			t_free += now - t0;
-			cyc_free += sim->avr->cycle - c0;
+			cyc_free += world_cycle(&sim->world) - c0;
 		}
 		control_poll(&sim->control);
 		sim_throttle(sim, &th, n != 0, now);
 	}
 	fprintf(stderr, "orfa-sim: %" PRIu64 " cycles in %.2f s wall;"
 		" running free %.1f simulated MHz per wall second (%.1fx real time)\n",
-		(uint64_t)sim->avr->cycle, sim_now() - t_start,
+		(uint64_t)world_cycle(&sim->world), sim_now() - t_start,
 		t_free > 0 ? cyc_free / t_free / 1e6 : 0.0,
 		t_free > 0 ? cyc_free / t_free / SIM_FREQUENCY : 0.0);
 	return rc;
@@ -496,8 +431,8 @@ int main(int argc, char **argv)
 	 * most SIM_BOOT_MAX_CYCLES) before the PC can reach the port, so a
 	 * first byte sent right after the link appears is not lost to a
 	 * board that is still initialising. */
-	while (!sim_stop && rc == 0 && sim.avr->cycle < SIM_BOOT_MAX_CYCLES &&
-	       !(sim.avr->data[sim.usart.regs->ucsrb] & SIM_UCSRB_RXEN)) {
+	while (!sim_stop && rc == 0 && world_cycle(&sim.world) < SIM_BOOT_MAX_CYCLES &&
+	       !(sim.gateway.avr->data[sim.gateway.usart.regs->ucsrb] & SIM_UCSRB_RXEN)) {
 		rc = sim_batch(&sim);
 	}
 	if (rc == 0 && !sim_stop) {
@@ -514,7 +449,7 @@ int main(int argc, char **argv)
 	}
 	pty_close(&sim.pty);
 	control_close(&sim.control);
-	signals_vcd_close(&sim.bm.signals, sim.avr->cycle);
-	trace_close(&sim.trace);
+	signals_vcd_close(&sim.gateway.bm.signals, world_cycle(&sim.world));
+	trace_close(&sim.world.trace);
 	return rc;
 }
