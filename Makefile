@@ -86,7 +86,12 @@ SIM_HDR := $(wildcard sim/*.h sim/parts/*.h boards/*/board.h)
 SIM_CFLAGS := -std=gnu99 -O2 -g -Wall -Wextra -Werror -I. -Isim -I/usr/include/simavr
 SIM_LIBS := -lsimavr -lelf -lutil -lpthread -lm
 
-sim: build/sim/orfa-sim
+sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf
+
+# Test firmware for the simulator's bus tests (tests/sim/fw), not ORFA.
+build/sim-fw/%.elf: tests/sim/fw/%.c
+	@mkdir -p $(dir $@)
+	avr-gcc -mmcu=atmega32 -DF_CPU=7372800UL -std=gnu99 -Os -Wall -Wextra -Werror $< -o $@
 
 build/sim/orfa-sim: $(SIM_SRC) $(SIM_HDR)
 	@mkdir -p $(dir $@)
