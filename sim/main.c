@@ -34,11 +34,16 @@
 #define SIM_BOOT_MAX_CYCLES (SIM_FREQUENCY / 10)	/* 100 ms simulated */
 #define SIM_UCSRB_RXEN 0x10
 
+#define SIM_MAX_SLAVES (WORLD_MAX_BOARDS - 1)
+
 typedef struct sim_t {
 	const board_desc_t *board;	/* the gateway's */
 	world_t world;
 	sim_board_t gateway;
+	sim_board_t slave[SIM_MAX_SLAVES];
+	int twar_checked[WORLD_MAX_BOARDS];	/* slave's TWAR compared with --slave */
 	pty_t pty;
+	vcd_t vcd;
 	control_t control;
 	int idle_throttle;
 } sim_t;
@@ -57,13 +62,52 @@ static void sim_usage(void)
 		"usage: orfa-sim --board %s --link PATH [--eeprom ADDR[:wp]]...\n"
 		"                [--trace FILE] [--no-idle-throttle] [--control PATH]\n"
 		"                [--vcd FILE] [--spi KIND@PIN[:mode=N][:lsb]]...\n"
-		"                [--adc CH=MV]... [--avcc MV] [--aref MV] FIRMWARE.elf\n",
-		board_names());
+		"                [--adc CH=MV]... [--avcc MV] [--aref MV]\n"
+		"                [--slave BOARD:ADDR:ELF]... GATEWAY.elf\n"
+		"\n"
+		"GATEWAY.elf runs on the --board board, whose serial port is the pty at\n"
+		"--link. Each --slave adds a board (%s) running ELF on the same\n"
+		"I2C bus; ADDR is its 8-bit address (0x10..0xEE, even): it names the\n"
+		"board's signals in the control interface (`10/servo3`, `@10`) and is\n"
+		"checked against the firmware's TWAR (the firmware decides). The\n"
+		"--spi/--adc/--avcc/--aref options set up the gateway board; the\n"
+		"control interface reaches every board. See docs/simulator.md.\n",
+		board_names(), board_names());
 }
 
 static void sim_to_host(void *param, uint8_t byte)
 {
 	pty_write(param, byte);
+}
+
+/* A slave board's serial port is not connected. */
+static void sim_discard(void *param, uint8_t byte)
+{
+	(void)param;
+	(void)byte;
+}
+
+/* Once a slave's firmware enables its TWI as a slave, say so on stderr if
+ * it answers at another address than its --slave: the firmware's TWAR
+ * decides, the option only names the board. */
+static void sim_check_twar(sim_t *sim)
+{
+	world_t *w = &sim->world;
+
+	for (int i = 1; i < w->nboards; i++) {
+		sim_board_t *b = w->boards[i];
+		uint8_t cr = b->avr->data[b->mcu->twi.twcr];
+		uint8_t twar = b->avr->data[b->mcu->twi.twar] & 0xfe;
+
+		if (sim->twar_checked[i] || !(cr & 0x04) || !(cr & 0x40)) {
+			continue;	/* TWEN and TWEA not both set yet */
+		}
+		sim->twar_checked[i] = 1;
+		if (twar != b->addr) {
+			fprintf(stderr, "orfa-sim: slave %s: its firmware answers at 0x%02X"
+				" (TWAR), not 0x%02X\n", b->prefix, twar, b->addr);
+		}
+	}
 }
 
 static double sim_now(void)
@@ -101,7 +145,8 @@ static int sim_batch(sim_t *sim)
 	}
 	rc = world_run(w, target);
 	pty_flush(&sim->pty);
-	signals_vcd_flush(&sim->gateway.bm.signals, world_cycle(w), 0);
+	sim_check_twar(sim);
+	vcd_flush(&sim->vcd, world_cycle(w), 0);
 	if (rc) {
 		sim_board_t *b = w->boards[w->dead];
 
@@ -132,7 +177,63 @@ typedef struct sim_args_t {
 	uint32_t adc_mv[8];
 	uint8_t adc_set;		/* bit per channel given */
 	uint32_t avcc, aref;		/* 0: default */
+	const board_desc_t *slave_board[SIM_MAX_SLAVES];
+	uint8_t slave_addr[SIM_MAX_SLAVES];
+	const char *slave_elf[SIM_MAX_SLAVES];
+	int slave_count;
 } sim_args_t;
+
+/* The I2C addresses SPEC section 4 reserves (8-bit 0x00-0x0F, 0xF0-0xFF). */
+static int sim_addr_reserved(uint8_t addr8)
+{
+	return addr8 < 0x10 || addr8 >= 0xf0;
+}
+
+/* --slave BOARD:ADDR:ELF. 0, or -1 after printing why. */
+static int sim_parse_slave(sim_args_t *args, const char *spec)
+{
+	char board[16], addr[16];
+	const char *c1 = strchr(spec, ':');
+	const char *c2 = c1 ? strchr(c1 + 1, ':') : NULL;
+	int n = args->slave_count;
+
+	if (!c1 || !c2 || c1 - spec >= (long)sizeof(board) || c2 - c1 - 1 >= (long)sizeof(addr) ||
+	    !c2[1]) {
+		fprintf(stderr, "orfa-sim: bad --slave '%s' (BOARD:ADDR:ELF, e.g."
+			" m128s:0x10:build/m128s-slave/orfa.elf)\n", spec);
+		return -1;
+	}
+	if (n == SIM_MAX_SLAVES) {
+		fprintf(stderr, "orfa-sim: too many --slave (at most %d)\n", SIM_MAX_SLAVES);
+		return -1;
+	}
+	memcpy(board, spec, (size_t)(c1 - spec));
+	board[c1 - spec] = 0;
+	memcpy(addr, c1 + 1, (size_t)(c2 - c1 - 1));
+	addr[c2 - c1 - 1] = 0;
+	args->slave_board[n] = board_find(board);
+	if (!args->slave_board[n]) {
+		fprintf(stderr, "orfa-sim: bad --slave '%s': unknown board '%s' (%s)\n", spec,
+			board, board_names());
+		return -1;
+	}
+	if (sim_parse_addr(addr, &args->slave_addr[n]) < 0 ||
+	    sim_addr_reserved(args->slave_addr[n])) {
+		fprintf(stderr, "orfa-sim: bad --slave '%s': ADDR must be an even 8-bit address"
+			" 0x10..0xEE like 0x10\n", spec);
+		return -1;
+	}
+	for (int i = 0; i < n; i++) {
+		if (args->slave_addr[i] == args->slave_addr[n]) {
+			fprintf(stderr, "orfa-sim: bad --slave '%s': two slaves at 0x%02X\n", spec,
+				args->slave_addr[n]);
+			return -1;
+		}
+	}
+	args->slave_elf[n] = c2 + 1;
+	args->slave_count++;
+	return 0;
+}
 
 /* "1234" millivolts, 0..100000. 0 or -1. */
 static int sim_parse_mv(const char *s, uint32_t *out)
@@ -163,6 +264,7 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		{ "adc", required_argument, NULL, 'a' },
 		{ "avcc", required_argument, NULL, 'V' },
 		{ "aref", required_argument, NULL, 'R' },
+		{ "slave", required_argument, NULL, 'S' },
 		{ "help", no_argument, NULL, 'h' },
 		{ NULL, 0, NULL, 0 },
 	};
@@ -252,6 +354,11 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 				return 2;
 			}
 			break;
+		case 'S':
+			if (sim_parse_slave(args, optarg) < 0) {
+				return 2;
+			}
+			break;
 		case 'h':
 			sim_usage();
 			exit(0);
@@ -264,8 +371,38 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		sim_usage();
 		return 2;
 	}
+	for (int i = 0; i < args->slave_count; i++) {
+		for (int k = 0; k < args->eeprom_count; k++) {
+			if (args->eeprom_addr[k] == args->slave_addr[i]) {
+				fprintf(stderr, "orfa-sim: --slave at 0x%02X and --eeprom at the"
+					" same address\n", args->slave_addr[i]);
+				return 2;
+			}
+		}
+	}
 	args->firmware = argv[optind];
 	return 0;
+}
+
+/* One VCD for every board: the gateway's signals in scope `board` under
+ * their own names, a slave's in scope `board_10` as `10/servo3`. */
+static int sim_open_vcd(sim_t *sim, const char *path)
+{
+	static char scope[WORLD_MAX_BOARDS][16], prefix[WORLD_MAX_BOARDS][8];
+	signals_t *sets[WORLD_MAX_BOARDS];
+	const char *scopes[WORLD_MAX_BOARDS], *prefixes[WORLD_MAX_BOARDS];
+	world_t *w = &sim->world;
+
+	for (int i = 0; i < w->nboards; i++) {
+		sim_board_t *b = w->boards[i];
+
+		snprintf(scope[i], sizeof(scope[i]), i ? "board_%s" : "board", b->prefix);
+		snprintf(prefix[i], sizeof(prefix[i]), i ? "%s/" : "", b->prefix);
+		sets[i] = &b->bm.signals;
+		scopes[i] = scope[i];
+		prefixes[i] = prefix[i];
+	}
+	return vcd_open(&sim->vcd, path, SIM_FREQUENCY, sets, scopes, prefixes, w->nboards);
 }
 
 /* Build the world: the bus and its EEPROMs, the gateway board with its
@@ -291,6 +428,14 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 		return rc;
 	}
 	w->boards[w->nboards++] = gw;
+	for (int i = 0; i < args->slave_count; i++) {
+		rc = sim_board_init(&sim->slave[i], args->slave_board[i], args->slave_elf[i],
+				    args->slave_addr[i], &w->bus, &w->trace, sim_discard, NULL);
+		if (rc) {
+			return rc;
+		}
+		w->boards[w->nboards++] = &sim->slave[i];
+	}
 	for (int i = 0; i < args->spi_count; i++) {
 		const char *err = board_model_add_spi(&gw->bm, args->spi[i]);
 
@@ -310,7 +455,7 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	if (args->aref) {
 		board_model_set_aref(&gw->bm, args->aref);
 	}
-	if (args->vcd && signals_vcd_open(&gw->bm.signals, args->vcd, SIM_FREQUENCY) < 0) {
+	if (args->vcd && sim_open_vcd(sim, args->vcd) < 0) {
 		fprintf(stderr, "orfa-sim: cannot write VCD '%s': %s\n", args->vcd, strerror(errno));
 		return 2;
 	}
@@ -320,6 +465,10 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 		fprintf(stderr, "orfa-sim: cannot listen on '%s': %s\n", args->control,
 			strerror(errno));
 		return 2;
+	}
+	for (int i = 1; i < w->nboards; i++) {
+		control_add_board(&sim->control, w->boards[i]->addr, w->boards[i]->avr,
+				  &w->boards[i]->bm);
 	}
 	return 0;
 }
@@ -395,11 +544,14 @@ static int sim_run(sim_t *sim)
 		control_poll(&sim->control);
 		sim_throttle(sim, &th, n != 0, now);
 	}
+	/* world cycles: with B boards the MCUs run B times as many */
 	fprintf(stderr, "orfa-sim: %" PRIu64 " cycles in %.2f s wall;"
-		" running free %.1f simulated MHz per wall second (%.1fx real time)\n",
+		" running free %.1f simulated MHz per wall second (%.1fx real time),"
+		" %d board%s\n",
 		(uint64_t)world_cycle(&sim->world), sim_now() - t_start,
 		t_free > 0 ? cyc_free / t_free / 1e6 : 0.0,
-		t_free > 0 ? cyc_free / t_free / SIM_FREQUENCY : 0.0);
+		t_free > 0 ? cyc_free / t_free / SIM_FREQUENCY : 0.0,
+		sim->world.nboards, sim->world.nboards == 1 ? "" : "s");
 	return rc;
 }
 
@@ -449,7 +601,7 @@ int main(int argc, char **argv)
 	}
 	pty_close(&sim.pty);
 	control_close(&sim.control);
-	signals_vcd_close(&sim.gateway.bm.signals, world_cycle(&sim.world));
+	vcd_close(&sim.vcd, world_cycle(&sim.world));
 	trace_close(&sim.world.trace);
 	return rc;
 }
