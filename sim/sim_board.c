@@ -39,6 +39,28 @@ static void sim_board_reset_hook(avr_io_t *io)
 	}
 }
 
+/* The firmware's main loops execute WDR all the time, and simavr turns
+ * every WDR into avr_ioctl(AVR_IOCTL_WATCHDOG_RESET), which asks each IO
+ * module in list order until one answers: 11-18% of a board's time went
+ * there (perf). With the watchdog first the walk ends at once. Only the
+ * order of the modules' reset hooks changes, and the watchdog's touches
+ * nothing another module owns. */
+static void sim_board_watchdog_first(avr_t *avr)
+{
+	avr_io_t **link = &avr->io_port;
+
+	while (*link && strcmp((*link)->kind, "watchdog") != 0) {
+		link = &(*link)->next;
+	}
+	if (*link && *link != avr->io_port) {
+		avr_io_t *wd = *link;
+
+		*link = wd->next;
+		wd->next = avr->io_port;
+		avr->io_port = wd;
+	}
+}
+
 int sim_board_init(sim_board_t *b, const board_desc_t *board, const char *elf,
 		   uint8_t addr, twi_bus_t *bus, trace_t *trace,
 		   usart_to_host_t to_host, void *to_host_param)
@@ -87,6 +109,7 @@ int sim_board_init(sim_board_t *b, const board_desc_t *board, const char *elf,
 	b->reset_watch.kind = "orfa-reset";
 	b->reset_watch.reset = sim_board_reset_hook;
 	mcu_register_io_last(b->avr, &b->reset_watch);
+	sim_board_watchdog_first(b->avr);
 	return 0;
 }
 
