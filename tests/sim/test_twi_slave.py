@@ -1,9 +1,10 @@
 """Several boards on one bus: the TWI slave model and clock stretching.
 
-A gateway board (m32d or m128s) and a slave board running the test firmware
-tests/sim/fw/twi_slave_echo.c (an interrupt-driven TWI slave at 0x20 that
+A gateway board (m32d or m128s) and two slave boards running the test
+firmware tests/sim/fw/twi_slave_echo.c (an interrupt-driven TWI slave that
 keeps what it is written and gives it back; it waits 1500 cycles with TWINT
-set before the first byte of every read), plus an EEPROM at 0xA0.
+set before the first byte of every read): an m32d at 0x20 and an m128s at
+0x22, plus an EEPROM at 0xA0.
 """
 
 import subprocess
@@ -17,6 +18,8 @@ from conftest import REPLY_TIMEOUT, require_builds
 
 ECHO_ELF = REPO_ROOT / "build" / "sim-fw" / "twi_slave_echo.elf"
 ECHO = 0x20
+ECHO128_ELF = REPO_ROOT / "build" / "sim-fw" / "twi_slave_echo_m128.elf"
+ECHO128 = 0x22
 ECHO_STRETCH = 1500
 #: TWBR/TWSR data addresses of the gateway's MCU (to compute the SCL period).
 TWI_REGS = {"m32d": (0x20, 0x21), "m128s": (0x70, 0x71)}
@@ -24,8 +27,9 @@ TWI_REGS = {"m32d": (0x20, 0x21), "m128s": (0x70, 0x71)}
 
 def require_echo():
     require_builds()
-    if not ECHO_ELF.is_file():
-        pytest.fail("missing %s: run `make sim`" % ECHO_ELF, pytrace=False)
+    for elf in (ECHO_ELF, ECHO128_ELF):
+        if not elf.is_file():
+            pytest.fail("missing %s: run `make sim`" % elf, pytrace=False)
 
 
 class Robot:
@@ -47,8 +51,9 @@ class Robot:
 @pytest.fixture(scope="module", params=BOARDS)
 def robot(request):
     require_echo()
-    sim = SimRobot(request.param, slaves=[("m32d", ECHO, ECHO_ELF)], eeproms=(0xA0,),
-                   trace=True, control=True)
+    sim = SimRobot(request.param, slaves=[("m32d", ECHO, ECHO_ELF),
+                                          ("m128s", ECHO128, ECHO128_ELF)],
+                   eeproms=(0xA0,), trace=True, control=True)
     sim.start()
     r = Robot(sim)
     try:
@@ -64,6 +69,14 @@ def test_write_then_read_back(robot):
     assert robot.ask("S 20 05 06 07 S 21 03 P") == "SWAAASR050607P"
     # the firmware gives its bytes again from the first
     assert robot.ask("S 21 04 P") == "SR05060705P"
+
+
+def test_two_slaves_keep_apart(robot):
+    assert robot.ask("S 20 A1 A2 P") == "SWAAP"
+    assert robot.ask("S 22 B1 B2 B3 P") == "SWAAAP"
+    assert robot.ask("S 21 02 S 23 03 P") == "SRA1A2SRB1B2B3P"
+    # write one, read the other in a single transaction
+    assert robot.ask("S 22 C4 S 21 01 S 23 01 P") == "SWASRA1SRC4P"
 
 
 def test_read_is_stretched_by_the_slave(robot):
@@ -100,7 +113,7 @@ def test_data_nack_when_the_slave_is_full(robot):
 def test_other_devices_and_addresses(robot):
     assert robot.ask("S A0 00 11 22 P") == "SWAAAP"
     assert robot.ask("S A0 00 S A1 02 P") == "SWASR1122P"
-    assert robot.ask("S 22 01 P").startswith("ERROR")          # nobody at 0x22
+    assert robot.ask("S 24 01 P").startswith("ERROR")          # nobody at 0x24
     assert robot.ask("S 20 77 P") == "SWAP"
     assert robot.ask("S 21 01 P") == "SR77P"
 
@@ -152,6 +165,7 @@ def test_control_reaches_every_board(robot):
     ctl = robot.ctl
     names = ctl.signals()
     assert "A0" in names and "20/A0" in names and "20/D7" in names
+    assert "22/G4" in names and "22/servo31" in names
     echo = ctl.slave(ECHO)
     assert echo.signals() == [n for n in names if n.startswith("20/")]
     # a slave's pin, by prefix or through its view; the gateway's is apart
@@ -170,6 +184,7 @@ def test_control_reaches_every_board(robot):
     assert echo.peek(twar) == bytes([ECHO])
     assert echo.stack()["ramend"] == 0x085F
     assert ctl.request("time @20").isdigit()
+    assert ctl.slave(ECHO128).peek(0x72) == bytes([ECHO128])     # its TWAR
     for bad in ("peek @30 0", "pin 30/A5", "rx @20 999999999999 00"):
         with pytest.raises(Exception, match="ERR"):
             ctl.request(bad)
