@@ -125,7 +125,18 @@ SIM_HDR := $(wildcard sim/*.h sim/parts/*.h boards/*/board.h)
 SIM_CFLAGS := -std=gnu99 -O2 -g -Wall -Wextra -Werror -I. -Isim -I/usr/include/simavr
 SIM_LIBS := -lsimavr -lelf -lutil -lpthread -lm
 
-sim: build/sim/orfa-sim
+sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf build/sim-fw/twi_slave_echo_m128.elf
+
+# Test firmware for the simulator's bus tests (tests/sim/fw), not ORFA: the
+# echo slave on an ATmega32 at 0x20 and on an ATmega128 at 0x22.
+SIM_FW_CFLAGS := -DF_CPU=7372800UL -std=gnu99 -Os -Wall -Wextra -Werror
+build/sim-fw/%_m128.elf: tests/sim/fw/%.c
+	@mkdir -p $(dir $@)
+	avr-gcc -mmcu=atmega128 -DECHO_ADDR=0x22 $(SIM_FW_CFLAGS) $< -o $@
+
+build/sim-fw/%.elf: tests/sim/fw/%.c
+	@mkdir -p $(dir $@)
+	avr-gcc -mmcu=atmega32 $(SIM_FW_CFLAGS) $< -o $@
 
 build/sim/orfa-sim: $(SIM_SRC) $(SIM_HDR)
 	@mkdir -p $(dir $@)

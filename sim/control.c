@@ -236,7 +236,7 @@ static void cmd_measure(control_t *c, reply_t *r, signal_t *s, unsigned nmax,
 	   (double)hsum / (double)psum, periods);
 }
 
-static void cmd_spi(control_t *c, reply_t *r)
+static void cmd_spi(board_model_t *bm, reply_t *r)
 {
 	spi_log_t e;
 	int any = 0, open = 0;
@@ -245,7 +245,7 @@ static void cmd_spi(control_t *c, reply_t *r)
 	char mosi[2 * SPI_LOG + 1], miso[2 * SPI_LOG + 1];
 	size_t nm = 0;
 
-	while (spi_log_pop(&c->bm->spi, &e)) {
+	while (spi_log_pop(&bm->spi, &e)) {
 		if (open && (e.cs != cs || e.txn != txn)) {
 			mosi[nm] = miso[nm] = 0;
 			rp(r, "%s%s:%s:%s", any ? " " : "", cs, mosi, miso);
@@ -278,7 +278,61 @@ static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
 	"stack [FROM] | peek ADDR [LEN] | rx CYCLE HEX... | signals | "
-	"srf08 ADDR [range MM [MM2] | light N] | help";
+	"srf08 ADDR [range MM [MM2] | light N] | help; "
+	"a slave board's pins, signals and inputs as 10/A5, other requests with @10 "
+	"first (stack @10 FROM)";
+
+/* The board with address text S ("10", hex), or NULL. */
+static control_board_t *control_board_find(control_t *c, const char *s)
+{
+	char *end;
+	unsigned long v;
+
+	if (!*s) {
+		return NULL;
+	}
+	v = strtoul(s, &end, 16);
+	if (*end || v == 0 || v > 0xff) {
+		return NULL;
+	}
+	for (int i = 1; i < c->nboards; i++) {
+		if (c->board[i].addr == v) {
+			return &c->board[i];
+		}
+	}
+	return NULL;
+}
+
+/* NAME as "10/A5" (slave 10's A5) or "A5" (board *CB's): the name within
+ * its board, *CB set to that board; NULL when no board has the prefix. */
+static const char *control_name(control_t *c, const char *name, control_board_t **cb)
+{
+	const char *slash = strchr(name, '/');
+	char prefix[8];
+
+	if (!slash) {
+		return name;
+	}
+	if ((size_t)(slash - name) >= sizeof(prefix)) {
+		return NULL;
+	}
+	memcpy(prefix, name, (size_t)(slash - name));
+	prefix[slash - name] = 0;
+	*cb = control_board_find(c, prefix);
+	return *cb ? slash + 1 : NULL;
+}
+
+static void control_list_signals(reply_t *r, const control_board_t *cb, int *any)
+{
+	for (int i = 0; i < cb->bm->signals.count; i++) {
+		if (cb->addr) {
+			rp(r, "%s%02X/%s", *any ? " " : "", cb->addr, cb->bm->signals.sig[i]->name);
+		} else {
+			rp(r, "%s%s", *any ? " " : "", cb->bm->signals.sig[i]->name);
+		}
+		*any = 1;
+	}
+}
 
 int control_request(control_t *c, const char *line, char **out, size_t *len,
 		    size_t *cap, uint64_t *wait_until)
@@ -287,8 +341,10 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 	char buf[CONTROL_LINE];
 	char *argv[CONTROL_MAX_ARGS + 1], *save = NULL, *tok;
 	int argc = 0;
-	board_model_t *bm = c->bm;
-	avr_t *avr = c->avr;
+	control_board_t *cb = &c->board[0];
+	int board_given = 0;
+	board_model_t *bm;
+	avr_t *avr;
 	uint64_t u;
 	uint32_t mv;
 
@@ -308,8 +364,38 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 	}
 	const char *cmd = argv[0];
 
+	/* `@10` as the first argument: the request is about slave board 10 */
+	if (argc >= 2 && argv[1][0] == '@') {
+		cb = control_board_find(c, argv[1] + 1);
+		if (!cb) {
+			rp(&r, "ERR no board '%s' (slave boards: @ and the address, like @10)",
+			   argv[1]);
+			return 0;
+		}
+		board_given = 1;
+		memmove(&argv[1], &argv[2], (size_t)(argc - 2) * sizeof(argv[0]));
+		argc--;
+	}
+	/* A request naming a pin, signal or input may name a slave's: 10/A5. */
+	if (argc >= 2 && strchr(argv[1], '/') &&
+	    (!strcasecmp(cmd, "pin") || !strcasecmp(cmd, "drive") || !strcasecmp(cmd, "adc") ||
+	     !strcasecmp(cmd, "level") || !strcasecmp(cmd, "edges") ||
+	     !strcasecmp(cmd, "measure") || !strcasecmp(cmd, "spidev"))) {
+		const char *name = control_name(c, argv[1], &cb);
+
+		if (!name) {
+			rp(&r, "ERR no board for '%s' (slave names: the address, a slash, the"
+			   " name: 10/A5)", argv[1]);
+			return 0;
+		}
+		argv[1] = (char *)name;
+	}
+	bm = cb->bm;
+	avr = cb->avr;
+
 	if (!strcasecmp(cmd, "time") && argc == 1) {
-		rp(&r, "%" PRIu64, (uint64_t)avr->cycle);
+		/* world time: every board counts the same cycles */
+		rp(&r, "%" PRIu64, (uint64_t)c->avr->cycle);
 	} else if (!strcasecmp(cmd, "stack") && (argc == 1 || argc == 2)) {
 		uint64_t from = 0;
 		uint32_t deepest;
@@ -342,7 +428,7 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 			rp(&r, "ERR wait N: N cycles, decimal");
 			return 0;
 		}
-		*wait_until = avr->cycle + u;
+		*wait_until = c->avr->cycle + u;
 		return 1;
 	} else if ((!strcasecmp(cmd, "pin") && argc == 2) ||
 		   (!strcasecmp(cmd, "drive") && argc == 3)) {
@@ -430,9 +516,13 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 				    argc == 4, since);
 		}
 	} else if (!strcasecmp(cmd, "rx")) {
+		if (cb != &c->board[0]) {
+			rp(&r, "ERR rx: only the gateway's serial line reaches the PC");
+			return 0;
+		}
 		cmd_rx(c, &r, argc, argv);
 	} else if (!strcasecmp(cmd, "spi") && argc == 1) {
-		cmd_spi(c, &r);
+		cmd_spi(bm, &r);
 	} else if (!strcasecmp(cmd, "spidev") && argc == 2) {
 		spi_dev_t *d = board_model_spi_dev(bm, argv[1]);
 		char text[512];
@@ -447,13 +537,19 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 		}
 		rp(&r, "%s mode %d %s %s", d->kind, d->mode, d->lsb_first ? "lsb" : "msb", text);
 	} else if (!strcasecmp(cmd, "signals") && argc == 1) {
-		for (int i = 0; i < bm->signals.count; i++) {
-			rp(&r, "%s%s", i ? " " : "", bm->signals.sig[i]->name);
+		int any = 0;
+
+		if (board_given) {
+			control_list_signals(&r, cb, &any);
+		} else {
+			for (int i = 0; i < c->nboards; i++) {
+				control_list_signals(&r, &c->board[i], &any);
+			}
 		}
 	} else if (!strcasecmp(cmd, "srf08")) {
 		char text[256];
 
-		srf08_control(c->srf08, c->srf08_count, avr->cycle, argc, argv, text, sizeof(text));
+		srf08_control(c->srf08, c->srf08_count, c->avr->cycle, argc, argv, text, sizeof(text));
 		rp(&r, "%s", text);
 	} else if (!strcasecmp(cmd, "help") && argc == 1) {
 		rp(&r, "%s", control_help);
@@ -475,6 +571,8 @@ int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm,
 	c->avr = avr;
 	c->bm = bm;
 	c->usart = usart;
+	c->board[0] = (control_board_t) { .addr = 0, .avr = avr, .bm = bm };
+	c->nboards = 1;
 	for (int i = 0; i < CONTROL_CLIENTS; i++) {
 		c->client[i].fd = -1;
 	}
@@ -497,6 +595,15 @@ int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm,
 		return -1;
 	}
 	c->path = strdup(path);
+	return 0;
+}
+
+int control_add_board(control_t *c, uint8_t addr, avr_t *avr, board_model_t *bm)
+{
+	if (c->fd < 0 || c->nboards == CONTROL_MAX_BOARDS) {
+		return -1;
+	}
+	c->board[c->nboards++] = (control_board_t) { .addr = addr, .avr = avr, .bm = bm };
 	return 0;
 }
 

@@ -32,11 +32,23 @@ typedef struct control_client_t {
 	uint64_t wait_until;
 } control_client_t;
 
+#define CONTROL_MAX_BOARDS 16
+
+/* A board the requests can reach: the gateway (addr 0, first) or a slave,
+ * named by its 8-bit address: `10/servo3`, `@10`. */
+typedef struct control_board_t {
+	uint8_t addr;
+	avr_t *avr;
+	board_model_t *bm;
+} control_board_t;
+
 typedef struct control_t {
 	int fd;				/* listening socket, -1: off */
 	char *path;
-	avr_t *avr;
+	avr_t *avr;			/* the gateway's: its cycle is world time */
 	board_model_t *bm;
+	control_board_t board[CONTROL_MAX_BOARDS];
+	int nboards;
 	usart_t *usart;			/* the board's serial port (`rx`) */
 	control_client_t client[CONTROL_CLIENTS];
 	uint32_t activity;		/* bumps on every request */
@@ -47,6 +59,9 @@ typedef struct control_t {
 /* Listen on PATH (an existing socket file there is replaced). 0 or -1. */
 int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm,
 		 usart_t *usart);
+
+/* Let the requests reach a slave board at ADDR (8-bit). 0 or -1 when full. */
+int control_add_board(control_t *c, uint8_t addr, avr_t *avr, board_model_t *bm);
 
 /* Accept, read, answer, send: never blocks. */
 void control_poll(control_t *c);

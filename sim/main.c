@@ -1,10 +1,11 @@
 /*
  * main.c: orfa-sim, an ORFA board under simavr 1.6 (docs/simulator.md).
  *
- * Single-threaded: avr_run() in batches of about a millisecond of simulated
- * time; between batches the pty is serviced, the idle throttle decides
- * whether to wait for wall time, and signals are noticed. The pty is never
- * serviced from cycle timers because a watchdog reset wipes them.
+ * Single-threaded: the world (world.h: the boards in lock-step, the bus)
+ * runs in batches of about a millisecond of simulated time; between batches
+ * the pty is serviced, the idle throttle decides whether to wait for wall
+ * time, and signals are noticed. The pty is never serviced from cycle
+ * timers because a watchdog reset wipes them.
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -19,41 +20,30 @@
 #include <time.h>
 
 #include "sim_avr.h"
-#include "sim_elf.h"
 
 #include "board.h"
-#include "board_model.h"
 #include "control.h"
-#include "mcu.h"
 #include "pty.h"
+#include "sim_board.h"
 #include "trace.h"
-#include "twi.h"
-#include "twi_bus.h"
-#include "usart.h"
-#include "parts/eeprom24.h"
-#include "parts/srf08.h"
+#include "world.h"
 
-#define SIM_FREQUENCY 7372800u
-#define SIM_MAX_EEPROMS 8
-#define SIM_MAX_SRF08 16	/* as many as it has addresses */
+#define SIM_MAX_EEPROMS WORLD_MAX_EEPROMS
 #define SIM_BATCH_CYCLES (SIM_FREQUENCY / 1000)	/* 1 ms simulated */
 #define SIM_IDLE_AFTER_S 0.5
 #define SIM_BOOT_MAX_CYCLES (SIM_FREQUENCY / 10)	/* 100 ms simulated */
 #define SIM_UCSRB_RXEN 0x10
 
+#define SIM_MAX_SLAVES (WORLD_MAX_BOARDS - 1)
+
 typedef struct sim_t {
-	const board_desc_t *board;
-	const mcu_desc_t *mcu;
-	avr_t *avr;
-	avr_io_t reset_watch;		/* traces "reset" on a watchdog reset */
-	trace_t trace;
+	const board_desc_t *board;	/* the gateway's */
+	world_t world;
+	sim_board_t gateway;
+	sim_board_t slave[SIM_MAX_SLAVES];
+	int twar_checked[WORLD_MAX_BOARDS];	/* slave's TWAR compared with --slave */
 	pty_t pty;
-	usart_t usart;
-	twi_bus_t bus;
-	twi_t twi;
-	eeprom24_t eeprom[SIM_MAX_EEPROMS];
-	srf08_t srf08[SIM_MAX_SRF08];
-	board_model_t bm;
+	vcd_t vcd;
 	control_t control;
 	int idle_throttle;
 } sim_t;
@@ -73,38 +63,52 @@ static void sim_usage(void)
 		"                [--srf08 ADDR]...\n"
 		"                [--trace FILE] [--no-idle-throttle] [--control PATH]\n"
 		"                [--vcd FILE] [--spi KIND@PIN[:mode=N][:lsb]]...\n"
-		"                [--adc CH=MV]... [--avcc MV] [--aref MV] FIRMWARE.elf\n",
-		board_names());
-}
-
-/* simavr chatters on stdout (the ELF loader's "Loaded ..."); the contract
- * allows one line there. Errors go to stderr, the rest nowhere. */
-static void sim_logger(avr_t *avr, const int level, const char *fmt, va_list ap)
-{
-	(void)avr;
-	if (level <= LOG_ERROR) {
-		vfprintf(stderr, fmt, ap);
-	}
-}
-
-/* The firmware never sleeps; should it, simavr would usleep() to wall time.
- * Simulated time must not depend on wall time, so sleeping costs nothing. */
-static void sim_sleep(avr_t *avr, avr_cycle_count_t how_long)
-{
-	(void)avr;
-	(void)how_long;
-}
-
-static void sim_reset_hook(avr_io_t *io)
-{
-	sim_t *sim = (sim_t *)((char *)io - offsetof(sim_t, reset_watch));
-
-	trace_event(&sim->trace, io->avr->cycle, "reset");
+		"                [--adc CH=MV]... [--avcc MV] [--aref MV]\n"
+		"                [--slave BOARD:ADDR:ELF]... GATEWAY.elf\n"
+		"\n"
+		"GATEWAY.elf runs on the --board board, whose serial port is the pty at\n"
+		"--link. Each --slave adds a board (%s) running ELF on the same\n"
+		"I2C bus; ADDR is its 8-bit address (0x10..0xEE, even): it names the\n"
+		"board's signals in the control interface (`10/servo3`, `@10`) and is\n"
+		"checked against the firmware's TWAR (the firmware decides). The\n"
+		"--spi/--adc/--avcc/--aref options set up the gateway board; the\n"
+		"control interface reaches every board. See docs/simulator.md.\n",
+		board_names(), board_names());
 }
 
 static void sim_to_host(void *param, uint8_t byte)
 {
 	pty_write(param, byte);
+}
+
+/* A slave board's serial port is not connected. */
+static void sim_discard(void *param, uint8_t byte)
+{
+	(void)param;
+	(void)byte;
+}
+
+/* Once a slave's firmware enables its TWI as a slave, say so on stderr if
+ * it answers at another address than its --slave: the firmware's TWAR
+ * decides, the option only names the board. */
+static void sim_check_twar(sim_t *sim)
+{
+	world_t *w = &sim->world;
+
+	for (int i = 1; i < w->nboards; i++) {
+		sim_board_t *b = w->boards[i];
+		uint8_t cr = b->avr->data[b->mcu->twi.twcr];
+		uint8_t twar = b->avr->data[b->mcu->twi.twar] & 0xfe;
+
+		if (sim->twar_checked[i] || !(cr & 0x04) || !(cr & 0x40)) {
+			continue;	/* TWEN and TWEA not both set yet */
+		}
+		sim->twar_checked[i] = 1;
+		if (twar != b->addr) {
+			fprintf(stderr, "orfa-sim: slave %s: its firmware answers at 0x%02X"
+				" (TWAR), not 0x%02X\n", b->prefix, twar, b->addr);
+		}
+	}
 }
 
 static double sim_now(void)
@@ -127,31 +131,31 @@ static int sim_parse_addr(const char *s, uint8_t *out)
 	return 0;
 }
 
-/* Run about a millisecond of simulated time and hand the firmware's output
- * to the pty. 0, or 1 when the firmware crashed or stopped for good. */
+/* Run about a millisecond of simulated time and hand the gateway's output
+ * to the pty. 0, or 1 when a firmware crashed or stopped for good. */
 static int sim_batch(sim_t *sim)
 {
-	avr_cycle_count_t target = sim->avr->cycle + SIM_BATCH_CYCLES;
+	world_t *w = &sim->world;
+	uint64_t target = world_cycle(w) + SIM_BATCH_CYCLES;
 	uint64_t deadline = control_deadline(&sim->control);
-	int state = cpu_Running;
+	int rc;
 
 	/* a control client's `wait` ends near its cycle, not a batch later */
 	if (deadline < target) {
 		target = deadline;
 	}
-
-	while (sim->avr->cycle < target) {
-		state = avr_run(sim->avr);
-		if (state == cpu_Done || state == cpu_Crashed) {
-			break;
-		}
-	}
+	rc = world_run(w, target);
 	pty_flush(&sim->pty);
-	signals_vcd_flush(&sim->bm.signals, sim->avr->cycle, 0);
-	if (state == cpu_Done || state == cpu_Crashed) {
-		fprintf(stderr, "orfa-sim: firmware %s at pc 0x%04x, cycle %" PRIu64 "\n",
-			state == cpu_Crashed ? "crashed" : "stopped (sleep with interrupts off)",
-			sim->avr->pc, (uint64_t)sim->avr->cycle);
+	sim_check_twar(sim);
+	vcd_flush(&sim->vcd, world_cycle(w), 0);
+	if (rc) {
+		sim_board_t *b = w->boards[w->dead];
+
+		fprintf(stderr, "orfa-sim: %s%sfirmware %s at pc 0x%04x, cycle %" PRIu64 "\n",
+			b->prefix, b->prefix[0] ? ": " : "",
+			w->dead_state == cpu_Crashed ? "crashed" :
+			"stopped (sleep with interrupts off)",
+			b->avr->pc, (uint64_t)b->avr->cycle);
 		return 1;
 	}
 	return 0;
@@ -159,25 +163,80 @@ static int sim_batch(sim_t *sim)
 
 static uint32_t sim_activity(const sim_t *sim)
 {
-	return sim->usart.activity + sim->bus.activity + sim->bm.spi.activity +
-	       sim->bm.activity + sim->control.activity;
+	return world_activity(&sim->world) + sim->control.activity;
 }
 
 #define SIM_MAX_SPI 8
 
 typedef struct sim_args_t {
 	const char *link, *trace, *firmware, *control, *vcd;
+	uint8_t srf08_addr[WORLD_MAX_SRF08];
+	int srf08_count;
 	uint8_t eeprom_addr[SIM_MAX_EEPROMS];
 	uint8_t eeprom_wp[SIM_MAX_EEPROMS];
 	int eeprom_count;
-	uint8_t srf08_addr[SIM_MAX_SRF08];
-	int srf08_count;
 	const char *spi[SIM_MAX_SPI];
 	int spi_count;
 	uint32_t adc_mv[8];
 	uint8_t adc_set;		/* bit per channel given */
 	uint32_t avcc, aref;		/* 0: default */
+	const board_desc_t *slave_board[SIM_MAX_SLAVES];
+	uint8_t slave_addr[SIM_MAX_SLAVES];
+	const char *slave_elf[SIM_MAX_SLAVES];
+	int slave_count;
 } sim_args_t;
+
+/* The I2C addresses SPEC section 4 reserves (8-bit 0x00-0x0F, 0xF0-0xFF). */
+static int sim_addr_reserved(uint8_t addr8)
+{
+	return addr8 < 0x10 || addr8 >= 0xf0;
+}
+
+/* --slave BOARD:ADDR:ELF. 0, or -1 after printing why. */
+static int sim_parse_slave(sim_args_t *args, const char *spec)
+{
+	char board[16], addr[16];
+	const char *c1 = strchr(spec, ':');
+	const char *c2 = c1 ? strchr(c1 + 1, ':') : NULL;
+	int n = args->slave_count;
+
+	if (!c1 || !c2 || c1 - spec >= (long)sizeof(board) || c2 - c1 - 1 >= (long)sizeof(addr) ||
+	    !c2[1]) {
+		fprintf(stderr, "orfa-sim: bad --slave '%s' (BOARD:ADDR:ELF, e.g."
+			" m128s:0x10:build/m128s-slave/orfa.elf)\n", spec);
+		return -1;
+	}
+	if (n == SIM_MAX_SLAVES) {
+		fprintf(stderr, "orfa-sim: too many --slave (at most %d)\n", SIM_MAX_SLAVES);
+		return -1;
+	}
+	memcpy(board, spec, (size_t)(c1 - spec));
+	board[c1 - spec] = 0;
+	memcpy(addr, c1 + 1, (size_t)(c2 - c1 - 1));
+	addr[c2 - c1 - 1] = 0;
+	args->slave_board[n] = board_find(board);
+	if (!args->slave_board[n]) {
+		fprintf(stderr, "orfa-sim: bad --slave '%s': unknown board '%s' (%s)\n", spec,
+			board, board_names());
+		return -1;
+	}
+	if (sim_parse_addr(addr, &args->slave_addr[n]) < 0 ||
+	    sim_addr_reserved(args->slave_addr[n])) {
+		fprintf(stderr, "orfa-sim: bad --slave '%s': ADDR must be an even 8-bit address"
+			" 0x10..0xEE like 0x10\n", spec);
+		return -1;
+	}
+	for (int i = 0; i < n; i++) {
+		if (args->slave_addr[i] == args->slave_addr[n]) {
+			fprintf(stderr, "orfa-sim: bad --slave '%s': two slaves at 0x%02X\n", spec,
+				args->slave_addr[n]);
+			return -1;
+		}
+	}
+	args->slave_elf[n] = c2 + 1;
+	args->slave_count++;
+	return 0;
+}
 
 /* "1234" millivolts, 0..100000. 0 or -1. */
 static int sim_parse_mv(const char *s, uint32_t *out)
@@ -200,7 +259,7 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		{ "board", required_argument, NULL, 'b' },
 		{ "link", required_argument, NULL, 'l' },
 		{ "eeprom", required_argument, NULL, 'e' },
-		{ "srf08", required_argument, NULL, 'S' },
+		{ "srf08", required_argument, NULL, 'F' },
 		{ "trace", required_argument, NULL, 't' },
 		{ "no-idle-throttle", no_argument, NULL, 'n' },
 		{ "control", required_argument, NULL, 'c' },
@@ -209,6 +268,7 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		{ "adc", required_argument, NULL, 'a' },
 		{ "avcc", required_argument, NULL, 'V' },
 		{ "aref", required_argument, NULL, 'R' },
+		{ "slave", required_argument, NULL, 'S' },
 		{ "help", no_argument, NULL, 'h' },
 		{ NULL, 0, NULL, 0 },
 	};
@@ -259,11 +319,11 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 			args->eeprom_count++;
 			break;
 		}
-		case 'S': {
+		case 'F': {
 			/* the 16 addresses an SRF08 can be set to: E0, E2 .. FE */
 			uint8_t a;
 
-			if (args->srf08_count == SIM_MAX_SRF08 || sim_parse_addr(optarg, &a) < 0 ||
+			if (args->srf08_count == WORLD_MAX_SRF08 || sim_parse_addr(optarg, &a) < 0 ||
 			    a < 0xE0) {
 				fprintf(stderr, "orfa-sim: bad or too many --srf08 '%s'"
 					" (0xE0, 0xE2 .. 0xFE)\n", optarg);
@@ -317,6 +377,11 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 				return 2;
 			}
 			break;
+		case 'S':
+			if (sim_parse_slave(args, optarg) < 0) {
+				return 2;
+			}
+			break;
 		case 'h':
 			sim_usage();
 			exit(0);
@@ -333,67 +398,88 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 				return 2;
 			}
 		}
+		for (int j = 0; j < args->slave_count; j++) {
+			if (args->srf08_addr[i] == args->slave_addr[j]) {
+				fprintf(stderr, "orfa-sim: a --slave and an SRF08 at 0x%02X\n",
+					args->srf08_addr[i]);
+				return 2;
+			}
+		}
 	}
 	if (!sim->board || !args->link || optind != argc - 1) {
 		sim_usage();
 		return 2;
 	}
+	for (int i = 0; i < args->slave_count; i++) {
+		for (int k = 0; k < args->eeprom_count; k++) {
+			if (args->eeprom_addr[k] == args->slave_addr[i]) {
+				fprintf(stderr, "orfa-sim: --slave at 0x%02X and --eeprom at the"
+					" same address\n", args->slave_addr[i]);
+				return 2;
+			}
+		}
+	}
 	args->firmware = argv[optind];
 	return 0;
 }
 
-/* Load the firmware into a fresh MCU and wire up the board's parts. 0, or
- * the exit status. */
+/* One VCD for every board: the gateway's signals in scope `board` under
+ * their own names, a slave's in scope `board_10` as `10/servo3`. */
+static int sim_open_vcd(sim_t *sim, const char *path)
+{
+	static char scope[WORLD_MAX_BOARDS][16], prefix[WORLD_MAX_BOARDS][8];
+	signals_t *sets[WORLD_MAX_BOARDS];
+	const char *scopes[WORLD_MAX_BOARDS], *prefixes[WORLD_MAX_BOARDS];
+	world_t *w = &sim->world;
+
+	for (int i = 0; i < w->nboards; i++) {
+		sim_board_t *b = w->boards[i];
+
+		snprintf(scope[i], sizeof(scope[i]), i ? "board_%s" : "board", b->prefix);
+		snprintf(prefix[i], sizeof(prefix[i]), i ? "%s/" : "", b->prefix);
+		sets[i] = &b->bm.signals;
+		scopes[i] = scope[i];
+		prefixes[i] = prefix[i];
+	}
+	return vcd_open(&sim->vcd, path, SIM_FREQUENCY, sets, scopes, prefixes, w->nboards);
+}
+
+/* Build the world: the bus and its EEPROMs, the gateway board with its
+ * options, the control socket. 0, or the exit status. */
 static int sim_build(sim_t *sim, const sim_args_t *args)
 {
-	elf_firmware_t fw;
+	world_t *w = &sim->world;
+	sim_board_t *gw = &sim->gateway;
+	int rc;
 
-	avr_global_logger_set(sim_logger);
-	memset(&fw, 0, sizeof(fw));
-	if (elf_read_firmware(args->firmware, &fw) != 0 || !fw.flash || !fw.flashsize) {
-		fprintf(stderr, "orfa-sim: cannot load firmware '%s'\n", args->firmware);
-		return 2;
-	}
-	sim->mcu = mcu_find(sim->board->mcu);
-	sim->avr = avr_make_mcu_by_name(sim->board->mcu);
-	if (!sim->mcu || !sim->avr) {
-		fprintf(stderr, "orfa-sim: simavr lacks MCU '%s'\n", sim->board->mcu);
-		return 2;
-	}
-	avr_init(sim->avr);
-	if (fw.flashsize > sim->avr->flashend + 1u) {
-		fprintf(stderr, "orfa-sim: '%s' does not fit the %s's flash\n",
-			args->firmware, sim->board->mcu);
-		return 2;
-	}
-	avr_load_firmware(sim->avr, &fw);
-	sim->avr->frequency = SIM_FREQUENCY;	/* our ELFs carry no .mmcu */
-	sim->avr->sleep = sim_sleep;
-
-	if (args->trace && trace_open(&sim->trace, args->trace) < 0) {
+	world_init(w);
+	if (args->trace && trace_open(&w->trace, args->trace) < 0) {
 		fprintf(stderr, "orfa-sim: cannot write trace '%s': %s\n",
 			args->trace, strerror(errno));
 		return 2;
 	}
-	twi_bus_init(&sim->bus, &sim->trace);
 	for (int i = 0; i < args->eeprom_count; i++) {
-		eeprom24_init(&sim->eeprom[i], args->eeprom_addr[i]);
-		sim->eeprom[i].write_protect = args->eeprom_wp[i];
-		twi_bus_attach(&sim->bus, &sim->eeprom[i].dev);
+		world_add_eeprom(w, args->eeprom_addr[i], args->eeprom_wp[i]);
 	}
 	for (int i = 0; i < args->srf08_count; i++) {
-		srf08_init(&sim->srf08[i], args->srf08_addr[i], SIM_FREQUENCY, &sim->bus);
-		twi_bus_attach(&sim->bus, &sim->srf08[i].dev);
+		world_add_srf08(w, args->srf08_addr[i]);
 	}
-	usart_init(&sim->usart, sim->avr, &sim->mcu->usart[sim->board->wiring->host_usart],
-		   &sim->trace, sim_to_host, &sim->pty);
-	twi_init(&sim->twi, sim->avr, &sim->mcu->twi, &sim->bus);
-	if (board_model_init(&sim->bm, sim->avr, sim->board, sim->mcu, &sim->trace) < 0) {
-		fprintf(stderr, "orfa-sim: cannot build the %s board model\n", sim->board->name);
-		return 2;
+	rc = sim_board_init(gw, sim->board, args->firmware, 0, &w->bus, &w->trace,
+			    sim_to_host, &sim->pty);
+	if (rc) {
+		return rc;
+	}
+	w->boards[w->nboards++] = gw;
+	for (int i = 0; i < args->slave_count; i++) {
+		rc = sim_board_init(&sim->slave[i], args->slave_board[i], args->slave_elf[i],
+				    args->slave_addr[i], &w->bus, &w->trace, sim_discard, NULL);
+		if (rc) {
+			return rc;
+		}
+		w->boards[w->nboards++] = &sim->slave[i];
 	}
 	for (int i = 0; i < args->spi_count; i++) {
-		const char *err = board_model_add_spi(&sim->bm, args->spi[i]);
+		const char *err = board_model_add_spi(&gw->bm, args->spi[i]);
 
 		if (err) {
 			fprintf(stderr, "orfa-sim: bad --spi '%s': %s\n", args->spi[i], err);
@@ -402,31 +488,32 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	}
 	for (int ch = 0; ch < 8; ch++) {
 		if (args->adc_set & (1u << ch)) {
-			board_model_set_adc(&sim->bm, ch, args->adc_mv[ch]);
+			board_model_set_adc(&gw->bm, ch, args->adc_mv[ch]);
 		}
 	}
 	if (args->avcc) {
-		board_model_set_avcc(&sim->bm, args->avcc);
+		board_model_set_avcc(&gw->bm, args->avcc);
 	}
 	if (args->aref) {
-		board_model_set_aref(&sim->bm, args->aref);
+		board_model_set_aref(&gw->bm, args->aref);
 	}
-	if (args->vcd && signals_vcd_open(&sim->bm.signals, args->vcd, SIM_FREQUENCY) < 0) {
+	if (args->vcd && sim_open_vcd(sim, args->vcd) < 0) {
 		fprintf(stderr, "orfa-sim: cannot write VCD '%s': %s\n", args->vcd, strerror(errno));
 		return 2;
 	}
 	sim->control.fd = -1;
 	if (args->control &&
-	    control_open(&sim->control, args->control, sim->avr, &sim->bm, &sim->usart) < 0) {
+	    control_open(&sim->control, args->control, gw->avr, &gw->bm, &gw->usart) < 0) {
 		fprintf(stderr, "orfa-sim: cannot listen on '%s': %s\n", args->control,
 			strerror(errno));
 		return 2;
 	}
-	sim->control.srf08 = sim->srf08;	/* control_open clears control_t */
-	sim->control.srf08_count = args->srf08_count;
-	sim->reset_watch.kind = "orfa-reset";
-	sim->reset_watch.reset = sim_reset_hook;
-	mcu_register_io_last(sim->avr, &sim->reset_watch);
+	for (int i = 1; i < w->nboards; i++) {
+		control_add_board(&sim->control, w->boards[i]->addr, w->boards[i]->avr,
+				  &w->boards[i]->bm);
+	}
+	sim->control.srf08 = w->srf08;	/* control_open clears control_t */
+	sim->control.srf08_count = w->nsrf08;
 	return 0;
 }
 
@@ -446,7 +533,7 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 	uint32_t act = sim_activity(sim);
 
 	if (host_bytes || act != th->last_activity || control_waiting(&sim->control) ||
-	    usart_inject_pending(&sim->usart)) {
+	    usart_inject_pending(&sim->gateway.usart)) {
 		th->last_activity = act;
 		th->t_last_activity = now;
 		th->on = 0;
@@ -454,10 +541,10 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 		   now - th->t_last_activity > SIM_IDLE_AFTER_S) {
 		th->on = 1;
 		th->wall0 = now;
-		th->cycle0 = sim->avr->cycle;
+		th->cycle0 = world_cycle(&sim->world);
 	}
 	if (th->on) {
-		double ahead = (double)(sim->avr->cycle - th->cycle0) / SIM_FREQUENCY -
+		double ahead = (double)(world_cycle(&sim->world) - th->cycle0) / SIM_FREQUENCY -
 			       (now - th->wall0);
 		if (ahead > 0.0005) {
 			/* Wait for wall time, or for the PC or a control
@@ -483,29 +570,32 @@ static int sim_run(sim_t *sim)
 	th.t_last_activity = t_start;
 	while (!sim_stop && rc == 0) {
 		uint8_t buf[512];
-		size_t room = usart_host_room(&sim->usart);
+		size_t room = usart_host_room(&sim->gateway.usart);
 		size_t n = pty_read(&sim->pty, buf, room < sizeof(buf) ? room : sizeof(buf));
 
 		if (n) {
-			usart_host_send(&sim->usart, buf, n);
+			usart_host_send(&sim->gateway.usart, buf, n);
 		}
 		control_poll(&sim->control);
 		double t0 = sim_now();
-		avr_cycle_count_t c0 = sim->avr->cycle;
+		avr_cycle_count_t c0 = world_cycle(&sim->world);
 		rc = sim_batch(sim);
 		double now = sim_now();
 		if (!th.on) {
 			t_free += now - t0;
-			cyc_free += sim->avr->cycle - c0;
+			cyc_free += world_cycle(&sim->world) - c0;
 		}
 		control_poll(&sim->control);
 		sim_throttle(sim, &th, n != 0, now);
 	}
+	/* world cycles: with B boards the MCUs run B times as many */
 	fprintf(stderr, "orfa-sim: %" PRIu64 " cycles in %.2f s wall;"
-		" running free %.1f simulated MHz per wall second (%.1fx real time)\n",
-		(uint64_t)sim->avr->cycle, sim_now() - t_start,
+		" running free %.1f simulated MHz per wall second (%.1fx real time),"
+		" %d board%s\n",
+		(uint64_t)world_cycle(&sim->world), sim_now() - t_start,
 		t_free > 0 ? cyc_free / t_free / 1e6 : 0.0,
-		t_free > 0 ? cyc_free / t_free / SIM_FREQUENCY : 0.0);
+		t_free > 0 ? cyc_free / t_free / SIM_FREQUENCY : 0.0,
+		sim->world.nboards, sim->world.nboards == 1 ? "" : "s");
 	return rc;
 }
 
@@ -537,8 +627,8 @@ int main(int argc, char **argv)
 	 * most SIM_BOOT_MAX_CYCLES) before the PC can reach the port, so a
 	 * first byte sent right after the link appears is not lost to a
 	 * board that is still initialising. */
-	while (!sim_stop && rc == 0 && sim.avr->cycle < SIM_BOOT_MAX_CYCLES &&
-	       !(sim.avr->data[sim.usart.regs->ucsrb] & SIM_UCSRB_RXEN)) {
+	while (!sim_stop && rc == 0 && world_cycle(&sim.world) < SIM_BOOT_MAX_CYCLES &&
+	       !(sim.gateway.avr->data[sim.gateway.usart.regs->ucsrb] & SIM_UCSRB_RXEN)) {
 		rc = sim_batch(&sim);
 	}
 	if (rc == 0 && !sim_stop) {
@@ -555,7 +645,7 @@ int main(int argc, char **argv)
 	}
 	pty_close(&sim.pty);
 	control_close(&sim.control);
-	signals_vcd_close(&sim.bm.signals, sim.avr->cycle);
-	trace_close(&sim.trace);
+	vcd_close(&sim.vcd, world_cycle(&sim.world));
+	trace_close(&sim.world.trace);
 	return rc;
 }

@@ -34,21 +34,23 @@ signal_t *signal_find(signals_t *set, const char *name)
 
 static void signals_vcd_queue(signals_t *set, const signal_t *s, uint64_t cycle)
 {
-	if (!set->vcd) {
+	vcd_t *v = set->vcd;
+
+	if (!v) {
 		return;
 	}
-	if (set->npending == set->cap) {
-		size_t cap = set->cap ? set->cap * 2 : 4096;
-		vcd_event_t *p = realloc(set->pending, cap * sizeof(*p));
+	if (v->npending == v->cap) {
+		size_t cap = v->cap ? v->cap * 2 : 4096;
+		vcd_event_t *p = realloc(v->pending, cap * sizeof(*p));
 
 		if (!p) {
 			return;
 		}
-		set->pending = p;
-		set->cap = cap;
+		v->pending = p;
+		v->cap = cap;
 	}
-	set->pending[set->npending++] = (vcd_event_t) {
-		.cycle = cycle, .seq = set->seq++, .sig = (uint16_t)s->index,
+	v->pending[v->npending++] = (vcd_event_t) {
+		.cycle = cycle, .seq = v->seq++, .sig = (uint16_t)(set->vcd_base + s->index),
 		.level = (uint8_t)s->level,
 	};
 }
@@ -99,17 +101,15 @@ const signal_edge_t *signal_edge(const signal_t *s, unsigned i)
 
 /* --- VCD ----------------------------------------------------------------- */
 
-static uint32_t vcd_frequency;
-
 /* Picoseconds of CYCLE, rounded: a cycle at 7.3728 MHz is 135633.68 ps, so
  * no VCD timescale holds it exactly; 1 ps keeps the order and the error
  * below half a picosecond. The cycle of every change is also known from
  * the trace and the control interface. */
-static uint64_t vcd_ps(uint64_t cycle)
+static uint64_t vcd_ps(const vcd_t *v, uint64_t cycle)
 {
 	unsigned __int128 t = (unsigned __int128)cycle * 1000000000000ull;
 
-	return (uint64_t)((t + vcd_frequency / 2) / vcd_frequency);
+	return (uint64_t)((t + v->frequency / 2) / v->frequency);
 }
 
 static void vcd_id(int index, char *out)
@@ -120,28 +120,43 @@ static void vcd_id(int index, char *out)
 	out[2] = 0;
 }
 
-int signals_vcd_open(signals_t *set, const char *path, uint32_t frequency)
+int vcd_open(vcd_t *v, const char *path, uint32_t frequency, signals_t *const *sets,
+	     const char *const *scope, const char *const *prefix, int n)
 {
 	char id[3];
+	int base = 0;
 
-	set->vcd = fopen(path, "w");
-	if (!set->vcd) {
+	memset(v, 0, sizeof(*v));
+	v->file = fopen(path, "w");
+	if (!v->file) {
 		return -1;
 	}
-	vcd_frequency = frequency;
-	fprintf(set->vcd, "$comment orfa-sim, %" PRIu32 " Hz: one CPU cycle is %.3f ps $end\n",
+	v->frequency = frequency;
+	fprintf(v->file, "$comment orfa-sim, %" PRIu32 " Hz: one CPU cycle is %.3f ps $end\n",
 		frequency, 1e12 / frequency);
-	fprintf(set->vcd, "$timescale 1ps $end\n$scope module board $end\n");
-	for (int i = 0; i < set->count; i++) {
-		vcd_id(i, id);
-		fprintf(set->vcd, "$var wire 1 %s %s $end\n", id, set->sig[i]->name);
+	fprintf(v->file, "$timescale 1ps $end\n");
+	for (int k = 0; k < n; k++) {
+		signals_t *set = sets[k];
+
+		set->vcd = v;
+		set->vcd_base = base;
+		fprintf(v->file, "$scope module %s $end\n", scope[k]);
+		for (int i = 0; i < set->count; i++) {
+			vcd_id(base + i, id);
+			fprintf(v->file, "$var wire 1 %s %s%s $end\n", id, prefix[k],
+				set->sig[i]->name);
+		}
+		fprintf(v->file, "$upscope $end\n");
+		base += set->count;
 	}
-	fprintf(set->vcd, "$upscope $end\n$enddefinitions $end\n#0\n$dumpvars\n");
-	for (int i = 0; i < set->count; i++) {
-		vcd_id(i, id);
-		fprintf(set->vcd, "%d%s\n", set->sig[i]->level, id);
+	fprintf(v->file, "$enddefinitions $end\n#0\n$dumpvars\n");
+	for (int k = 0; k < n; k++) {
+		for (int i = 0; i < sets[k]->count; i++) {
+			vcd_id(sets[k]->vcd_base + i, id);
+			fprintf(v->file, "%d%s\n", sets[k]->sig[i]->level, id);
+		}
 	}
-	fprintf(set->vcd, "$end\n");
+	fprintf(v->file, "$end\n");
 	return 0;
 }
 
@@ -155,42 +170,41 @@ static int vcd_cmp(const void *a, const void *b)
 	return x->seq < y->seq ? -1 : (x->seq > y->seq);
 }
 
-void signals_vcd_flush(signals_t *set, uint64_t now, int all)
+void vcd_flush(vcd_t *v, uint64_t now, int all)
 {
 	size_t n = 0;
 	char id[3];
 
-	if (!set->vcd || !set->npending) {
+	if (!v->file || !v->npending) {
 		return;
 	}
-	qsort(set->pending, set->npending, sizeof(*set->pending), vcd_cmp);
-	while (n < set->npending &&
-	       (all || set->pending[n].cycle + SIGNALS_VCD_LAG < now)) {
-		const vcd_event_t *e = &set->pending[n++];
-		uint64_t cycle = e->cycle < set->vcd_last ? set->vcd_last : e->cycle;
+	qsort(v->pending, v->npending, sizeof(*v->pending), vcd_cmp);
+	while (n < v->npending && (all || v->pending[n].cycle + SIGNALS_VCD_LAG < now)) {
+		const vcd_event_t *e = &v->pending[n++];
+		uint64_t cycle = e->cycle < v->last ? v->last : e->cycle;
 
-		if (!set->vcd_have_time || cycle != set->vcd_last) {
-			fprintf(set->vcd, "#%" PRIu64 "\n", vcd_ps(cycle));
-			set->vcd_last = cycle;
-			set->vcd_have_time = 1;
+		if (!v->have_time || cycle != v->last) {
+			fprintf(v->file, "#%" PRIu64 "\n", vcd_ps(v, cycle));
+			v->last = cycle;
+			v->have_time = 1;
 		}
 		vcd_id(e->sig, id);
-		fprintf(set->vcd, "%d%s\n", e->level, id);
+		fprintf(v->file, "%d%s\n", e->level, id);
 	}
-	memmove(set->pending, set->pending + n, (set->npending - n) * sizeof(*set->pending));
-	set->npending -= n;
+	memmove(v->pending, v->pending + n, (v->npending - n) * sizeof(*v->pending));
+	v->npending -= n;
 }
 
-void signals_vcd_close(signals_t *set, uint64_t now)
+void vcd_close(vcd_t *v, uint64_t now)
 {
-	if (!set->vcd) {
+	if (!v->file) {
 		return;
 	}
-	signals_vcd_flush(set, now, 1);
-	fprintf(set->vcd, "#%" PRIu64 "\n", vcd_ps(now));
-	fclose(set->vcd);
-	set->vcd = NULL;
-	free(set->pending);
-	set->pending = NULL;
-	set->npending = set->cap = 0;
+	vcd_flush(v, now, 1);
+	fprintf(v->file, "#%" PRIu64 "\n", vcd_ps(v, now));
+	fclose(v->file);
+	v->file = NULL;
+	free(v->pending);
+	v->pending = NULL;
+	v->npending = v->cap = 0;
 }

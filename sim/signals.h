@@ -48,16 +48,24 @@ typedef struct vcd_event_t {
 	uint8_t level;
 } vcd_event_t;
 
+/* One VCD file for the signals of one or more boards. Events wait in a
+ * buffer until they are old enough to be in time order (some edges are
+ * stamped a few cycles in the past, and the boards of a world run a
+ * quantum apart). */
+typedef struct vcd_t {
+	FILE *file;
+	uint32_t frequency;
+	vcd_event_t *pending;
+	size_t npending, cap;
+	uint64_t seq, last;
+	int have_time;
+} vcd_t;
+
 typedef struct signals_t {
 	signal_t *sig[SIGNAL_MAX];
 	int count;
-	/* VCD: events wait in a buffer until they are old enough to be in
-	 * time order (some edges are stamped a few cycles in the past). */
-	FILE *vcd;
-	vcd_event_t *pending;
-	size_t npending, cap;
-	uint64_t seq, vcd_last;
-	int vcd_have_time;
+	vcd_t *vcd;			/* NULL: not in a VCD */
+	int vcd_base;			/* its signals' first VCD index */
 } signals_t;
 
 /* Register S under NAME with initial LEVEL. 0, or -1 when full. */
@@ -74,13 +82,16 @@ void signal_listen(signal_t *s, signal_listener_t fn, void *param);
 /* The i-th newest edge held (0 = newest); NULL past the end. */
 const signal_edge_t *signal_edge(const signal_t *s, unsigned i);
 
-/* VCD of every registered signal to PATH (call after all signal_add).
- * 0 or -1 with errno. */
-int signals_vcd_open(signals_t *set, const char *path, uint32_t frequency);
+/* A VCD at PATH of every signal of the N sets (call after all signal_add):
+ * set i in scope SCOPE[i], each signal named PREFIX[i] followed by its own
+ * name. 0 or -1 with errno. */
+int vcd_open(vcd_t *v, const char *path, uint32_t frequency, signals_t *const *sets,
+	     const char *const *scope, const char *const *prefix, int n);
 
-/* Write buffered VCD events older than NOW - SIGNALS_VCD_LAG cycles. */
+/* Write buffered VCD events older than NOW - SIGNALS_VCD_LAG cycles (all
+ * with ALL). */
 #define SIGNALS_VCD_LAG 8192
-void signals_vcd_flush(signals_t *set, uint64_t now, int all);
-void signals_vcd_close(signals_t *set, uint64_t now);
+void vcd_flush(vcd_t *v, uint64_t now, int all);
+void vcd_close(vcd_t *v, uint64_t now);
 
 #endif

@@ -1,6 +1,7 @@
 /*
- * twi.c: TWI model, master mode.
+ * twi.c: TWI model, master and slave mode (twi.h).
  */
+#include <stddef.h>
 #include <string.h>
 
 #include "sim_regbit.h"
@@ -19,6 +20,10 @@ enum {
 	TW_MT_ARB_LOST = 0x38,
 	TW_MR_SLA_ACK = 0x40, TW_MR_SLA_NACK = 0x48,
 	TW_MR_DATA_ACK = 0x50, TW_MR_DATA_NACK = 0x58,
+	TW_SR_SLA_ACK = 0x60, TW_SR_DATA_ACK = 0x80, TW_SR_DATA_NACK = 0x88,
+	TW_SR_STOP = 0xa0,
+	TW_ST_SLA_ACK = 0xa8, TW_ST_DATA_ACK = 0xb8, TW_ST_DATA_NACK = 0xc0,
+	TW_ST_LAST_DATA = 0xc8,
 	TW_NO_INFO = 0xf8,
 };
 
@@ -71,6 +76,9 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 	int ack;
 
 	(void)avr;
+	/* The bus events carry the exact completion cycle, not the cycle
+	 * simavr got round to calling us (1-4 later). */
+	when = t->op_end;
 	switch (t->op) {
 	case TWI_OP_START:
 		twi_bus_start(t->bus, when);
@@ -84,8 +92,10 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 		*twcr &= (uint8_t)~BIT(TWCR_TWSTO);
 		t->status = TW_NO_INFO;
 		if (t->op == TWI_OP_STOP_START) {
+			/* nothing holds SCL right after a STOP (twi_bus.h) */
 			t->op = TWI_OP_START;
-			return when + twi_scl_period(t);
+			t->op_end = when + twi_scl_period(t);
+			return t->op_end;
 		}
 		t->op = TWI_OP_NONE;
 		twi_sync(t);	/* no TWINT after a STOP */
@@ -112,11 +122,206 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 	return 0;
 }
 
+/* The operation in progress begins on the bus at cycle START. */
+static void twi_schedule(twi_t *t, avr_cycle_count_t start)
+{
+	avr_cycle_count_t now = t->avr->cycle;
+
+	t->op_end = start + t->op_periods * twi_scl_period(t);
+	avr_cycle_timer_register(t->avr, t->op_end > now ? t->op_end - now : 1, twi_timer, t);
+}
+
+static void twi_master_resume(twi_bus_master_t *m, uint64_t cycle)
+{
+	twi_t *t = (twi_t *)((char *)m - offsetof(twi_t, master));
+
+	if (t->op != TWI_OP_NONE) {
+		twi_schedule(t, cycle);
+	}
+}
+
+/* Start OP, PERIODS SCL periods long, as soon as no slave holds SCL. */
 static void twi_begin(twi_t *t, twi_op_t op, avr_cycle_count_t periods)
 {
+	twi_bus_op_t kind = TWI_BUS_DATA;
+	uint64_t at;
+
+	switch (op) {
+	case TWI_OP_START:
+		kind = TWI_BUS_START;
+		break;
+	case TWI_OP_STOP:
+	case TWI_OP_STOP_START:
+		kind = TWI_BUS_STOP;
+		break;
+	case TWI_OP_SLA:
+		kind = TWI_BUS_ADDR;
+		break;
+	default:
+		break;
+	}
 	t->op = op;
-	avr_cycle_timer_register(t->avr, periods * twi_scl_period(t), twi_timer, t);
+	t->op_periods = periods;
+	t->op_end = 0;
+	at = twi_bus_begin(t->bus, &t->master, kind, t->avr->cycle);
+	if (at) {
+		twi_schedule(t, at);
+	}
 }
+
+/* --- slave mode ----------------------------------------------------------- */
+
+static void twi_slave_rise(twi_t *t)
+{
+	t->sl_pending = 0;
+	t->status = t->sl_status;
+	if (t->sl_has_data) {
+		*twi_reg(t, t->regs->twdr) = t->sl_data;
+	}
+	*twi_reg(t, t->regs->twcr) |= BIT(TWCR_TWINT);
+	twi_sync(t);
+}
+
+static avr_cycle_count_t twi_slave_timer(avr_t *avr, avr_cycle_count_t when, void *param)
+{
+	(void)avr;
+	(void)when;
+	twi_slave_rise(param);
+	return 0;
+}
+
+/* A bus event for this slave completed at the bus's cycle: TWINT rises
+ * then with STATUS (and DATA in TWDR), and SCL is held low until the
+ * firmware clears TWINT. This board may be behind the master inside the
+ * lock-step quantum: then the rise waits for its cycle. */
+static void twi_slave_deliver(twi_t *t, uint8_t status, int has_data, uint8_t data,
+			      twi_hold_t hold)
+{
+	uint64_t at = t->bus->cycle;
+
+	twi_bus_hold(t->bus, &t->dev, hold);
+	t->sl_status = status;
+	t->sl_has_data = has_data;
+	t->sl_data = data;
+	t->sl_at = at;
+	if (t->avr->cycle >= at) {
+		twi_slave_rise(t);
+	} else {
+		t->sl_pending = 1;
+		avr_cycle_timer_register(t->avr, at - t->avr->cycle, twi_slave_timer, t);
+	}
+}
+
+/* The firmware cleared TWINT (CR: the value written) while holding SCL. */
+static void twi_slave_release(twi_t *t, uint8_t cr)
+{
+	t->sl_ea = !!(cr & BIT(TWCR_TWEA));
+	t->sl_tx = *twi_reg(t, t->regs->twdr);
+	t->status = TW_NO_INFO;
+	twi_bus_release(t->bus, &t->dev, t->avr->cycle, t->sl_addr);
+}
+
+/* TWI off or reset: forget the transfer, let SCL go. */
+static void twi_slave_abandon(twi_t *t)
+{
+	if (t->sl_pending) {
+		avr_cycle_timer_cancel(t->avr, twi_slave_timer, t);
+		t->sl_pending = 0;
+	}
+	t->addressed = 0;
+	twi_bus_release(t->bus, &t->dev, t->avr->cycle, t->sl_addr);
+}
+
+static twi_t *twi_of_dev(twi_dev_t *dev)
+{
+	return (twi_t *)((char *)dev - offsetof(twi_t, dev));
+}
+
+static int twi_dev_start(twi_dev_t *dev, uint8_t addr8)
+{
+	twi_t *t = twi_of_dev(dev);
+	uint8_t cr = *twi_reg(t, t->regs->twcr);
+	uint8_t twar = *twi_reg(t, t->regs->twar);
+
+	/* A master never answers its own address; a slave answers only while
+	 * enabled with TWEA and idle (the bus waits for a TWINT it holds). */
+	if (t->owner || t->op != TWI_OP_NONE || t->sl_pending || dev->hold ||
+	    !(cr & BIT(TWCR_TWEN)) || !(cr & BIT(TWCR_TWEA)) || (cr & BIT(TWCR_TWINT)) ||
+	    (addr8 & 0xfe) != (twar & 0xfe)) {
+		return 0;
+	}
+	t->sl_addr = addr8 & 0xfe;
+	if (addr8 & 1) {
+		t->addressed = TWI_SLAVE_TX;
+		twi_slave_deliver(t, TW_ST_SLA_ACK, 0, 0, TWI_HOLD_ALL);
+	} else {
+		t->addressed = TWI_SLAVE_RX;
+		twi_slave_deliver(t, TW_SR_SLA_ACK, 0, 0, TWI_HOLD_ALL);
+	}
+	return 1;
+}
+
+static int twi_dev_write(twi_dev_t *dev, uint8_t byte)
+{
+	twi_t *t = twi_of_dev(dev);
+
+	if (t->addressed != TWI_SLAVE_RX) {
+		return 0;
+	}
+	if (t->sl_ea) {
+		twi_slave_deliver(t, TW_SR_DATA_ACK, 1, byte, TWI_HOLD_ALL);
+		return 1;
+	}
+	/* NACKed: not addressed any more until the next START */
+	t->addressed = 0;
+	twi_slave_deliver(t, TW_SR_DATA_NACK, 1, byte, TWI_HOLD_ALL);
+	return 0;
+}
+
+static uint8_t twi_dev_read(twi_dev_t *dev, int master_acks)
+{
+	twi_t *t = twi_of_dev(dev);
+	uint8_t byte = t->sl_tx;
+	uint8_t status;
+
+	if (t->addressed != TWI_SLAVE_TX) {
+		return 0xff;		/* SDA released: pull-ups */
+	}
+	if (!master_acks) {
+		status = TW_ST_DATA_NACK;
+	} else if (t->sl_ea) {
+		status = TW_ST_DATA_ACK;
+	} else {
+		status = TW_ST_LAST_DATA;
+	}
+	if (status != TW_ST_DATA_ACK) {
+		t->addressed = 0;
+	}
+	twi_slave_deliver(t, status, 0, 0, TWI_HOLD_ALL);
+	return byte;
+}
+
+/* STOP, or a repeated START, ends a transfer this slave takes part in. */
+static void twi_dev_end(twi_dev_t *dev)
+{
+	twi_t *t = twi_of_dev(dev);
+
+	if (t->addressed == TWI_SLAVE_RX) {
+		t->addressed = 0;
+		twi_slave_deliver(t, TW_SR_STOP, 0, 0, TWI_HOLD_ADDR);
+	} else {
+		/* the datasheet gives a transmitter no code for it */
+		t->addressed = 0;
+	}
+}
+
+static const twi_dev_ops_t twi_dev_ops = {
+	.start = twi_dev_start,
+	.write = twi_dev_write,
+	.read = twi_dev_read,
+	.stop = twi_dev_end,
+	.bus_start = twi_dev_end,
+};
 
 /* TWINT was cleared with TWEN set: start what TWSTA/TWSTO and the state
  * ask for. */
@@ -173,6 +378,9 @@ static void twi_write_twcr(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *para
 	if (t->op == TWI_OP_STOP || t->op == TWI_OP_STOP_START) {
 		cr |= BIT(TWCR_TWSTO);
 	}
+	if (clear_int && t->dev.hold && (old & BIT(TWCR_TWINT)) && !t->sl_pending) {
+		twi_slave_release(t, (uint8_t)v);
+	}
 	if (clear_int) {
 		keep &= (uint8_t)~BIT(TWCR_TWINT);
 	}
@@ -181,6 +389,8 @@ static void twi_write_twcr(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *para
 	if (!(v & BIT(TWCR_TWEN))) {
 		/* TWI off: transfers end, the lines are released. */
 		avr_cycle_timer_cancel(avr, twi_timer, t);
+		twi_bus_cancel(t->bus, &t->master);
+		twi_slave_abandon(t);
 		t->op = TWI_OP_NONE;
 		t->owner = 0;
 		t->status = TW_NO_INFO;
@@ -241,6 +451,10 @@ static void twi_reset(avr_io_t *io)
 	twi_t *t = (twi_t *)io;
 	avr_t *avr = t->avr;
 
+	/* simavr wiped the cycle timers already */
+	t->sl_pending = 0;
+	twi_bus_cancel(t->bus, &t->master);
+	twi_slave_abandon(t);
 	t->op = TWI_OP_NONE;
 	t->owner = 0;
 	t->status = TW_NO_INFO;
@@ -260,6 +474,10 @@ void twi_init(twi_t *t, avr_t *avr, const mcu_twi_regs_t *regs, twi_bus_t *bus)
 	t->bus = bus;
 	t->io.kind = "orfa-twi";
 	t->io.reset = twi_reset;
+	t->master.resume = twi_master_resume;
+	t->dev.ops = &twi_dev_ops;
+	t->dev.name = "avr-twi";
+	twi_bus_attach(bus, &t->dev);
 
 	t->vect_twi = (avr_int_vector_t) {
 		.vector = regs->vect_twi,

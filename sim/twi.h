@@ -9,10 +9,14 @@
  * P = 16 + 2*TWBR*4^TWPS cycles; START and STOP take P, a byte with its
  * acknowledge 9P; TWINT rises at the end.
  *
- * Slave mode (a later issue) hooks in at two points: a twi_dev_t embedded
- * here and attached to the bus (its start() compares TWAR, sets TWSR
- * 60/A8/..., raises TWINT and holds the bus: clock stretching), and the
- * "TWINT cleared while addressed" branch of twi_action().
+ * Slave mode: every TWI is also a device on the bus (twi_t.dev). With TWEN
+ * and TWEA set it acknowledges its TWAR address (general call not
+ * modelled) and gives the datasheet's slave codes 60/80/88/A0 (receiver)
+ * and A8/B8/C0/C8 (transmitter). Its TWINT rises at the cycle the master's
+ * operation completes (the end of the acknowledge bit, or the STOP /
+ * repeated START); while it is set the slave holds SCL low (twi_bus_hold)
+ * and the master's next operation waits until the firmware clears TWINT,
+ * then takes its normal time from that release (clock stretching).
  */
 #ifndef SIM_TWI_H
 #define SIM_TWI_H
@@ -47,7 +51,25 @@ typedef struct twi_t {
 	int owner;			/* this master holds the bus */
 	twi_op_t op;			/* operation in progress (TWINT low) */
 	int op_ack;			/* RX: TWEA when the byte started */
+	avr_cycle_count_t op_periods;	/* its length in SCL periods */
+	avr_cycle_count_t op_end;	/* the cycle it completes (0: waits for SCL) */
+	twi_bus_master_t master;	/* the bus resumes a waiting operation here */
+
+	/* slave mode */
+	twi_dev_t dev;			/* this TWI as a device on the bus */
+	int addressed;			/* 0, or TWI_SLAVE_RX / TWI_SLAVE_TX */
+	int sl_ea;			/* TWEA when TWINT was last cleared */
+	uint8_t sl_tx;			/* TWDR when TWINT was last cleared (ST) */
+	int sl_pending;			/* a TWINT rise is scheduled */
+	uint8_t sl_status;		/* ... with this status */
+	int sl_has_data;		/* ... and this received byte */
+	uint8_t sl_data;
+	avr_cycle_count_t sl_at;	/* ... at this cycle */
+	uint8_t sl_addr;		/* TWAR address it answered (trace) */
 } twi_t;
+
+#define TWI_SLAVE_RX 1
+#define TWI_SLAVE_TX 2
 
 /* Take over the TWI described by REGS on AVR (after avr_init). */
 void twi_init(twi_t *t, avr_t *avr, const mcu_twi_regs_t *regs, twi_bus_t *bus);

@@ -2,6 +2,7 @@
  * twi_bus.c: the bus object; it also writes the bus's trace lines, so a bus
  * shared by several simulated boards is traced once.
  */
+#include <inttypes.h>
 #include <stddef.h>
 
 #include "twi_bus.h"
@@ -13,7 +14,10 @@ void twi_bus_init(twi_bus_t *bus, trace_t *trace)
 	bus->busy = 0;
 	bus->trace = trace;
 	bus->activity = 0;
-	bus->now = 0;
+	bus->cycle = 0;
+	bus->waiter = NULL;
+	bus->released_all = 0;
+	bus->released_addr = 0;
 }
 
 void twi_bus_attach(twi_bus_t *bus, twi_dev_t *dev)
@@ -24,21 +28,28 @@ void twi_bus_attach(twi_bus_t *bus, twi_dev_t *dev)
 		link = &(*link)->next;
 	}
 	dev->next = NULL;
+	dev->hold = TWI_HOLD_NONE;
 	*link = dev;
 }
 
 void twi_bus_start(twi_bus_t *bus, uint64_t cycle)
 {
+	bus->cycle = cycle;
 	bus->busy = 1;
 	bus->selected = NULL;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi start");
+	for (twi_dev_t *d = bus->devs; d; d = d->next) {
+		if (d->ops->bus_start) {
+			d->ops->bus_start(d);
+		}
+	}
 }
 
 int twi_bus_address(twi_bus_t *bus, uint64_t cycle, uint8_t addr8)
 {
+	bus->cycle = cycle;
 	bus->selected = NULL;
-	bus->now = cycle;
 	for (twi_dev_t *d = bus->devs; d; d = d->next) {
 		if (d->ops->start(d, addr8) && !bus->selected) {
 			bus->selected = d;
@@ -52,9 +63,10 @@ int twi_bus_address(twi_bus_t *bus, uint64_t cycle, uint8_t addr8)
 
 int twi_bus_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte)
 {
-	bus->now = cycle;
-	int ack = bus->selected ? bus->selected->ops->write(bus->selected, byte) : 0;
+	int ack;
 
+	bus->cycle = cycle;
+	ack = bus->selected ? bus->selected->ops->write(bus->selected, byte) : 0;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi write %02X %s", byte, ack ? "ack" : "nack");
 	return ack;
@@ -64,7 +76,7 @@ uint8_t twi_bus_read(twi_bus_t *bus, uint64_t cycle, int master_acks)
 {
 	uint8_t byte = 0xff;
 
-	bus->now = cycle;
+	bus->cycle = cycle;
 	if (bus->selected) {
 		byte = bus->selected->ops->read(bus->selected, master_acks);
 	}
@@ -76,7 +88,7 @@ uint8_t twi_bus_read(twi_bus_t *bus, uint64_t cycle, int master_acks)
 
 void twi_bus_stop(twi_bus_t *bus, uint64_t cycle)
 {
-	bus->now = cycle;
+	bus->cycle = cycle;
 	for (twi_dev_t *d = bus->devs; d; d = d->next) {
 		d->ops->stop(d);
 	}
@@ -84,4 +96,88 @@ void twi_bus_stop(twi_bus_t *bus, uint64_t cycle)
 	bus->busy = 0;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi stop");
+}
+
+/* Does a hold HOW stop an operation OP? */
+static int twi_bus_blocks(twi_hold_t how, twi_bus_op_t op)
+{
+	return how == TWI_HOLD_ALL || (how == TWI_HOLD_ADDR && op == TWI_BUS_ADDR);
+}
+
+static int twi_bus_blocked(const twi_bus_t *bus, twi_bus_op_t op)
+{
+	for (const twi_dev_t *d = bus->devs; d; d = d->next) {
+		if (twi_bus_blocks(d->hold, op)) {
+			return 1;
+		}
+	}
+	return 0;
+}
+
+uint64_t twi_bus_begin(twi_bus_t *bus, twi_bus_master_t *m, twi_bus_op_t op, uint64_t now)
+{
+	uint64_t free_at = bus->released_all;
+	uint8_t by = bus->released_all_by;
+
+	if (op == TWI_BUS_ADDR && bus->released_addr > free_at) {
+		free_at = bus->released_addr;
+		by = bus->released_addr_by;
+	}
+	if (twi_bus_blocked(bus, op)) {
+		bus->waiter = m;
+		bus->waiter_op = op;
+		bus->waiter_since = now;
+		return 0;
+	}
+	/* A slave that ran ahead inside the lock-step quantum may have
+	 * released after NOW: the operation begins at the release. */
+	if (free_at > now) {
+		trace_event(bus->trace, free_at, "twi stretch %02X %" PRIu64, by, free_at - now);
+		return free_at;
+	}
+	return now;
+}
+
+void twi_bus_cancel(twi_bus_t *bus, twi_bus_master_t *m)
+{
+	if (bus->waiter == m) {
+		bus->waiter = NULL;
+	}
+}
+
+void twi_bus_hold(twi_bus_t *bus, twi_dev_t *dev, twi_hold_t how)
+{
+	(void)bus;
+	dev->hold = how;
+}
+
+void twi_bus_release(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle, uint8_t addr8)
+{
+	twi_hold_t how = dev->hold;
+
+	if (how == TWI_HOLD_NONE) {
+		return;
+	}
+	dev->hold = TWI_HOLD_NONE;
+	if (how == TWI_HOLD_ALL && cycle >= bus->released_all) {
+		bus->released_all = cycle;
+		bus->released_all_by = addr8;
+	} else if (how == TWI_HOLD_ADDR && cycle >= bus->released_addr) {
+		bus->released_addr = cycle;
+		bus->released_addr_by = addr8;
+	}
+	if (!bus->waiter || !twi_bus_blocks(how, bus->waiter_op)) {
+		return;
+	}
+	if (cycle > bus->waiter_since) {
+		trace_event(bus->trace, cycle, "twi stretch %02X %" PRIu64, addr8,
+			    cycle - bus->waiter_since);
+	}
+	if (!twi_bus_blocked(bus, bus->waiter_op)) {
+		twi_bus_master_t *m = bus->waiter;
+		uint64_t at = cycle > bus->waiter_since ? cycle : bus->waiter_since;
+
+		bus->waiter = NULL;
+		m->resume(m, at);
+	}
 }

@@ -5,10 +5,12 @@
  * acknowledged; a read with nobody selected returns FF (pull-ups).
  *
  * A device is a context struct whose first member is a twi_dev_t (simavr's
- * part style). Devices planned beyond the EEPROM plug in here unchanged:
- * another simulated board's TWI in slave mode becomes a device whose
- * callbacks drive its TWSR/TWINT, and a second master adds arbitration at
- * twi_bus_start (status 0x38) without changes to the devices.
+ * part style). Simple devices (the EEPROM) answer at once. A simulated
+ * board's TWI in slave mode is a device too; it may hold SCL low (clock
+ * stretching) while its firmware has TWINT set: twi_bus_hold() and
+ * twi_bus_release(). A master asks twi_bus_begin() before each operation;
+ * while a device holds SCL the operation waits, and the bus resumes the
+ * master with the release's cycle. One master per bus (no arbitration).
  */
 #ifndef SIM_TWI_BUS_H
 #define SIM_TWI_BUS_H
@@ -29,13 +31,41 @@ typedef struct twi_dev_ops_t {
 	uint8_t (*read)(twi_dev_t *dev, int master_acks);
 	/* STOP on the bus (all devices). */
 	void (*stop)(twi_dev_t *dev);
+	/* Optional (NULL: not told): a START condition completed (all
+	 * devices), before any address; a repeated START ends a transfer. */
+	void (*bus_start)(twi_dev_t *dev);
 } twi_dev_ops_t;
+
+/* How a device holds SCL low. */
+typedef enum twi_hold_t {
+	TWI_HOLD_NONE = 0,
+	/* Low after an acknowledge bit: every master operation waits. */
+	TWI_HOLD_ALL,
+	/* TWINT set by a STOP or repeated START (0xA0): SCL was high then,
+	 * so the START/STOP pass, but the next address byte waits. */
+	TWI_HOLD_ADDR,
+} twi_hold_t;
 
 struct twi_dev_t {
 	const twi_dev_ops_t *ops;
 	const char *name;
 	twi_dev_t *next;
+	twi_hold_t hold;	/* set through twi_bus_hold/twi_bus_release only */
 };
+
+/* What a master is about to put on the bus (decides which holds stop it). */
+typedef enum twi_bus_op_t {
+	TWI_BUS_START,		/* START, repeated START */
+	TWI_BUS_ADDR,		/* address byte */
+	TWI_BUS_DATA,		/* data byte, either direction */
+	TWI_BUS_STOP,
+} twi_bus_op_t;
+
+/* A master's handle: the bus calls RESUME when its waiting operation may
+ * begin, with the cycle it begins at. */
+typedef struct twi_bus_master_t {
+	void (*resume)(struct twi_bus_master_t *m, uint64_t cycle);
+} twi_bus_master_t;
 
 typedef struct twi_bus_t {
 	twi_dev_t *devs;
@@ -43,8 +73,15 @@ typedef struct twi_bus_t {
 	int busy;		/* between START and STOP */
 	trace_t *trace;
 	uint32_t activity;	/* bumps on every bus event */
-	uint64_t now;		/* cycle of the event being delivered, for
-				 * devices that keep time (SRF08 ranging) */
+	uint64_t cycle;		/* cycle of the event being delivered to devices */
+
+	/* clock stretching */
+	twi_bus_master_t *waiter;	/* master whose operation waits */
+	twi_bus_op_t waiter_op;
+	uint64_t waiter_since;		/* cycle it wanted to begin */
+	uint64_t released_all;		/* last release of a TWI_HOLD_ALL */
+	uint64_t released_addr;		/* last release of a TWI_HOLD_ADDR */
+	uint8_t released_all_by, released_addr_by;	/* their slaves' addresses */
 } twi_bus_t;
 
 void twi_bus_init(twi_bus_t *bus, trace_t *trace);
@@ -56,5 +93,20 @@ int twi_bus_address(twi_bus_t *bus, uint64_t cycle, uint8_t addr8);
 int twi_bus_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte);
 uint8_t twi_bus_read(twi_bus_t *bus, uint64_t cycle, int master_acks);
 void twi_bus_stop(twi_bus_t *bus, uint64_t cycle);
+
+/* Master M wants to begin OP at cycle NOW. Returns the cycle it begins at
+ * (NOW, or later when a device released SCL after NOW), or 0 when a device
+ * holds SCL: M->resume() is called on the release. */
+uint64_t twi_bus_begin(twi_bus_t *bus, twi_bus_master_t *m, twi_bus_op_t op, uint64_t now);
+
+/* M's waiting operation is abandoned (TWI off, reset). */
+void twi_bus_cancel(twi_bus_t *bus, twi_bus_master_t *m);
+
+/* DEV holds SCL low (from the event being delivered on). */
+void twi_bus_hold(twi_bus_t *bus, twi_dev_t *dev, twi_hold_t how);
+
+/* DEV (answering at ADDR8, for the trace) lets SCL go at CYCLE. A master
+ * that waited on it gets a `twi stretch ADDR8 CYCLES` trace line. */
+void twi_bus_release(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle, uint8_t addr8);
 
 #endif

@@ -45,11 +45,26 @@ def terminal(gw: Gateway, stdin: TextIO, stdout: TextIO) -> int:
         stdout.flush()
 
 
+def slave_spec(text: str):
+    """`BOARD:ADDR[:ELF]` -> (board, addr, elf or None: the board's slave build)."""
+    parts = text.split(":", 2)
+    if len(parts) < 2 or parts[0] not in BOARDS:
+        raise argparse.ArgumentTypeError(
+            "%r: BOARD:ADDR[:ELF] with BOARD one of %s" % (text, ", ".join(BOARDS)))
+    try:
+        addr = int(parts[1], 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0x10" % text) from None
+    if addr & 1 or not 0x10 <= addr <= 0xEE:
+        raise argparse.ArgumentTypeError("%r: ADDR must be even, 0x10..0xEE" % text)
+    return (parts[0], addr, parts[2] if len(parts) == 3 and parts[2] else None)
+
+
 def cmd_sim(args) -> int:
     try:
         board = SimBoard(args.board, eeproms=args.eeprom, trace=False,
-                         firmware=args.firmware).start()
-    except SimError as exc:
+                         firmware=args.firmware, slaves=args.slave).start()
+    except (SimError, ValueError) as exc:
         print("orfa: %s" % exc, file=sys.stderr)
         return 2
     stop = []
@@ -96,6 +111,10 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--firmware", help="ELF to run (default: build/<board>-gate/orfa.elf)")
     sim.add_argument("--terminal", action="store_true",
                      help="also open a line console on the board")
+    sim.add_argument("--slave", type=slave_spec, action="append", default=[],
+                     metavar="BOARD:ADDR[:ELF]",
+                     help="a slave board on the bus (repeatable); ELF defaults to"
+                          " build/<board>-slave/orfa.elf")
     sim.set_defaults(func=cmd_sim)
 
     req = sub.add_parser("request", help="send requests, print the replies")

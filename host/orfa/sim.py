@@ -7,6 +7,7 @@ simulator's stdout/stderr), so any number run in parallel.
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -63,6 +64,20 @@ def parse_trace(text: str) -> List[TraceEvent]:
     return [parse_trace_line(line) for line in text.splitlines() if line.strip()]
 
 
+#: A slave board on the simulated bus: (board, 8-bit address, ELF or None).
+#: None means the board's slave build, build/<board>-slave/orfa.elf.
+SlaveSpec = Tuple[str, int, Union[str, Path, None]]
+
+
+def slave_option(spec: SlaveSpec) -> str:
+    """The simulator's `--slave BOARD:ADDR:ELF` value of a SlaveSpec."""
+    board, addr, elf = spec
+    if board not in BOARDS:
+        raise ValueError("slave board must be one of %s" % (BOARDS,))
+    path = Path(elf) if elf else firmware_path(board, "slave")
+    return "%s:0x%02X:%s" % (board, addr, path)
+
+
 class SimBoard:
     """A simulated ORFA board running as a child process; a context manager.
 
@@ -73,6 +88,11 @@ class SimBoard:
     avcc/aref (mV) set the board's SPI devices and analog inputs; srf08=[0xE0]
     puts SRF08 range finders on the I2C bus (their `srf08` control request
     sets what they sense).
+
+    slaves=[("m128s", 0x10, elf_path), ...] puts further boards, each running
+    its own firmware (elf_path None: build/<board>-slave/orfa.elf), on the
+    same I2C bus as I2C slaves: a robot. The control socket reaches them as
+    `10/servo3` (signals) and `@10` (other requests); see docs/simulator.md.
     """
 
     def __init__(self, board: str = "m32d", eeproms: Sequence[int] = (),
@@ -80,7 +100,8 @@ class SimBoard:
                  start_timeout: float = 15.0, extra_args: Sequence[str] = (),
                  control: bool = False, vcd: bool = False, spi: Sequence[str] = (),
                  adc: Optional[Dict[int, int]] = None, avcc: Optional[int] = None,
-                 aref: Optional[int] = None, srf08: Sequence[int] = ()):
+                 aref: Optional[int] = None, srf08: Sequence[int] = (),
+                 slaves: Sequence[SlaveSpec] = ()):
         if board not in BOARDS:
             raise ValueError("board must be one of %s" % (BOARDS,))
         self.board = board
@@ -96,6 +117,8 @@ class SimBoard:
         self.adc = dict(adc or {})
         self.avcc = avcc
         self.aref = aref
+        self.slaves = tuple(slaves)
+        self.slave_options = [slave_option(spec) for spec in self.slaves]
         self.control_path: Optional[Path] = None
         self.vcd_path: Optional[Path] = None
         self._control: Optional[SimControl] = None
@@ -104,6 +127,7 @@ class SimBoard:
         self.trace_path: Optional[Path] = None
         self.proc: Optional[subprocess.Popen] = None
         self.banner = ""
+        self.final_stderr = ""
 
     # --- lifetime -------------------------------------------------------------
     def command(self) -> List[str]:
@@ -126,10 +150,13 @@ class SimBoard:
             cmd += ["--avcc", str(self.avcc)]
         if self.aref is not None:
             cmd += ["--aref", str(self.aref)]
+        for opt in self.slave_options:
+            cmd += ["--slave", opt]
         return cmd + list(self.extra_args) + [str(self.firmware)]
 
     def start(self) -> "SimBoard":
-        for path in (sim_path(), self.firmware):
+        slave_elfs = [Path(opt.split(":", 2)[2]) for opt in self.slave_options]
+        for path in [sim_path(), self.firmware] + slave_elfs:
             if not path.is_file():
                 raise SimError("%s is missing: %s" % (path, BUILD_HINT))
         self.dir = Path(tempfile.mkdtemp(prefix="orfa-sim-%s-" % self.board))
@@ -182,6 +209,7 @@ class SimBoard:
             self.proc = None
             self._stdout.close()
             self._stderr.close()
+            self.final_stderr = self._read("stderr")
         if self.dir is not None and not keep_dir:
             shutil.rmtree(self.dir, ignore_errors=True)
             self.dir = None
@@ -206,6 +234,13 @@ class SimBoard:
             self._control = SimControl(str(self.control_path))
         return self._control
 
+    def speed(self) -> Optional[float]:
+        """After stop(): world cycles per wall second while running free, in
+        MHz, from the simulator's exit line (each of the boards ran that many
+        cycles); None when it printed none."""
+        m = re.search(r"running free ([0-9.]+) simulated MHz", self.final_stderr)
+        return float(m.group(1)) if m else None
+
     @property
     def stderr(self) -> str:
         return self._read("stderr") if self.dir else ""
@@ -223,6 +258,12 @@ class SimBoard:
         """A position in the trace; trace_events(since=mark) gives what follows."""
         return len(self.trace_text().encode())
 
+    def stretches(self, since: int = 0) -> List[Tuple[int, int, int]]:
+        """[(cycle, slave address, cycles)] of the `twi stretch` trace lines:
+        a slave held SCL low and the master's next operation waited."""
+        return [(e.cycle, int(e.fields[0], 16), int(e.fields[1]))
+                for e in self.trace_events(since, ["twi stretch"])]
+
     def trace_events(self, since: int = 0, kinds: Optional[Iterable[str]] = None
                      ) -> List[TraceEvent]:
         """Parsed trace events after position `since`, optionally only some kinds.
@@ -237,3 +278,15 @@ class SimBoard:
             kinds = tuple(kinds)
             events = [e for e in events if e.kind.startswith(kinds)]
         return events
+
+
+class SimRobot(SimBoard):
+    """A gateway board and its slave boards on one simulated I2C bus.
+
+    SimRobot("m32d", slaves=[("m128s", 0x10, None), ("m128s", 0x12, None)])
+    is SimBoard with the gateway board first; every SimBoard option applies
+    (to the gateway's board, and the control socket reaches every board).
+    """
+
+    def __init__(self, gateway: str = "m32d", slaves: Sequence[SlaveSpec] = (), **kw):
+        super().__init__(gateway, slaves=slaves, **kw)

@@ -69,30 +69,51 @@ class SimControl:
         """Returns the cycle at which the wait ended (>= now + cycles)."""
         return int(self.request("wait %d" % cycles))
 
+    # --- which board ----------------------------------------------------------
+    #: A slave board's view (SimControl.slave) prefixes names with "10/" and
+    #: puts "@10" first in requests that name no signal; names that already
+    #: carry a prefix ("12/A5") are left alone, so any view reaches any board.
+    _prefix = ""
+    _at = ""
+
+    def _name(self, name: str) -> str:
+        return name if "/" in name else self._prefix + name
+
+    def _board(self, request: str) -> str:
+        if not self._at:
+            return request
+        cmd, _, rest = request.partition(" ")
+        return ("%s %s %s" % (cmd, self._at, rest)).rstrip()
+
+    def slave(self, addr: int) -> "SimControl":
+        """The same socket, aimed at the slave board with 8-bit address `addr`."""
+        return _SlaveView(self, addr)
+
     def pin(self, name: str) -> Tuple[int, str]:
         """(level, "out" | "in" | "in pullup" | "in ext" | "out oc" | "out spi")."""
-        level, how = self.request("pin %s" % name).split(" ", 1)
+        level, how = self.request("pin %s" % self._name(name)).split(" ", 1)
         return int(level), how
 
     def drive(self, name: str, value: Union[int, str, None]) -> None:
         """Drive pin NAME to 0 or 1; None or "z" releases it."""
         v = "z" if value is None or value == "z" else str(int(value))
-        self.request("drive %s %s" % (name, v))
+        self.request("drive %s %s" % (self._name(name), v))
 
-    def adc(self, ch: int, mv: int) -> None:
-        self.request("adc %d %d" % (ch, mv))
+    def adc(self, ch: Union[int, str], mv: int) -> None:
+        self.request("adc %s %d" % (self._name(str(ch)), mv))
 
     def avcc(self, mv: int) -> None:
-        self.request("avcc %d" % mv)
+        self.request(self._board("avcc %d" % mv))
 
     def aref(self, mv: int) -> None:
-        self.request("aref %d" % mv)
+        self.request(self._board("aref %d" % mv))
 
     def level(self, sig: str) -> int:
-        return int(self.request("level %s" % sig))
+        return int(self.request("level %s" % self._name(sig)))
 
     def edges(self, sig: str, since: Optional[int] = None) -> List[Tuple[int, int]]:
         """[(cycle, level), ...], oldest first."""
+        sig = self._name(sig)
         reply = self.request("edges %s" % sig if since is None else "edges %s %d" % (sig, since))
         if reply == "-":
             return []
@@ -104,7 +125,7 @@ class SimControl:
 
     def measure(self, sig: str, n: Optional[int] = None, since: Optional[int] = None) -> Dict:
         """{"steady": 0|1} or {"high": (min, max, mean), "period": (...), "duty": f, "n": k}."""
-        req = "measure %s" % sig
+        req = "measure %s" % self._name(sig)
         if n is not None or since is not None:
             req += " %d" % (n if n is not None else 50)
         if since is not None:
@@ -121,7 +142,7 @@ class SimControl:
 
     def spi(self) -> List[Dict]:
         """Exchanges since the last call: [{"cs": "C2", "mosi": bytes, "miso": bytes}]."""
-        reply = self.request("spi")
+        reply = self.request(self._board("spi"))
         if reply == "-":
             return []
         out = []
@@ -131,17 +152,18 @@ class SimControl:
         return out
 
     def spidev(self, pin: str) -> str:
-        return self.request("spidev %s" % pin)
+        return self.request("spidev %s" % self._name(pin))
 
     def signals(self) -> List[str]:
-        return self.request("signals").split()
+        """Every board's signals (a slave's as "10/servo3"); a slave view: its own."""
+        return self.request(self._board("signals")).split()
 
     def stack(self, heap_start: int = 0) -> Dict[str, int]:
         """Peak stack use since the last reset (the simulator paints SRAM).
 
         heap_start: the end of the firmware's static data (avr-nm's
         __heap_start, minus 0x800000); 0 lets the simulator guess."""
-        words = self.request("stack %d" % heap_start).split()
+        words = self.request(self._board("stack %d" % heap_start)).split()
         return {"peak": int(words[1]), "deepest": int(words[3], 16), "ramend": int(words[5], 16)}
 
     def rx(self, cycle: int, data: bytes) -> int:
@@ -156,7 +178,7 @@ class SimControl:
 
     def peek(self, addr: int, n: int = 1) -> bytes:
         """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
-        return bytes.fromhex(self.request("peek %d %d" % (addr, n)))
+        return bytes.fromhex(self.request(self._board("peek %d %d" % (addr, n))))
 
     def srf08_range(self, addr: int, mm: int, mm2: Optional[int] = None) -> None:
         """What the SRF08 at 8-bit address `addr` sees at its next ping: a
@@ -175,3 +197,22 @@ class SimControl:
         return {"addr": int(w[1], 16), "range": (int(w[3]), int(w[4])),
                 "light": int(w[6]), "gain": int(w[8]), "rangereg": int(w[10]),
                 "busy": int(w[12]), "rangings": int(w[14])}
+
+
+class _SlaveView(SimControl):
+    """SimControl.slave(addr): requests go through the parent's socket."""
+
+    def __init__(self, parent: SimControl, addr: int):
+        self._parent = parent
+        self.addr = addr
+        self._prefix = "%02X/" % addr
+        self._at = "@%02X" % addr
+
+    def request(self, line: str) -> str:
+        return self._parent.request(line)
+
+    def close(self) -> None:
+        pass
+
+    def rx(self, cycle: int, data: bytes) -> int:
+        raise SimControlError("rx: only the gateway's serial line reaches the PC")

@@ -135,7 +135,7 @@ static void srf08_range_start(srf08_t *s, uint8_t cmd)
 			}
 		}
 	}
-	s->busy_until = s->bus->now + srf08_ranging_cycles(s, s->range);
+	s->busy_until = s->bus->cycle + srf08_ranging_cycles(s, s->range);
 	s->rangings++;
 }
 
@@ -178,7 +178,7 @@ static int srf08_start(twi_dev_t *dev, uint8_t addr8)
 
 	s->selected = 0;
 	s->want_ptr = 0;
-	if (srf08_busy(s, s->bus->now)) {
+	if (srf08_busy(s, s->bus->cycle)) {
 		return 0;	/* deaf while ranging */
 	}
 	/* its own address either way; the broadcast address 0 to write */
@@ -193,7 +193,7 @@ static int srf08_write(twi_dev_t *dev, uint8_t byte)
 {
 	srf08_t *s = (srf08_t *)dev;
 
-	if (!s->selected || srf08_busy(s, s->bus->now)) {
+	if (!s->selected || srf08_busy(s, s->bus->cycle)) {
 		return 0;	/* a command in this transfer started a ranging */
 	}
 	if (s->want_ptr) {
@@ -224,7 +224,7 @@ static uint8_t srf08_read(twi_dev_t *dev, int master_acks)
 	uint8_t v;
 
 	(void)master_acks;
-	if (!s->selected || srf08_busy(s, s->bus->now)) {
+	if (!s->selected || srf08_busy(s, s->bus->cycle)) {
 		return 0xff;	/* SDA left to the pull-up */
 	}
 	if (s->ptr == 0) {

@@ -7,7 +7,7 @@
  * What the part senses is set from outside (control request `srf08`): the
  * distance to the nearest target, optionally a second, farther one, and the
  * light level. A ranging command starts a measurement that takes simulated
- * time (read from the bus's `now`); meanwhile the part ignores the bus.
+ * time (read from the bus's `cycle`); meanwhile the part ignores the bus.
  */
 #ifndef SIM_PARTS_SRF08_H
 #define SIM_PARTS_SRF08_H
@@ -28,7 +28,7 @@
 
 typedef struct srf08_t {
 	twi_dev_t dev;			/* first: the bus's view */
-	const twi_bus_t *bus;		/* its `now` is the time of an event */
+	const twi_bus_t *bus;		/* its `cycle` is the time of an event */
 	uint32_t hz;			/* bus cycles per second */
 	uint8_t addr8;			/* 8-bit address, R/W bit clear */
 	uint8_t ptr;			/* location counter */

@@ -82,3 +82,20 @@ def test_bad_firmware_shows_the_simulators_stderr(tmp_path):
         SimBoard("m32d", firmware=elf, start_timeout=10).start()
     assert "exited with 2" in str(exc.value)
     assert "stderr: (empty)" not in str(exc.value)
+
+
+def test_terminal_with_a_slave_board():
+    require_builds(["m32d"])
+    echo = Path(__file__).resolve().parents[2] / "build" / "sim-fw" / "twi_slave_echo.elf"
+    if not echo.is_file():
+        pytest.fail("missing %s: %s" % (echo, BUILD_HINT), pytrace=False)
+    result = orfa("sim", "--board", "m32d", "--slave", "m32d:0x20:%s" % echo, "--terminal",
+                  input="S 20 5A P\nS 21 01 P\n")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[1:] == ["SWAP", "SR5AP"]
+
+
+def test_sim_refuses_a_bad_slave():
+    result = orfa("sim", "--slave", "m32d:0x21")
+    assert result.returncode == 2
+    assert "BOARD:ADDR" in result.stderr or "even" in result.stderr

@@ -65,6 +65,11 @@ def test_pwm_frequency(drv):
     # both lines rise together at the timer's BOTTOM
     r5 = [c for c, l in drv.edges("D5", since) if l == 1]
     r4 = [c for c, l in drv.edges("D4", since) if l == 1]
+    # the two requests come a little wall time apart and each signal keeps
+    # its last 1024 edges: compare from the first rise both still hold
+    first = max(r5[0], r4[0])
+    r5 = [c for c in r5 if c >= first]
+    r4 = [c for c in r4 if c >= first]
     assert r5[:10] == r4[:10]
 
 

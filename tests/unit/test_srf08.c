@@ -39,25 +39,25 @@ static void eq(long got, long want, const char *what)
 
 static int ev_addr(uint64_t t, uint8_t a8)
 {
-	bus.now = t;
+	bus.cycle = t;
 	return s.dev.ops->start(&s.dev, a8);
 }
 
 static int ev_write(uint64_t t, uint8_t b)
 {
-	bus.now = t;
+	bus.cycle = t;
 	return s.dev.ops->write(&s.dev, b);
 }
 
 static uint8_t ev_read(uint64_t t, int ack)
 {
-	bus.now = t;
+	bus.cycle = t;
 	return s.dev.ops->read(&s.dev, ack);
 }
 
 static void ev_stop(uint64_t t)
 {
-	bus.now = t;
+	bus.cycle = t;
 	s.dev.ops->stop(&s.dev);
 }
 
