@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "control.h"
+#include "isr_watch.h"
 #include "srf08_ctl.h"
 
 #define CONTROL_OUT_MAX (4u << 20)
@@ -277,7 +278,7 @@ static void cmd_spi(board_model_t *bm, reply_t *r)
 static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
-	"stack [FROM] | peek ADDR [LEN] | rx CYCLE HEX... | signals | "
+	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx CYCLE HEX... | signals | "
 	"srf08 ADDR [range MM [MM2] | light N] | help; "
 	"a slave board's pins, signals and inputs as 10/A5, other requests with @10 "
 	"first (stack @10 FROM)";
@@ -412,6 +413,18 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 		}
 		rp(&r, "peak %d deepest 0x%04X ramend 0x%04X", peak, (unsigned)deepest,
 		   (unsigned)avr->ramend);
+	} else if (!strcasecmp(cmd, "isr") && (argc == 1 || (argc == 2 &&
+						      !strcasecmp(argv[1], "clear")))) {
+		/* the board's TWI interrupt: longest run, entry to RETI */
+		if (!cb->twi_isr) {
+			rp(&r, "ERR isr: not watched on this board");
+			return 0;
+		}
+		rp(&r, "twi longest %" PRIu64 " count %" PRIu64 " total %" PRIu64,
+		   cb->twi_isr->longest, cb->twi_isr->count, cb->twi_isr->total);
+		if (argc == 2) {
+			isr_watch_clear(cb->twi_isr);
+		}
 	} else if (!strcasecmp(cmd, "peek") && (argc == 2 || argc == 3)) {
 		uint64_t addr, n = 1;
 

@@ -40,6 +40,7 @@ typedef struct control_board_t {
 	uint8_t addr;
 	avr_t *avr;
 	board_model_t *bm;
+	struct isr_watch_t *twi_isr;	/* its TWI interrupt's durations (`isr`), or NULL */
 } control_board_t;
 
 typedef struct control_t {

@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 
 #include "sim_avr.h"
@@ -62,7 +63,7 @@ static void sim_usage(void)
 		"usage: orfa-sim --board %s --link PATH [--eeprom ADDR[:wp]]...\n"
 		"                [--srf08 ADDR]...\n"
 		"                [--trace FILE] [--no-idle-throttle] [--control PATH]\n"
-		"                [--vcd FILE] [--spi KIND@PIN[:mode=N][:lsb]]...\n"
+		"                [--vcd FILE] [--spi [SLAVE/]KIND@PIN[:mode=N][:lsb]]...\n"
 		"                [--adc CH=MV]... [--avcc MV] [--aref MV]\n"
 		"                [--slave BOARD:ADDR:ELF]... GATEWAY.elf\n"
 		"\n"
@@ -71,7 +72,8 @@ static void sim_usage(void)
 		"I2C bus; ADDR is its 8-bit address (0x10..0xEE, even): it names the\n"
 		"board's signals in the control interface (`10/servo3`, `@10`) and is\n"
 		"checked against the firmware's TWAR (the firmware decides). The\n"
-		"--spi/--adc/--avcc/--aref options set up the gateway board; the\n"
+		"--adc/--avcc/--aref options set up the gateway board, --spi too\n"
+		"unless prefixed with a slave's address (--spi 12/eeprom25@C2); the\n"
 		"control interface reaches every board. See docs/simulator.md.\n",
 		board_names(), board_names());
 }
@@ -479,7 +481,30 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 		w->boards[w->nboards++] = &sim->slave[i];
 	}
 	for (int i = 0; i < args->spi_count; i++) {
-		const char *err = board_model_add_spi(&gw->bm, args->spi[i]);
+		/* "12/eeprom25@C2": a device on slave 12's SPI bus */
+		const char *spec = args->spi[i];
+		const char *slash = strchr(spec, '/');
+		sim_board_t *on = gw;
+		const char *err;
+
+		if (slash) {
+			on = NULL;
+			for (int k = 1; k < w->nboards; k++) {
+				size_t n = strlen(w->boards[k]->prefix);
+
+				if ((size_t)(slash - spec) == n &&
+				    !strncasecmp(spec, w->boards[k]->prefix, n)) {
+					on = w->boards[k];
+				}
+			}
+			if (!on) {
+				fprintf(stderr, "orfa-sim: bad --spi '%s': no --slave %.*s\n", spec,
+					(int)(slash - spec), spec);
+				return 2;
+			}
+			spec = slash + 1;
+		}
+		err = board_model_add_spi(&on->bm, spec);
 
 		if (err) {
 			fprintf(stderr, "orfa-sim: bad --spi '%s': %s\n", args->spi[i], err);
@@ -511,6 +536,9 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	for (int i = 1; i < w->nboards; i++) {
 		control_add_board(&sim->control, w->boards[i]->addr, w->boards[i]->avr,
 				  &w->boards[i]->bm);
+	}
+	for (int i = 0; i < w->nboards && i < sim->control.nboards; i++) {
+		sim->control.board[i].twi_isr = &w->boards[i]->twi.isr;
 	}
 	sim->control.srf08 = w->srf08;	/* control_open clears control_t */
 	sim->control.srf08_count = w->nsrf08;

@@ -486,6 +486,7 @@ void twi_init(twi_t *t, avr_t *avr, const mcu_twi_regs_t *regs, twi_bus_t *bus)
 		.raise_sticky = 1,
 	};
 	avr_register_vector(avr, &t->vect_twi);
+	isr_watch_init(&t->isr, avr, &t->vect_twi);
 	avr_irq_register_notify(&t->vect_twi.irq[AVR_INT_IRQ_RUNNING],
 				twi_irq_running, t);
 

@@ -27,6 +27,7 @@
 #include "sim_io.h"
 #include "sim_interrupts.h"
 
+#include "isr_watch.h"
 #include "mcu.h"
 #include "twi_bus.h"
 
@@ -46,6 +47,7 @@ typedef struct twi_t {
 	const mcu_twi_regs_t *regs;
 	twi_bus_t *bus;
 	avr_int_vector_t vect_twi;
+	isr_watch_t isr;		/* how long the TWI interrupt runs */
 
 	uint8_t status;			/* TWSR bits 7..3 */
 	int owner;			/* this master holds the bus */

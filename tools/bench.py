@@ -60,11 +60,15 @@ BUDGET_FLASH = 11152
 BUDGET_RAM = 992
 
 
-def footprint(board):
-    out = subprocess.run(["avr-size", str(firmware_path(board))], check=True,
+def footprint_of(elf):
+    out = subprocess.run(["avr-size", str(elf)], check=True,
                          capture_output=True, text=True).stdout.splitlines()[1].split()
     text, data, bss = int(out[0]), int(out[1]), int(out[2])
     return text + data, data + bss
+
+
+def footprint(board):
+    return footprint_of(firmware_path(board))
 
 
 class Schedule:
@@ -246,11 +250,15 @@ def servo_figures(ctl, board, quiet, load):
     return sample(quiet), sample(load)
 
 
-def heap_start(board):
-    out = subprocess.run(["avr-nm", str(firmware_path(board))], check=True,
+def heap_start_of(elf):
+    out = subprocess.run(["avr-nm", str(elf)], check=True,
                          capture_output=True, text=True).stdout
     end = next(line.split()[0] for line in out.splitlines() if line.endswith(" _end"))
     return int(end, 16) - 0x800000
+
+
+def heap_start(board):
+    return heap_start_of(firmware_path(board))
 
 
 def schedule_bytes(board, count):
@@ -309,6 +317,128 @@ def bench_board(board, count):
     rows["speed"] = cycles_total / wall / 1e6
     rows["footprint"] = footprint(board)
     return rows
+
+
+# --- RoboBus: slave boards behind an M32-D gateway ------------------------------
+
+#: The test robot's slaves (Makefile `robot`), in the order the speed rows add them.
+ROBOT = [("m128s", 0x10), ("m32d", 0x12), ("m128s", 0x14), ("m32d", 0x16),
+         ("m128s", 0x18), ("m32d", 0x1A), ("m128s", 0x1C), ("m32d", 0x1E)]
+SLAVE_OF = {"m128s": 0x10, "m32d": 0x12}
+SLAVE_PIPELINE = 200
+#: Simulated cycles each speed row runs for.
+SPEED_CYCLES = 2 * F_CPU
+
+
+def robot_elf(board, addr):
+    return ROOT / "build" / "robot" / ("%s-0x%02X" % (board, addr)) / "orfa.elf"
+
+
+def scl_period(khz):
+    """SCL period in cycles for the rate the gateway sets for `khz` (TWPS 0:
+    the smallest TWBR whose rate is not above it; firmware/twi_rate.c)."""
+    twbr = 0
+    while F_CPU / (16 + 2 * twbr) > khz * 1000:
+        twbr += 1
+    return 16 + 2 * twbr
+
+
+def intro_read(addr):
+    """Driver 1's record from a slave: 3 bytes written, 7 read."""
+    return "S %02X 00 01 S %02X 06 P\r" % (addr, addr | 1)
+
+
+#: SCL periods of intro_read on the wire: START, 3 bytes, repeated START,
+#: 7 bytes, STOP (a byte with its acknowledge is 9 periods).
+INTRO_READ_PERIODS = 1 + 3 * 9 + 1 + 7 * 9 + 1
+
+
+def bus_window(events, after):
+    """(first `twi start`, last `twi stop` of that transfer, longest
+    `twi stretch` in between) of the transfer after cycle `after`."""
+    start = next(e.cycle for e in events if e.kind == "twi start" and e.cycle > after)
+    stop = next(e.cycle for e in events if e.kind == "twi stop" and e.cycle > start)
+    stretch = max([int(e.fields[1]) for e in events
+                   if e.kind == "twi stretch" and start <= e.cycle <= stop] or [0])
+    return start, stop, stretch
+
+
+def slave_exercise(addr):
+    board = next(b for b, a in ROBOT if a == addr)
+    w, r = "%02X" % addr, "%02X" % (addr | 1)
+    return [q.replace("AA", w).replace("AB", r) for q in EXERCISE[board]]
+
+
+def bench_slave(board, count):
+    """The slave figures of `board` as the test robot's slave behind an M32-D
+    gateway, all requests scheduled at fixed cycles as bench_board's."""
+    addr = SLAVE_OF[board]
+    elf = robot_elf(board, addr)
+    rows = {}
+    with SimBoard("m32d", control=True, slaves=[(board, addr, elf)]) as sim:
+        ctl = sim.control
+        sctl = ctl.slave(addr)
+        if ctl.time() >= START:
+            raise SystemExit("bench: the simulator passed the schedule's start")
+        sched = Schedule(ctl, START)
+        sp = SERVOS[board][0]
+        chans = [2 * k if board == "m128s" else k for k in range(16)]
+        # 16 triples, then at once a repeated START reading it back: the
+        # slave holds SCL until its driver has taken the write
+        servo16 = "S%02X%02X%sS%02X02P\r" % (addr, sp, "".join(
+            "%02X%04X" % (ch, 1000 + 50 * k) for k, ch in enumerate(chans)), addr | 1)
+        steps = [("intro100", sched.send(intro_read(addr).encode())),
+                 ("clock400", sched.send(b"C 0190\r")),
+                 ("intro400", sched.send(intro_read(addr).encode())),
+                 ("clock100", sched.send(b"C 0064\r")),
+                 ("pipeline", sched.send(("S %02X 00 00 S %02X 01 P\r" % (addr, addr | 1)
+                                          * count).encode(), gap=F_CPU // 10)),
+                 ("servo16", sched.send(servo16.encode()))]
+        steps += [("exercise", sched.send((q + "\r").encode())) for q in slave_exercise(addr)]
+        steps.append(("servo off", sched.send(("S%02X%02X%sP\r" % (
+            addr, sp, "".join("%02X0000" % ch for ch in chans))).encode())))
+        with serial.Serial(sim.port, 115200, timeout=30) as port:
+            replies = {}
+            for name, _ in steps:
+                n = count if name == "pipeline" else 1
+                replies.setdefault(name, []).extend(read_replies(port, n))
+        events = parse_trace(sim.trace_text())
+        win = dict(steps[:6])
+        for khz in (100, 400):
+            name = "intro%d" % khz
+            want = b"SWAASR000001000002P\r\n"
+            if replies[name] != [want]:
+                raise SystemExit("bench: %s slave intro read at %d kHz answered %r"
+                                 % (board, khz, replies[name]))
+            lat, _ = latency(events, win[name], replies[name][0])
+            start, stop, stretch = bus_window(events, win[name][1])
+            rows[name] = (lat, stop - start, INTRO_READ_PERIODS * scl_period(khz), stretch)
+        want = b"SWAASR%02XP\r\n" % (5 if board == "m128s" else 6)
+        correct, cycles, rx_bytes = pipeline(events, win["pipeline"], win["servo16"][0],
+                                             replies["pipeline"], want,
+                                             len("S %02X 00 00 S %02X 01 P\r") * count)
+        rows["pipeline"] = (correct, cycles, rx_bytes * CYCLES_PER_BYTE)
+        if replies["servo16"] != [b"SW" + b"A" * 49 + b"SR03E8P\r\n"]:
+            raise SystemExit("bench: %s slave servo write answered %r" % (board, replies["servo16"]))
+        _, _, rows["stretch write"] = bus_window(events, win["servo16"][1])
+        rows["stretch byte"] = max(rows["intro100"][3], rows["intro400"][3])
+        rows["isr"] = sctl.isr()["longest"]
+        rows["stack"] = sctl.stack(heap_start_of(elf))
+    rows["footprint"] = footprint_of(elf)
+    return rows
+
+
+def bench_speed(nboards):
+    """World MHz per wall second running free with the gateway and the
+    first nboards - 1 robot slaves."""
+    slaves = [(b, a, robot_elf(b, a)) for b, a in ROBOT[:nboards - 1]]
+    with SimBoard("m32d", control=True, slaves=slaves) as sim:
+        ctl = sim.control
+        ctl.wait(F_CPU // 10)                      # every board booted
+        t0, c0 = time.monotonic(), ctl.time()
+        c1 = ctl.wait(SPEED_CYCLES)
+        wall = time.monotonic() - t0
+    return (c1 - c0) / wall / 1e6
 
 
 def main():
@@ -383,6 +513,51 @@ def main():
     print()
     print("Targets are the M32-D's (issue 2); flash/RAM budget = ORFA 0.7.5's own M32-D figures.")
     ok = all(results[b]["pipeline"][0] == n for b in args.boards)
+
+    # --- RoboBus ------------------------------------------------------------------
+    slaves = {b: bench_slave(b, SLAVE_PIPELINE) for b in args.boards}
+    speeds = [(k, bench_speed(k)) for k in (1, 3, 9)]
+    cols = ["%s@%02X" % (b, SLAVE_OF[b]) for b in args.boards]
+    print()
+    print("RoboBus: each board as an I2C slave (MODE=slave) behind an M32-D gateway")
+    print()
+    print("%-*s" % (width, "figure") + "".join("%14s" % c for c in cols) + "%10s" % "target")
+
+    def row(label, fmt, get, target=""):
+        print("%-*s" % (width, label) + "".join(fmt % get(slaves[b]) for b in args.boards)
+              + "%10s" % target)
+
+    for khz in (100, 400):
+        key = "intro%d" % khz
+        row("slave driver info %d kHz: latency" % khz, "%14d", lambda r: r[key][0])
+        row("  bus time, START to STOP (cycles)", "%14d", lambda r: r[key][1])
+        row("  wire time at that SCL (cycles)", "%14d", lambda r: r[key][2])
+        row("  bus time % of wire", "%14.1f", lambda r: 100.0 * r[key][1] / r[key][2])
+    row("longest SCL stretch per byte (cycles)", "%14d", lambda r: r["stretch byte"])
+    row("SCL stretch, 16-triple servo write", "%14d", lambda r: r["stretch write"], "<= 58982")
+    row("longest TWI interrupt (cycles)", "%14d", lambda r: r["isr"])
+    row("pipelined %d: correct replies" % SLAVE_PIPELINE, "%14s",
+        lambda r: "%d/%d" % (r["pipeline"][0], SLAVE_PIPELINE),
+        "%d/%d" % (SLAVE_PIPELINE, SLAVE_PIPELINE))
+    row("pipelined: % of serial wire", "%14.2f",
+        lambda r: 100.0 * r["pipeline"][2] / r["pipeline"][1], ">= 99")
+    row("flash (B)", "%14d", lambda r: r["footprint"][0])
+    row("static RAM (B)", "%14d", lambda r: r["footprint"][1])
+    row("peak stack (B)", "%14d", lambda r: r["stack"]["peak"])
+    print("%-*s" % (width, "SRAM never touched (%)") + "".join(
+        "%14.1f" % (100.0 * (slaves[b]["stack"]["deepest"] - heap_start_of(robot_elf(b, SLAVE_OF[b])))
+                    / (slaves[b]["stack"]["ramend"] + 1 - SRAM_START[b])) for b in args.boards)
+        + "%10s" % ">= 25")
+    print()
+    print("%-*s" % (width, "simulator: boards on one bus") + "".join("%14d" % k for k, _ in speeds))
+    print("%-*s" % (width, "  world MHz per wall second") + "".join("%14.1f" % v for _, v in speeds))
+    print("%-*s" % (width, "  x real time") + "".join("%14.2f" % (v * 1e6 / F_CPU) for _, v in speeds)
+          + "%10s" % ">= 1")
+    print()
+    print("A slave's latency runs from the request's last byte on the serial line to the")
+    print("reply's first; wire time counts SCL periods (a byte and its ACK: 9). The write's")
+    print("stretch is how long the slave held SCL before the read right after the write.")
+    ok = ok and all(slaves[b]["pipeline"][0] == SLAVE_PIPELINE for b in args.boards)
     return 0 if ok else 1
 
 

@@ -180,6 +180,13 @@ class SimControl:
         """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
         return bytes.fromhex(self.request(self._board("peek %d %d" % (addr, n))))
 
+    def isr(self, clear: bool = False) -> Dict[str, int]:
+        """The board's TWI interrupt since the last clear: {"longest", "count",
+        "total"} in cycles, from the vector's entry to its RETI; clear=True
+        starts the counts again (after reading them)."""
+        w = self.request(self._board("isr clear" if clear else "isr")).split()
+        return {"longest": int(w[2]), "count": int(w[4]), "total": int(w[6])}
+
     def srf08_range(self, addr: int, mm: int, mm2: Optional[int] = None) -> None:
         """What the SRF08 at 8-bit address `addr` sees at its next ping: a
         target `mm` millimetres away (0: none), optionally a second one."""

@@ -81,8 +81,10 @@ class Bench:
         return self.sim.trace_events(since, kinds)
 
     def bus(self, since: int):
-        """The bus events since `since`, as ("start",), ("addr", "A0", "ack"), ..."""
-        return [(e.kind[4:],) + e.fields for e in self.events(since, ["twi"])]
+        """The bus events since `since`, as ("start",), ("addr", "A0", "ack"), ...
+        (a slave's clock stretching, `twi stretch`, left out)."""
+        return [(e.kind[4:],) + e.fields for e in self.events(since, ["twi"])
+                if e.kind != "twi stretch"]
 
     # --- the local register map -------------------------------------------------
     def local_ok(self, request: str) -> bytes:
