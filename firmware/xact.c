@@ -103,6 +103,23 @@ bool xact_read_processed(uint8_t *byte)
 	return true;
 }
 
+bool xact_read_take(uint8_t n)
+{
+	if (xact.state != XACT_READ) {
+		return false;
+	}
+	while ((uint8_t)(xact.len - xact.pos) < n) {
+		/* the bytes answered so far are taken; the driver answers on */
+		n = (uint8_t)(n - (xact.len - xact.pos));
+		xact.pos = xact.len;
+		if (!xact_refill()) {
+			return false;
+		}
+	}
+	xact.pos = (uint8_t)(xact.pos + n);
+	return true;
+}
+
 bool xact_write_pending(void)
 {
 	return xact.state == XACT_DATA && xact.len > 0;

@@ -48,6 +48,13 @@ bool xact_read_requested(uint8_t *buf, uint8_t cap);
  * register gives nothing (cannot be read). */
 bool xact_read_processed(uint8_t *byte);
 
+/* The next n bytes of the read frame at once, exactly as n calls of
+ * xact_read_processed() would take them (a driver is asked as often, at the
+ * same bytes), left where they are in the buffer: for a front end that
+ * knows its read length and handed in the very bytes it replies from (the
+ * gateway). False when the register gives nothing. */
+bool xact_read_take(uint8_t n);
+
 /* True when a write frame holds data that xact_frame_end() will deliver to
  * a driver (a front end that must not call drivers from an interrupt defers
  * that frame end). */

@@ -44,13 +44,10 @@ static uint8_t run_local(uint8_t addr, uint8_t *data, uint8_t n)
 	uint8_t err = SG_OK;
 
 	if (addr & 1) {
-		if (!xact_read_requested(data, n)) {
+		/* n byte events at once: the answers are already where the
+		 * reply is made from */
+		if (!xact_read_requested(data, n) || !xact_read_take(n)) {
 			err = SG_ERR_ADDR_NACK;
-		}
-		for (uint8_t k = 0; k < n && err == SG_OK; k++) {
-			if (!xact_read_processed(&data[k])) {
-				err = SG_ERR_ADDR_NACK;
-			}
 		}
 		xact_frame_end();
 		return err;

@@ -416,7 +416,8 @@ def bench_slave(board, count):
         want = b"SWAASR%02XP\r\n" % (5 if board == "m128s" else 6)
         correct, cycles, rx_bytes = pipeline(events, win["pipeline"], win["servo16"][0],
                                              replies["pipeline"], want,
-                                             len("S %02X 00 00 S %02X 01 P\r") * count)
+                                             len("S %02X 00 00 S %02X 01 P\r" % (addr, addr | 1))
+                                             * count)
         rows["pipeline"] = (correct, cycles, rx_bytes * CYCLES_PER_BYTE)
         if replies["servo16"] != [b"SW" + b"A" * 49 + b"SR03E8P\r\n"]:
             raise SystemExit("bench: %s slave servo write answered %r" % (board, replies["servo16"]))

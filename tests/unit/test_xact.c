@@ -47,17 +47,16 @@ static uint8_t status_read(void)
 }
 
 /* The gateway's way (serialgate/sg_exec.c run_local): the frame's bytes are
- * the buffer, the read length is known. A write frame is [reg][data], so its
+ * the buffer, the read length is known, a read's bytes are taken at once
+ * (xact_read_take: n byte events in one call). A write frame is [reg][data], so its
  * select is part of it; a read frame reads the selected register. */
 static void run_gateway(const frame_t *f, result_t *r)
 {
 	uint8_t bytes[1 + SLAVE_BUF];
 	memset(r, 0, sizeof *r);
 	if (f->read) {
-		r->ok = xact_read_requested(r->got, f->n);
-		for (uint8_t k = 0; k < f->n && r->ok; k++) {
-			r->ok = xact_read_processed(&r->got[k]);
-		}
+		/* all n byte events at once, as the gateway takes them */
+		r->ok = xact_read_requested(r->got, f->n) && xact_read_take(f->n);
 		if (!r->ok) {
 			memset(r->got, 0, sizeof r->got);
 		}
