@@ -69,9 +69,22 @@ class Bench:
             request = request.encode("ascii")
         return self.exchange(request + end, 1)
 
-    def assert_silent(self, quiet: float = 0.3):
-        extra = self.gw.read_available(quiet)
-        assert extra == b"", "unexpected bytes from the board: %r" % extra
+    def assert_silent(self):
+        """Nothing more comes for what was sent. The board answers in order,
+        so a `V` sent now must get the very next reply line: decided by the
+        board's own order, not by waiting on the wall clock (a simulator of
+        several boards runs slower than one)."""
+        reply = self.exchange(b"V\n", 1)
+        assert reply == b"V1.1\r\n", "unexpected bytes from the board: %r" % reply
+
+    def settle(self):
+        """End a line a test may have left open and skip every reply still
+        coming: the replies up to the `V` sent last."""
+        self.gw.send(b"\nV\n")
+        for _ in range(300):
+            if self.read_lines(1) == b"V1.1\r\n":
+                return
+        raise AssertionError("the board did not come back to its V")
 
     # --- trace ----------------------------------------------------------------
     def mark(self) -> int:
@@ -342,8 +355,7 @@ class DrvBench(Bench):
     def drv_restore(self) -> None:
         """Every driver back to its reset state (SPI chip selects aside)."""
         lay = self.lay
-        self.gw.send(b"\n")          # end a line a test left open
-        self.gw.read_available(0.2)
+        self.settle()                 # end a line a test left open
         for name in sorted(self.driven):
             self.ctl.drive(name, None)
         self.driven.clear()

@@ -230,9 +230,10 @@ def test_widths_under_uart_load(drv):
     mark = drv.mark()
     t0 = drv.now()
     drv.gw.send(b"".join(r + b"\n" for r in reqs))
-    got = drv.gw.read_available(1.0)
+    got = drv.read_lines(len(reqs))
     # the load lasts until the last reply byte left the board
     t1 = drv.events(mark, ["uart tx"])[-1].cycle
+    drv.assert_silent()
     lines = [l + b"\r\n" for l in got.split(b"\r\n")[:-1]]
     assert t1 - t0 > 10 * SERVO_FRAME          # the load lasted at least 10 frames
     worst = 0.0

@@ -53,8 +53,7 @@ def spi(drv):
         bind(drv, ch, pins[ch])
     drv.ctl.spi()                                   # forget earlier exchanges
     yield drv
-    drv.gw.send(b"\n")
-    drv.gw.read_available(0.2)
+    drv.settle()
     drv.wr(cfg_reg(drv), b"\xff\x00\x02")
     for ch in range(4):
         bind(drv, ch, pins[ch])

@@ -70,7 +70,8 @@ def test_receive_overflow_is_error_04_never_garbage(board):
     want = board.ask(request[:-1].decode())
     assert len(want) == 129
     board.gw.send(request * 100)
-    got = board.gw.read_available(1.0)
+    got = board.read_lines(100)
+    board.assert_silent()                             # and not one more
     lines = got.split(b"\r\n")
     assert lines[-1] == b"", got[-200:]
     lines = lines[:-1]

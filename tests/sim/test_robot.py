@@ -335,3 +335,43 @@ def test_srf08_on_the_robot_bus(rb):
     assert ask(gw, "S E0 00 51 P") == b"SWAAP\r\n"
     ctl.wait(int(0.066 * F_CPU))
     assert ask(gw, "S E0 02 S E1 02 P") == b"SWASR007BP\r\n"         # 123 cm
+
+
+# --- clock stretching: measured and bounded --------------------------------------
+
+#: A slave holds SCL while its main loop fetches a driver's read answer
+#: (i2c_slave/): about 400 cycles at most (make bench), bounded here with room.
+STRETCH_PER_BYTE_MAX = 1000
+#: The gateway waits at most 8 ms for a stretching slave (firmware/twi_master.c).
+GATEWAY_STRETCH_WAIT = 8 * F_CPU // 1000
+
+
+@pytest.mark.parametrize("addr", [M128S, M32D])
+def test_stretch_per_byte_is_short(rb, addr):
+    gw, _ = rb
+    mark = gw.mark()
+    for _ in range(5):
+        assert ask(gw, "S %02X 00 01 S %02X 0C P" % (addr, addr | 1)).startswith(b"SWAASR")
+        assert ask(gw, "S %02X 00 00 S %02X 01 P" % (addr, addr | 1)).startswith(b"SWAASR")
+    stretches = [n for _, a, n in gw.sim.stretches(mark) if a == addr]
+    assert stretches, "the slave never held SCL"       # it does, reading a driver
+    assert max(stretches) <= STRETCH_PER_BYTE_MAX, stretches
+
+
+@pytest.mark.parametrize("addr", [M128S, M32D])
+def test_longest_write_stretches_within_the_gateways_wait(rb, addr):
+    """16 servo triples, then at once a read back: the slave holds SCL
+    until its driver took the write; the gateway waits it out."""
+    gw, boards = rb
+    b = boards[addr]
+    sp = b.lay["servo"] + 1
+    chans = [2 * k if b.board == "m128s" else k for k in range(16)]
+    body = "".join("%02X%04X" % (ch, 2500 - 37 * k) for k, ch in enumerate(chans))
+    mark = gw.mark()
+    try:
+        reply = ask(gw, "S%02X%02X%sS%02X02P" % (addr, sp, body, addr | 1))
+        assert reply == b"SW" + b"A" * 49 + b"SR09C4P\r\n"
+        longest = max(n for _, a, n in gw.sim.stretches(mark) if a == addr)
+        assert STRETCH_PER_BYTE_MAX < longest < GATEWAY_STRETCH_WAIT, longest
+    finally:
+        b.servos_off()

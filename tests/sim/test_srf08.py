@@ -67,8 +67,7 @@ def srf(srf_bench):
     b.gw.serial.reset_input_buffer()
     mark = b.mark()
     yield b
-    b.gw.send(b"\n")
-    b.gw.read_available(0.2)
+    b.settle()
     b.ctl.wait(MS65)                                # any ranging is over
     assert b.ask("S E0 01 1F FF P") == b"SWAAAP\r\n"  # gain 31, range 255
     b.ctl.srf08_range(SRF, 0)
