@@ -9,6 +9,7 @@
 #   make test           install what is missing, build everything, run all tests
 #   make bench          cycle-exact benchmark table
 #   make demo           a simulated M32-D gateway to talk to
+#   make demo-robot     the same with two slave boards on its I2C bus
 
 BOARD ?= m32d
 MODE ?= gate
@@ -83,7 +84,7 @@ $(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 
-.PHONY: firmware all-boards robot size sim unit test bench demo clean setup
+.PHONY: firmware all-boards robot size sim unit test bench demo demo-robot clean setup
 .DEFAULT_GOAL := firmware
 
 firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
@@ -161,6 +162,18 @@ bench: setup
 demo: setup
 	@$(MAKE) --no-print-directory BOARD=m32d MODE=gate firmware sim
 	PYTHONPATH=host python3 -m orfa sim --board m32d --eeprom 0xA0 --terminal
+
+# A robot: the M32-D gateway, an M128-S slave at 0x10, an M32-D slave at 0x12
+# and the EEPROM at A0, all on one simulated I2C bus.
+demo-robot: setup
+	@$(MAKE) --no-print-directory BOARD=m32d MODE=gate firmware sim
+	@$(MAKE) --no-print-directory BOARD=m128s MODE=slave ADDR=0x10 \
+		BUILD=build/robot/m128s-0x10 firmware
+	@$(MAKE) --no-print-directory BOARD=m32d MODE=slave ADDR=0x12 \
+		BUILD=build/robot/m32d-0x12 firmware
+	PYTHONPATH=host python3 -m orfa sim --board m32d --eeprom 0xA0 \
+		--slave m128s:0x10:build/robot/m128s-0x10/orfa.elf \
+		--slave m32d:0x12:build/robot/m32d-0x12/orfa.elf --terminal
 
 clean:
 	rm -rf build
