@@ -227,8 +227,11 @@ static void cmd_measure(control_t *c, reply_t *r, signal_t *s, unsigned nmax,
 	}
 	(void)first;
 	/* No complete period, or the signal stopped (no edge for more than
-	 * two of its longest periods): steady. */
-	if (!periods || (s->count && now - s->last_cycle > 2 * pmax)) {
+	 * two of its longest periods): steady. An edge may be stamped a few
+	 * cycles ahead of `now`, the gateway's cycle (a slave board ends its
+	 * quantum up to an instruction later; the board model places some
+	 * compares itself), so a last edge after now is a recent one. */
+	if (!periods || (s->count && now > s->last_cycle && now - s->last_cycle > 2 * pmax)) {
 		rp(r, "steady %d", s->level);
 		return;
 	}

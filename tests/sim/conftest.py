@@ -6,6 +6,7 @@ and on exit puts back what tests change (local address, clock), so no test
 sees another's state. Each simulator has its own temp dir and link path.
 """
 
+import contextlib
 import time
 from pathlib import Path
 
@@ -146,20 +147,28 @@ class Bench:
         assert self.sim.running, self.sim.stderr
 
 
-@pytest.fixture(scope="module", params=BOARDS)
-def bench(request):
-    require_builds([request.param])
-    # and a write-protected one that refuses data bytes (ERROR 07)
-    sim = SimBoard(request.param, eeproms=(EEPROM,), trace=True,
-                   extra_args=("--eeprom", "0x%02X:wp" % EEPROM_WP))
+@contextlib.contextmanager
+def running(sim: SimBoard, make_bench=Bench):
+    """Start `sim`, give a bench on it (make_bench(sim)), and stop it after:
+    the simulator must exit cleanly."""
     sim.start()
-    b = Bench(sim)
+    b = make_bench(sim)
     try:
         yield b
     finally:
         b.close()
         status = sim.stop()
         assert status == 0, "orfa-sim exited with %r" % status
+
+
+@pytest.fixture(scope="module", params=BOARDS)
+def bench(request):
+    require_builds([request.param])
+    # and a write-protected one that refuses data bytes (ERROR 07)
+    sim = SimBoard(request.param, eeproms=(EEPROM,), trace=True,
+                   extra_args=("--eeprom", "0x%02X:wp" % EEPROM_WP))
+    with running(sim) as b:
+        yield b
 
 
 @pytest.fixture
@@ -416,22 +425,16 @@ def drv_sim(request):
                        slaves=[(board_name, addr, elf)],
                        extra_args=tuple(a for spec in slave_opts.get("spi", [])
                                         for a in ("--spi", "%02X/%s" % (addr, spec))))
-    sim.start()
-    b = DrvBench(sim, board_name, addr)
-    if addr is not None:
-        analog = options
-        for ch, mv in sorted(analog.get("adc", {}).items()):
-            b.ctl.adc(ch, mv)
-        if analog.get("avcc") is not None:
-            b.ctl.avcc(analog["avcc"])
-        if analog.get("aref") is not None:
-            b.ctl.aref(analog["aref"])
-    try:
+    with running(sim, lambda s: DrvBench(s, board_name, addr)) as b:
+        if addr is not None:
+            # the slave's analog inputs, through the control socket
+            for ch, mv in sorted(options.get("adc", {}).items()):
+                b.ctl.adc(ch, mv)
+            if options.get("avcc") is not None:
+                b.ctl.avcc(options["avcc"])
+            if options.get("aref") is not None:
+                b.ctl.aref(options["aref"])
         yield b
-    finally:
-        b.close()
-        status = sim.stop()
-        assert status == 0, "orfa-sim exited with %r" % status
 
 
 def pytest_generate_tests(metafunc):

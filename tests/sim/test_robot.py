@@ -6,8 +6,8 @@ slaves' pins are watched through the control socket (`10/servo3`, `12/A5`)."""
 
 import pytest
 
-from conftest import (DRV_LAYOUT, F_CPU, SERVO_FRAME, REPLY_TIMEOUT, Bench, DrvBench,
-                      require_builds, require_slave)
+from conftest import (F_CPU, SERVO_FRAME, REPLY_TIMEOUT, DrvBench, require_builds,
+                      require_slave, running)
 from orfa.sim import SimBoard
 
 M128S, M32D = 0x10, 0x12
@@ -24,15 +24,10 @@ def robot():
               ("m32d", M32D, require_slave("m32d", M32D))]
     sim = SimBoard("m32d", eeproms=(EEPROM,), srf08=(SRF08,), trace=True, control=True,
                    slaves=slaves)
-    sim.start()
-    gw = Bench(sim)
-    boards = {M128S: DrvBench(sim, "m128s", M128S, gw=gw.gw),
-              M32D: DrvBench(sim, "m32d", M32D, gw=gw.gw)}
-    try:
+    with running(sim) as gw:
+        boards = {M128S: DrvBench(sim, "m128s", M128S, gw=gw.gw),
+                  M32D: DrvBench(sim, "m32d", M32D, gw=gw.gw)}
         yield gw, boards
-    finally:
-        gw.close()
-        assert sim.stop() == 0
 
 
 @pytest.fixture

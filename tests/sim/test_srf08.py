@@ -16,7 +16,7 @@ import pytest
 from orfa.sim import BOARDS, SimBoard
 from orfa.simctl import SimControlError
 
-from conftest import Bench, require_builds
+from conftest import Bench, require_builds, running
 
 SRF = 0xE0
 F_CPU = 7372800
@@ -49,14 +49,8 @@ class SrfBench(Bench):
 def srf_bench(request):
     require_builds([request.param])
     sim = SimBoard(request.param, trace=True, control=True, srf08=(SRF,))
-    sim.start()
-    b = SrfBench(sim)
-    try:
+    with running(sim, SrfBench) as b:
         yield b
-    finally:
-        b.close()
-        status = sim.stop()
-        assert status == 0, "orfa-sim exited with %r" % status
 
 
 @pytest.fixture
