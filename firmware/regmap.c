@@ -141,7 +141,9 @@ uint8_t regmap_driver_count(void)
 void regmap_driver_record(uint8_t n, uint8_t *dst, uint8_t len)
 {
 	const ORFA_FLASH uint8_t *r = regmap_records[n - 1];
-	for (uint8_t i = 0; i < len; i++) {
-		dst[i] = r[i];
+	/* counted down, pointers walking: the tightest loop avr-gcc makes here
+	 * (on the latency path of every introspection read) */
+	while (len--) {
+		*dst++ = *r++;
 	}
 }
