@@ -16,6 +16,15 @@ static struct {
 
 /* RC: [settings][mask], always both. Enabled channels take their pins
  * (input, no pull-up); all of the write or none of it. */
+reg_status_t drv_adc_check(uint8_t reg, const uint8_t *data, uint8_t len)
+{
+	(void)data;
+	if (reg != ADC_REG_RC) {
+		return REG_NOT_WRITABLE;
+	}
+	return len > 2 ? REG_BAD_LENGTH : REG_OK;  /* settings, mask */
+}
+
 reg_status_t drv_adc_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (reg != ADC_REG_RC) {

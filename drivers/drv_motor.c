@@ -25,6 +25,14 @@ void drv_motor_init(void)
 
 /* A write of k bytes to register r sets registers r..r+k-1 (4 bytes to PWM1
  * set all four), all of them or none. */
+reg_status_t drv_motor_check(uint8_t reg, const uint8_t *data, uint8_t len)
+{
+	(void)data;
+	/* too many registers; a bad direction is left to the write, which
+	 * tells a too long write first */
+	return reg + len > DRV_motor_NREGS ? REG_BAD_LENGTH : REG_OK;
+}
+
 reg_status_t drv_motor_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (len == 0 || reg + len > DRV_motor_NREGS) {

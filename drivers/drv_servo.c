@@ -92,6 +92,26 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	return REG_OK;
 }
 
+reg_status_t drv_servo_check(uint8_t reg, const uint8_t *data, uint8_t len)
+{
+	if (reg == SERVO_REG_RS) {
+		return REG_OK;
+	}
+	if (len > 3 * SERVO_MAX_TRIPLES) {
+		return REG_BAD_LENGTH;
+	}
+	/* Every third byte names a channel (a 1-byte write too): bytes 0, 3,
+	 * 6, ... A multiply instead of a division, which has no place in a
+	 * TWI interrupt: at * 43 >> 7 is at / 3 for every at below 48. */
+	_Static_assert(3 * SERVO_MAX_TRIPLES <= 48, "at * 43 >> 7 == at / 3 up to 47");
+	uint8_t at = (uint8_t)(len - 1);
+	uint8_t third = (uint8_t)((uint16_t)(at * 43u) >> 7);
+	if (at == (uint8_t)(3 * third) && data[at] >= SERVO_CHANNELS) {
+		return REG_BAD_VALUE;
+	}
+	return REG_OK;
+}
+
 reg_status_t drv_servo_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (reg == SERVO_REG_RS) {

@@ -17,6 +17,7 @@
 
 void drv_servo_init(void);
 reg_status_t drv_servo_write(uint8_t reg, const uint8_t *data, uint8_t len);
+reg_status_t drv_servo_check(uint8_t reg, const uint8_t *data, uint8_t len);
 uint8_t drv_servo_read(uint8_t reg, uint8_t *dst, uint8_t max);
 
 #endif

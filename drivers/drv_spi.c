@@ -110,6 +110,15 @@ static reg_status_t spi_data(const uint8_t *data, uint8_t len)
 	return REG_OK;
 }
 
+reg_status_t drv_spi_check(uint8_t reg, const uint8_t *data, uint8_t len)
+{
+	(void)data;
+	if (reg == SPI_REG_CONFIG) {
+		return len > 3 ? REG_BAD_LENGTH : REG_OK;
+	}
+	return len - 1 > SPI_BUF ? REG_BAD_LENGTH : REG_OK;  /* channel, bytes */
+}
+
 reg_status_t drv_spi_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	return reg == SPI_REG_CONFIG ? spi_config(data, len) : spi_data(data, len);

@@ -25,6 +25,15 @@ reg_status_t drv_intro_write(uint8_t reg, const uint8_t *data, uint8_t len)
 	return REG_OK;
 }
 
+reg_status_t drv_intro_check(uint8_t reg, const uint8_t *data, uint8_t len)
+{
+	(void)reg;
+	(void)data;
+	/* An N above the count is left to the write: it also moves the
+	 * cursor to driver 1. */
+	return len > 1 ? REG_BAD_LENGTH : REG_OK;
+}
+
 uint8_t drv_intro_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
 	(void)reg;

@@ -23,11 +23,12 @@ typedef struct {
 	void (*init)(void);
 	reg_status_t (*write)(uint8_t reg, const uint8_t *data, uint8_t len);
 	uint8_t (*read)(uint8_t reg, uint8_t *dst, uint8_t max);
+	reg_status_t (*check)(uint8_t reg, const uint8_t *data, uint8_t len);
 } regmap_entry_t;
 
 static const ORFA_FLASH regmap_entry_t regmap_table[] = {
-	{ drv_intro_init, drv_intro_write, drv_intro_read },
-#define X(name) { drv_##name##_init, drv_##name##_write, drv_##name##_read },
+	{ drv_intro_init, drv_intro_write, drv_intro_read, drv_intro_check },
+#define X(name) { drv_##name##_init, drv_##name##_write, drv_##name##_read, drv_##name##_check },
 	ORFA_DRIVER_LIST
 #undef X
 };
@@ -89,6 +90,15 @@ bool regmap_status_selected(void)
 	return rm.reg == REGMAP_STATUS_REG;
 }
 
+reg_status_t regmap_check(const uint8_t *data, uint8_t len)
+{
+	if (rm.reg == REGMAP_STATUS_REG) {
+		return REG_NOT_WRITABLE;
+	}
+	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
+	return e->check((uint8_t)(rm.reg - regmap_starts[rm.entry]), data, len);
+}
+
 reg_status_t regmap_write(const uint8_t *data, uint8_t len)
 {
 	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
@@ -126,6 +136,11 @@ uint8_t regmap_read(uint8_t *dst, uint8_t max)
 		return 0;
 	}
 	return got;
+}
+
+reg_status_t regmap_status(void)
+{
+	return (reg_status_t)rm.status;
 }
 
 void regmap_set_status(reg_status_t status)

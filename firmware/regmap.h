@@ -35,6 +35,12 @@ typedef enum {
  *   void drv_name_init(void);
  *   reg_status_t drv_name_write(uint8_t reg, const uint8_t *data, uint8_t len);
  *       applies all of `data` or nothing; REG_OK or why not
+ *   reg_status_t drv_name_check(uint8_t reg, const uint8_t *data, uint8_t len);
+ *       the first `len` bytes of a write still coming in, data[len - 1] just
+ *       arrived: REG_OK, or why no write that starts so can be taken
+ *       (whatever follows). Looks at the newest byte only, changes nothing,
+ *       and is quick: a TWI slave asks it in its interrupt, to refuse the
+ *       byte after (SPEC section 4). drv_name_write decides in the end.
  *   uint8_t drv_name_read(uint8_t reg, uint8_t *dst, uint8_t max);
  *       puts up to `max` bytes of the register's data at `dst` and returns
  *       how many; 0 means the register cannot be read. The regmap asks again
@@ -52,6 +58,10 @@ bool regmap_select(uint8_t reg);
 /* True when the selected register is the status register. */
 bool regmap_status_selected(void);
 
+/* Whether a write of the selected register that starts with these `len`
+ * bytes can still be taken (drv_name_check). */
+reg_status_t regmap_check(const uint8_t *data, uint8_t len);
+
 /* Delivers one write frame's data to the selected register. */
 reg_status_t regmap_write(const uint8_t *data, uint8_t len);
 
@@ -63,6 +73,9 @@ void regmap_read_start(void);
  * how many. 0: it cannot be read (status REG_NOT_READABLE). Asking again
  * gives the driver's next answer (xact.h asks when one is used up). */
 uint8_t regmap_read(uint8_t *dst, uint8_t max);
+
+/* The status register's value (what reading register 0x01 gives). */
+reg_status_t regmap_status(void);
 
 /* For drivers: record a status that does not fail the operation. */
 void regmap_set_status(reg_status_t status);

@@ -12,10 +12,14 @@
 /* Cycles of one twi_wait() polling loop at least (avr-gcc 5.4 -Os: 9 on
  * the ATmega32, 10 on the ATmega128, more with interrupts). */
 #define TWI_LOOP_CYCLES 9
-/* The longest SCL stretch a slave is waited for: an ORFA M32-D slave's
- * longest register write (16 servo triples) takes about 5.5 ms. */
-#define TWI_STRETCH_MAX_US 8000UL
-#define TWI_STRETCH_LOOPS (TWI_STRETCH_MAX_US * (F_CPU / 1000000UL) / TWI_LOOP_CYCLES)
+/* The longest SCL stretch a slave is waited for: an ORFA slave holds SCL
+ * while it applies a write; the longest is an SPI exchange of the 60 bytes a
+ * request can carry at the slowest SPI clock (F_CPU/128: 1024 cycles a
+ * byte), about 8.5 ms with the servo interrupts; 16 servo triples on an
+ * M32-D take about 5.6 ms. Interrupts only make a loop longer. */
+#define TWI_STRETCH_MAX_US 12000UL
+#define TWI_STRETCH_LOOPS \
+	(TWI_STRETCH_MAX_US * (F_CPU / 1000UL) / (1000UL * TWI_LOOP_CYCLES))
 
 static struct {
 	uint32_t timeout;  /* polling loops before a step counts as hung */

@@ -11,7 +11,9 @@ typedef enum {
 
 static struct {
 	uint8_t state;
-	uint8_t refusal;  /* why a refused write frame was refused */
+	/* why a refused write frame was refused; REG_NO_REGISTER also means
+	 * no register is selected (until a register byte names one) */
+	uint8_t refusal;
 	uint8_t *buf;
 	uint8_t cap;
 	uint8_t len;      /* write: data bytes held; read: bytes answered */
@@ -21,6 +23,7 @@ static struct {
 void xact_init(void)
 {
 	xact.state = XACT_IDLE;
+	xact.refusal = REG_OK;
 }
 
 void xact_write_requested(uint8_t *buf, uint8_t cap)
@@ -43,22 +46,28 @@ bool xact_write_received(uint8_t byte)
 {
 	switch (xact.state) {
 	case XACT_SELECT:
+		/* No register is selected after an unmapped one: a read then
+		 * gives nothing rather than the register selected before. */
 		if (!regmap_select(byte)) {
 			return xact_refuse(REG_NO_REGISTER);
 		}
+		xact.refusal = REG_OK;
 		xact.state = XACT_DATA;
 		return true;
-	case XACT_DATA:
-		/* Refused as early as it is known, so a TWI slave can refuse
-		 * the byte after it. */
-		if (regmap_status_selected()) {
-			return xact_refuse(REG_NOT_WRITABLE);
-		}
+	case XACT_DATA: {
+		/* Refused as early as it is known (the buffer is full, the
+		 * driver can take no write that starts so), so a TWI slave can
+		 * refuse the byte after it. */
 		if (xact.len >= xact.cap) {
 			return xact_refuse(REG_BAD_LENGTH);
 		}
 		xact.buf[xact.len++] = byte;
+		reg_status_t st = regmap_check(xact.buf, xact.len);
+		if (st != REG_OK) {
+			return xact_refuse(st);
+		}
 		return true;
+	}
 	default:
 		return false;
 	}
@@ -89,6 +98,10 @@ bool xact_read_requested(uint8_t *buf, uint8_t cap)
 	xact.cap = cap;
 	xact.len = 0;
 	xact.pos = 0;
+	if (xact.refusal == REG_NO_REGISTER) {
+		xact.state = XACT_NO_DATA;  /* the status keeps saying why */
+		return false;
+	}
 	regmap_read_start();
 	return cap > 0 && xact_refill();
 }

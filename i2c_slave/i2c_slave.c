@@ -1,7 +1,8 @@
 /*
  * The I2C slave front end (MODE=slave): the TWI answers at ORFA_ADDR and
  * slave_fsm.c decides; this file only moves its decisions into TWCR/TWDR.
- * The interrupt does byte moves only; work that reaches a driver runs in
+ * The interrupt does byte moves and quick checks only, with other
+ * interrupts allowed; work that reaches a driver runs in
  * front_poll() while TWINT stays set, so the TWI holds SCL low (clock
  * stretching) and the master waits for it.
  */
@@ -49,10 +50,18 @@ static void slave_apply(slave_action_t act, uint8_t byte)
 	}
 }
 
+/* Interruptible: the TWI's own interrupt is held off (TWIE clear) and
+ * TWINT stays set, holding SCL, while other interrupts may come first (the
+ * M32-D's cycle-exact servo edges must not wait for a bus byte). */
 ISR(TWI_vect)
 {
+	/* TWIE off before interrupts are on again, or this one would come
+	 * back at once: TWINT is a level. Writing TWINT 0 leaves it set. */
+	TWCR = (uint8_t)(TWCR & ~(_BV(TWINT) | _BV(TWIE)));
+	sei();
 	uint8_t byte = TWDR;
 	slave_action_t act = slave_fsm_event(TW_STATUS, &byte);
+	cli();
 	slave_apply(act, byte);
 }
 

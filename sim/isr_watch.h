@@ -1,9 +1,10 @@
 /*
  * isr_watch.h: how long an interrupt handler runs, in cycles, from the
  * moment the CPU takes the vector to its RETI (simavr raises the vector's
- * AVR_INT_IRQ_RUNNING with 1, then 0). Keeps the longest, the count and the
- * total, for `make bench` (the slave's TWI interrupt) and the control
- * request `isr`.
+ * AVR_INT_IRQ_RUNNING with 1, then 0), less the time of other handlers
+ * that interrupt it (a handler that enables interrupts early). Keeps the
+ * longest, the count and the total, for `make bench` (the slave's TWI
+ * interrupt) and the control request `isr`.
  */
 #ifndef SIM_ISR_WATCH_H
 #define SIM_ISR_WATCH_H
@@ -15,8 +16,13 @@
 
 typedef struct isr_watch_t {
 	avr_t *avr;
+	avr_int_vector_t *vect;
+	int others_hooked;	/* the other vectors are watched for nesting */
 	uint64_t entered;	/* cycle the running handler was entered at */
 	int inside;
+	int other_depth;	/* other handlers running inside it */
+	uint64_t other_since;
+	uint64_t nested;	/* their cycles, during this run */
 	uint64_t longest;	/* cycles */
 	uint64_t count;
 	uint64_t total;

@@ -117,6 +117,15 @@ void drv_fake_init(void)
 	fake.data[0] = 0x5A;
 }
 
+reg_status_t drv_fake_check(uint8_t reg, const uint8_t *data, uint8_t len)
+{
+	(void)data;
+	if (reg == 1) {
+		return REG_NOT_WRITABLE;
+	}
+	return reg == 0 && len > 4 ? REG_BAD_LENGTH : REG_OK;
+}
+
 reg_status_t drv_fake_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (reg == 1) {

@@ -17,6 +17,7 @@
 #define DRV_fake_MINOR 3
 void drv_fake_init(void);
 reg_status_t drv_fake_write(uint8_t reg, const uint8_t *data, uint8_t len);
+reg_status_t drv_fake_check(uint8_t reg, const uint8_t *data, uint8_t len);
 uint8_t drv_fake_read(uint8_t reg, uint8_t *dst, uint8_t max);
 
 /* Everything the fake bus saw, as text: "S A0+ W00+ R11+ R22- P ". */

@@ -162,6 +162,34 @@ static void test_rates(void)
 		/* never above the rate asked */
 		check(7372800UL / r.period <= t[i].khz * 1000UL || t[i].khz == 0, "rate<=asked", d);
 	}
+	/* Every rate from 1 to 1000 kHz against a search of all TWBR/TWPS:
+	 * the shortest period whose rate is not above the one asked (a
+	 * prescaler only when TWBR alone cannot reach it). */
+	int bad = 0;
+	for (uint32_t khz = 1; khz <= 1000 && !bad; khz++) {
+		uint32_t best = 0;
+		for (uint32_t ps = 0; ps < 4 && !best; ps++) {
+			for (uint32_t twbr = 0; twbr < 256; twbr++) {
+				uint32_t period = 16 + 2 * twbr * (1u << (2 * ps));
+				if (7372800UL <= khz * 1000UL * period) {  /* rate <= asked */
+					best = period;
+					break;
+				}
+			}
+		}
+		if (!best) {
+			best = 16 + 2 * 255 * 64;
+		}
+		twi_rate_t r = twi_rate_for_khz(7372800UL, (uint16_t)khz);
+		if (r.period != best || r.khz != 7372800UL / (best * 1000UL)) {
+			char d[120];
+			snprintf(d, sizeof d, "khz=%u period=%lu want %lu", (unsigned)khz,
+				 (unsigned long)r.period, (unsigned long)best);
+			check(0, "rate search", d);
+			bad = 1;
+		}
+	}
+	check(!bad, "rates 1..1000 kHz", NULL);
 }
 
 static void test_i2c(void)

@@ -34,6 +34,13 @@ typedef struct {
 	uint8_t status;      /* the status register afterwards */
 } result_t;
 
+/* The status register's value, without selecting register 01 (so a read
+ * frame of the fuzz reads the register its own select named). */
+static uint8_t status_now(void)
+{
+	return (uint8_t)regmap_status();
+}
+
 static uint8_t status_read(void)
 {
 	uint8_t buf[SLAVE_BUF], st = 0xEE;
@@ -69,7 +76,7 @@ static void run_gateway(const frame_t *f, result_t *r)
 		}
 	}
 	r->end = xact_frame_end();
-	r->status = status_read();
+	r->status = status_now();
 }
 
 /* The slave's way (i2c_slave/): its own 64-byte buffer, bytes one at a time
@@ -96,7 +103,7 @@ static void run_slave(const frame_t *f, result_t *r)
 		}
 	}
 	r->end = xact_frame_end();
-	r->status = status_read();
+	r->status = status_now();
 }
 
 /* The whole slave (i2c_slave/slave_fsm.c) under a model of the AVR TWI: the
@@ -124,15 +131,8 @@ static void run_twi(const frame_t *f, result_t *r)
 		}
 		sent_ok &= twi_event(TW_ST_DATA_NACK, &b) == SLAVE_ACK;
 		CHECK(sent_ok);
-		r->status = status_read();
-		r->ok = r->status != REG_NOT_READABLE;
-		if (!r->ok) {
-			/* SPEC 4: the read address is acknowledged anyway, FF */
-			for (uint8_t k = 0; k < f->n; k++) {
-				CHECK_EQ(r->got[k], 0xFF);
-			}
-			memset(r->got, 0, sizeof r->got);
-		}
+		r->status = status_now();
+		r->ok = 1;  /* the TWI cannot refuse: compared as FF bytes */
 		return;
 	}
 	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
@@ -152,7 +152,7 @@ static void run_twi(const frame_t *f, result_t *r)
 	if (addressed) {
 		CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
 	}
-	r->status = status_read();
+	r->status = status_now();
 }
 
 static uint32_t rng_state;
@@ -189,15 +189,20 @@ static void random_frame(frame_t *f)
 	}
 }
 
-/* A read frame of the register written last needs it selected: run the
- * select as a write frame of its own first, as both front ends would. */
-static void run_seq(const frame_t *seq, unsigned n, result_t *out,
+/* A read frame reads its register: the select runs first as a write frame
+ * of its own (its result is compared too), as a host would send it. */
+static void run_seq(const frame_t *seq, unsigned n, result_t *out, result_t *sel_out,
 		    void (*run)(const frame_t *, result_t *))
 {
 	boot();
 	xact_init();
 	slave_fsm_init();
 	for (unsigned i = 0; i < n; i++) {
+		memset(&sel_out[i], 0, sizeof sel_out[i]);
+		if (seq[i].read) {
+			frame_t sel = { .reg = seq[i].reg, .read = 0, .n = 0 };
+			run(&sel, &sel_out[i]);
+		}
 		run(&seq[i], &out[i]);
 	}
 }
@@ -206,7 +211,8 @@ static void test_equal_to_frames(void)
 {
 	enum { ROUNDS = 300, FRAMES = 40 };
 	static frame_t seq[FRAMES];
-	static result_t a[FRAMES], b[FRAMES], c[FRAMES];
+	static result_t a[FRAMES], b[FRAMES], c[FRAMES], sa[FRAMES], sb[FRAMES], sc[FRAMES];
+	unsigned reads = 0;
 	int bad = 0;
 
 	rng_state = 12345;
@@ -214,9 +220,18 @@ static void test_equal_to_frames(void)
 		for (unsigned i = 0; i < FRAMES; i++) {
 			random_frame(&seq[i]);
 		}
-		run_seq(seq, FRAMES, a, run_gateway);
-		run_seq(seq, FRAMES, b, run_slave);
-		run_seq(seq, FRAMES, c, run_twi);
+		run_seq(seq, FRAMES, a, sa, run_gateway);
+		run_seq(seq, FRAMES, b, sb, run_slave);
+		run_seq(seq, FRAMES, c, sc, run_twi);
+		for (unsigned i = 0; i < FRAMES; i++) {
+			sa[i].end = sb[i].end = sc[i].end = 0;  /* in the status too */
+			reads += seq[i].read && a[i].ok && seq[i].reg > REGMAP_STATUS_REG;
+			if (memcmp(&sa[i], &sb[i], sizeof sa[i]) != 0 ||
+			    memcmp(&sa[i], &sc[i], sizeof sa[i]) != 0) {
+				printf("xact fuzz round %d frame %u: the selects differ\n", round, i);
+				bad = 1;
+			}
+		}
 		for (unsigned i = 0; i < FRAMES && !bad; i++) {
 			if (memcmp(&a[i], &b[i], sizeof a[i]) != 0) {
 				printf("xact fuzz round %d frame %u (%s reg %02X n %u): gateway "
@@ -230,9 +245,18 @@ static void test_equal_to_frames(void)
 			}
 		}
 		for (unsigned i = 0; i < FRAMES && !bad; i++) {
-			a[i].end = 0;  /* the TWI run has no frame-end result: */
-			c[i].end = 0;  /* the status register carries it */
-			if (memcmp(&a[i], &c[i], sizeof a[i]) != 0) {
+			/* the TWI run has no frame-end result (the status has
+			 * it), and sends FF where the gateway refuses a read */
+			result_t want = a[i];
+			want.end = 0;
+			c[i].end = 0;
+			if (seq[i].read) {
+				if (!want.ok) {
+					memset(want.got, 0xFF, seq[i].n);
+				}
+				want.ok = 1;
+			}
+			if (memcmp(&want, &c[i], sizeof want) != 0) {
 				printf("twi fuzz round %d frame %u (%s reg %02X n %u): gateway acks %u "
 				       "st %02X ok %u, twi slave acks %u st %02X ok %u\n", round, i,
 				       seq[i].read ? "read" : "write", seq[i].reg, seq[i].n, a[i].acks,
@@ -242,6 +266,8 @@ static void test_equal_to_frames(void)
 		}
 	}
 	CHECK(!bad);
+	/* the reads reached drivers, not only the status register */
+	CHECK(reads > ROUNDS * FRAMES / 4);
 }
 
 static void test_refusals(void)
@@ -255,6 +281,12 @@ static void test_refusals(void)
 	CHECK(!xact_write_received(B.nregs));
 	CHECK(!xact_write_received(0x00));
 	CHECK_EQ(xact_frame_end(), REG_NO_REGISTER);
+	/* ... and no register is selected: a read gives FF, the status
+	 * keeps 08, until a register byte names one. */
+	CHECK(!xact_read_requested(buf, sizeof buf));
+	CHECK(!xact_read_processed(&byte));
+	CHECK_EQ(byte, 0xFF);
+	CHECK_EQ(xact_frame_end(), REG_OK);
 	CHECK_EQ(status_read(), REG_NO_REGISTER);
 	/* Data for the status register: the first data byte is refused. */
 	xact_write_requested(buf, sizeof buf);
@@ -273,15 +305,22 @@ static void test_refusals(void)
 	CHECK(!xact_write_received(0x05));
 	CHECK_EQ(xact_frame_end(), REG_BAD_LENGTH);
 	READ(B.servo_sp, 4, "00 00 00 00");
-	/* A write the driver rejects at the frame's end: acknowledged byte by
-	 * byte, rejected at the end, status tells. */
+	/* A data byte that makes the write invalid (a servo channel that
+	 * does not exist): refused at once, the rest too (SPEC section 4). */
 	xact_write_requested(buf, sizeof buf);
 	CHECK(xact_write_received(B.servo_sp));
-	CHECK(xact_write_received(B.servo_channels));
-	CHECK(xact_write_received(0x05));
-	CHECK(xact_write_received(0xDC));
+	CHECK(!xact_write_received(B.servo_channels));
+	CHECK(!xact_write_received(0x05));
 	CHECK_EQ(xact_frame_end(), REG_BAD_VALUE);
 	CHECK_EQ(status_read(), REG_BAD_VALUE);
+	/* A write found wrong only when it ends (two bytes of a triple):
+	 * acknowledged byte by byte, rejected at the end, status tells. */
+	xact_write_requested(buf, sizeof buf);
+	CHECK(xact_write_received(B.servo_sp));
+	CHECK(xact_write_received(0x00));
+	CHECK(xact_write_received(0x05));
+	CHECK_EQ(xact_frame_end(), REG_BAD_LENGTH);
+	CHECK_EQ(status_read(), REG_BAD_LENGTH);
 	/* A register that cannot be read (SPI DATA before any exchange):
 	 * nothing, FF bytes, status 05. */
 	xact_write_requested(buf, sizeof buf);
@@ -335,8 +374,93 @@ static void test_intro_cursor(void)
 	CHECK_EQ(rec[4], 0x02 + B.gpio_nports * 2);  /* driver 3 = SPI starts after GPIO */
 }
 
+/* A driver's check never refuses what its write would take: for random
+ * writes to every register, a write refused at some byte is also rejected
+ * whole by the driver (from the same state). */
+static void test_check_agrees_with_write(void)
+{
+	uint8_t data[SLAVE_BUF];
+	int bad = 0;
+
+	rng_state = 777;
+	for (int round = 0; round < 20000 && !bad; round++) {
+		uint8_t reg = (uint8_t)(2 + rnd(B.nregs - 2));
+		uint8_t n = (uint8_t)(1 + (rnd(2) ? rnd(6) : rnd(SLAVE_BUF)));
+		for (uint8_t k = 0; k < n; k++) {
+			data[k] = (uint8_t)(rnd(2) ? rnd(3) : rnd(256));
+		}
+		boot();
+		bad |= !regmap_select(reg);
+		uint8_t refused_at = 0;
+		for (uint8_t k = 1; k <= n && !refused_at; k++) {
+			if (regmap_check(data, k) != REG_OK) {
+				refused_at = k;
+			}
+		}
+		if (refused_at && regmap_write(data, n) == REG_OK) {
+			printf("check refused register %02X at byte %u of %u, the write took it\n",
+			       reg, refused_at, n);
+			bad = 1;
+		}
+	}
+	CHECK(!bad);
+}
+
+/* A master that gives up mid-frame: a bus error (illegal START/STOP) drops
+ * the frame whole; a read that a STOP ends without a NACK leaves the slave
+ * ready for the next frame. */
+static void test_aborted_frames(void)
+{
+	uint8_t b;
+
+	boot();
+	slave_fsm_init();
+	uint8_t sp = B.servo_sp;
+	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	b = sp;
+	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	b = 0x00;
+	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	b = 0x05;
+	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	b = 0xDC;
+	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
+	READ(sp, 2, "00 00");                    /* nothing applied */
+	/* the next frame is served: the same write, ended properly */
+	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	const uint8_t w[4] = { sp, 0x00, 0x05, 0xDC };
+	for (int i = 0; i < 4; i++) {
+		b = w[i];
+		CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	}
+	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	READ(sp, 2, "05 DC");
+	/* a read the master ends with a STOP after an ACK: no event comes
+	 * (the TWI leaves the frame by itself); the next write is served.
+	 * (READ above left the status register selected: select SP.) */
+	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	b = sp;
+	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(b, 0x05);
+	CHECK_EQ(twi_event(TW_ST_DATA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(b, 0xDC);
+	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	const uint8_t off[4] = { sp, 0x00, 0x00, 0x00 };
+	for (int i = 0; i < 4; i++) {
+		b = off[i];
+		CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	}
+	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	READ(sp, 2, "00 00");
+}
+
 void xact_tests(void)
 {
+	test_aborted_frames();
+	test_check_agrees_with_write();
 	test_refusals();
 	test_intro_cursor();
 	test_equal_to_frames();
