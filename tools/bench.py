@@ -536,7 +536,7 @@ def main():
         row("  bus time % of wire", "%14.1f", lambda r: 100.0 * r[key][1] / r[key][2])
     row("longest SCL stretch per byte (cycles)", "%14d", lambda r: r["stretch byte"])
     row("SCL stretch, 16-triple servo write", "%14d", lambda r: r["stretch write"], "<= 88473")
-    row("longest TWI interrupt (cycles)", "%14d", lambda r: r["isr"])
+    row("longest TWI interrupt, own (cycles)", "%14d", lambda r: r["isr"])
     row("pipelined %d: correct replies" % SLAVE_PIPELINE, "%14s",
         lambda r: "%d/%d" % (r["pipeline"][0], SLAVE_PIPELINE),
         "%d/%d" % (SLAVE_PIPELINE, SLAVE_PIPELINE))

@@ -78,6 +78,18 @@ def slave_option(spec: SlaveSpec) -> str:
     return "%s:0x%02X:%s" % (board, addr, path)
 
 
+def _die_with_parent() -> None:
+    """In the simulator's child process (Linux): SIGTERM it when the process
+    that started it dies, killed or crashed, so no simulator is left running
+    behind a test or a console that was killed."""
+    try:
+        import ctypes
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGTERM)          # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
 class SimBoard:
     """A simulated ORFA board running as a child process; a context manager.
 
@@ -167,7 +179,8 @@ class SimBoard:
         self._stdout = open(self.dir / "stdout", "wb")
         self._stderr = open(self.dir / "stderr", "wb")
         self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL,
-                                     stdout=self._stdout, stderr=self._stderr)
+                                     stdout=self._stdout, stderr=self._stderr,
+                                     preexec_fn=_die_with_parent)
         deadline = time.monotonic() + self.start_timeout
         while not os.path.exists(self.port):
             if self.proc.poll() is not None:
