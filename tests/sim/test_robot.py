@@ -277,7 +277,7 @@ def test_m128s_slave_servo_on_its_4017_output(rb):
         b.servos_off()
 
 
-def test_m128s_slave_servo_while_the_bus_streams_requests(rb):
+def test_slave_servos_while_the_bus_streams_requests(rb):
     """Servo widths on a slave stay within 1.1 us while it answers a stream
     of requests (its TWI interrupt and SCL stretching are short)."""
     gw, boards = rb
