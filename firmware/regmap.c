@@ -55,9 +55,13 @@ static const ORFA_FLASH uint8_t regmap_records[][REGMAP_RECORD_LEN] = {
 #undef X
 };
 
+/* rm.entry when no register is selected (after an unmapped one). */
+#define REGMAP_NO_ENTRY 0xFF
+_Static_assert(REGMAP_NDRIVERS < REGMAP_NO_ENTRY, "a driver index is never 0xFF");
+
 static struct {
 	uint8_t reg;     /* selected register */
-	uint8_t entry;   /* its driver's index in regmap_table */
+	uint8_t entry;   /* its driver's index in regmap_table, or REGMAP_NO_ENTRY */
 	uint8_t status;  /* result of the last write or read that reached a driver */
 } rm;
 
@@ -74,6 +78,10 @@ void regmap_init(void)
 bool regmap_select(uint8_t reg)
 {
 	if (reg >= REGMAP_END) {
+		/* Nothing is selected now: a read gives nothing rather than
+		 * the register selected before, and the status says 08. */
+		rm.entry = REGMAP_NO_ENTRY;
+		rm.status = REG_NO_REGISTER;
 		return false;
 	}
 	uint8_t i = 0;
@@ -85,13 +93,11 @@ bool regmap_select(uint8_t reg)
 	return true;
 }
 
-bool regmap_status_selected(void)
-{
-	return rm.reg == REGMAP_STATUS_REG;
-}
-
 reg_status_t regmap_check(const uint8_t *data, uint8_t len)
 {
+	if (rm.entry == REGMAP_NO_ENTRY) {
+		return REG_NO_REGISTER;
+	}
 	if (rm.reg == REGMAP_STATUS_REG) {
 		return REG_NOT_WRITABLE;
 	}
@@ -101,12 +107,14 @@ reg_status_t regmap_check(const uint8_t *data, uint8_t len)
 
 reg_status_t regmap_write(const uint8_t *data, uint8_t len)
 {
-	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
 	reg_status_t st;
 
-	if (rm.reg == REGMAP_STATUS_REG) {
+	if (rm.entry == REGMAP_NO_ENTRY) {
+		st = REG_NO_REGISTER;
+	} else if (rm.reg == REGMAP_STATUS_REG) {
 		st = REG_NOT_WRITABLE;
 	} else {
+		const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
 		st = e->write((uint8_t)(rm.reg - regmap_starts[rm.entry]), data, len);
 	}
 	rm.status = st;
@@ -115,13 +123,16 @@ reg_status_t regmap_write(const uint8_t *data, uint8_t len)
 
 void regmap_read_start(void)
 {
-	if (rm.reg != REGMAP_STATUS_REG) {
+	if (rm.reg != REGMAP_STATUS_REG && rm.entry != REGMAP_NO_ENTRY) {
 		rm.status = REG_OK;
 	}
 }
 
 uint8_t regmap_read(uint8_t *dst, uint8_t max)
 {
+	if (rm.entry == REGMAP_NO_ENTRY) {
+		return 0;  /* nothing selected: nothing to read, the status keeps 08 */
+	}
 	if (rm.reg == REGMAP_STATUS_REG) {
 		/* Reading the status leaves it as it is. */
 		for (uint8_t i = 0; i < max; i++) {
@@ -131,7 +142,7 @@ uint8_t regmap_read(uint8_t *dst, uint8_t max)
 	}
 	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
 	uint8_t got = e->read((uint8_t)(rm.reg - regmap_starts[rm.entry]), dst, max);
-	if (got == 0 || got > max) {
+	if (got == 0) {  /* (a driver gives at most max: tests/unit checks each) */
 		rm.status = REG_NOT_READABLE;
 		return 0;
 	}

@@ -51,12 +51,10 @@ typedef enum {
 /* Calls every driver's init; selects register 0x00; status OK. */
 void regmap_init(void);
 
-/* Selects a register for the following writes and reads. False, and nothing
- * changes, if no driver maps it. */
+/* Selects a register for the following writes and reads. False if no driver
+ * maps it: then no register is selected (reads give nothing, writes are
+ * refused) and the status says REG_NO_REGISTER. */
 bool regmap_select(uint8_t reg);
-
-/* True when the selected register is the status register. */
-bool regmap_status_selected(void);
 
 /* Whether a write of the selected register that starts with these `len`
  * bytes can still be taken (drv_name_check). */

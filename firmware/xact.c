@@ -11,9 +11,7 @@ typedef enum {
 
 static struct {
 	uint8_t state;
-	/* why a refused write frame was refused; REG_NO_REGISTER also means
-	 * no register is selected (until a register byte names one) */
-	uint8_t refusal;
+	uint8_t refusal;  /* why a refused write frame was refused */
 	uint8_t *buf;
 	uint8_t cap;
 	uint8_t len;      /* write: data bytes held; read: bytes answered */
@@ -23,7 +21,6 @@ static struct {
 void xact_init(void)
 {
 	xact.state = XACT_IDLE;
-	xact.refusal = REG_OK;
 }
 
 void xact_write_requested(uint8_t *buf, uint8_t cap)
@@ -46,12 +43,11 @@ bool xact_write_received(uint8_t byte)
 {
 	switch (xact.state) {
 	case XACT_SELECT:
-		/* No register is selected after an unmapped one: a read then
-		 * gives nothing rather than the register selected before. */
+		/* After an unmapped register none is selected (regmap.h): a
+		 * read then gives nothing, not the register selected before. */
 		if (!regmap_select(byte)) {
 			return xact_refuse(REG_NO_REGISTER);
 		}
-		xact.refusal = REG_OK;
 		xact.state = XACT_DATA;
 		return true;
 	case XACT_DATA: {
@@ -98,12 +94,8 @@ bool xact_read_requested(uint8_t *buf, uint8_t cap)
 	xact.cap = cap;
 	xact.len = 0;
 	xact.pos = 0;
-	if (xact.refusal == REG_NO_REGISTER) {
-		xact.state = XACT_NO_DATA;  /* the status keeps saying why */
-		return false;
-	}
 	regmap_read_start();
-	return cap > 0 && xact_refill();
+	return xact_refill();
 }
 
 bool xact_read_processed(uint8_t *byte)

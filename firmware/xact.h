@@ -39,8 +39,8 @@ void xact_write_requested(uint8_t *buf, uint8_t cap);
  * tells why. */
 bool xact_write_received(uint8_t byte);
 
-/* A read frame begins; driver answers go to `cap` bytes at `buf` (at least
- * REGMAP_READ_MAX for a front end that does not know the read length).
+/* A read frame begins; driver answers go to `cap` (>= 1) bytes at `buf` (at
+ * least REGMAP_READ_MAX for a front end that does not know the read length).
  * False when the selected register cannot be read (status tells). */
 bool xact_read_requested(uint8_t *buf, uint8_t cap);
 

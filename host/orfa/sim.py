@@ -78,16 +78,21 @@ def slave_option(spec: SlaveSpec) -> str:
     return "%s:0x%02X:%s" % (board, addr, path)
 
 
-def _die_with_parent() -> None:
-    """In the simulator's child process (Linux): SIGTERM it when the process
+def _die_with(parent: int):
+    """For the simulator's child process (Linux): SIGTERM it when the thread
     that started it dies, killed or crashed, so no simulator is left running
-    behind a test or a console that was killed."""
-    try:
-        import ctypes
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(1, signal.SIGTERM)          # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        pass
+    behind a test or a console that was killed (simulators are started from
+    the main thread). If the parent is already gone, do not start at all."""
+    def preexec() -> None:
+        try:
+            import ctypes
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGTERM)      # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            return
+        if os.getppid() != parent:
+            os._exit(1)
+    return preexec
 
 
 class SimBoard:
@@ -180,7 +185,7 @@ class SimBoard:
         self._stderr = open(self.dir / "stderr", "wb")
         self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL,
                                      stdout=self._stdout, stderr=self._stderr,
-                                     preexec_fn=_die_with_parent)
+                                     preexec_fn=_die_with(os.getpid()))
         deadline = time.monotonic() + self.start_timeout
         while not os.path.exists(self.port):
             if self.proc.poll() is not None:

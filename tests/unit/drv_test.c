@@ -278,13 +278,20 @@ static void test_intro(void)
 
 	/* The status register cannot be written: 04, and it says so. */
 	WRITE(REGMAP_STATUS_REG, "00", REG_NOT_WRITABLE);
-	/* Registers past the map are not acknowledged; the selection stays. */
+	/* Registers past the map are not acknowledged, and then none is
+	 * selected: a read gives nothing, the status says 08 (not the
+	 * register selected before: introspection's count here). */
 	const uint8_t zero = 0;
 	CHECK(regmap_select(0x00));
 	CHECK_EQ(regmap_write(&zero, 1), REG_OK);
 	CHECK(!regmap_select(B.nregs));
 	CHECK(!regmap_select(0xFF));
-	uint8_t c = 0;
+	uint8_t c = 0xEE;
+	CHECK_EQ(read_n(&c, 1), REG_NOT_READABLE);
+	CHECK_EQ(c, 0xEE);
+	CHECK_EQ(regmap_status(), REG_NO_REGISTER);
+	CHECK_EQ(regmap_write(&zero, 1), REG_NO_REGISTER);
+	CHECK(regmap_select(0x00));
 	CHECK_EQ(read_n(&c, 1), REG_OK);
 	CHECK_EQ(c, B.ndrivers);
 }

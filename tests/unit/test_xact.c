@@ -375,21 +375,28 @@ static void test_intro_cursor(void)
 }
 
 /* A driver's check never refuses what its write would take: for random
- * writes to every register, a write refused at some byte is also rejected
- * whole by the driver (from the same state). */
+ * writes to every register (introspection too), with an SPI channel bound so
+ * that exchanges can succeed, a write refused at byte k is rejected whole by
+ * the driver at every length from k on (each from the same fresh state). */
 static void test_check_agrees_with_write(void)
 {
 	uint8_t data[SLAVE_BUF];
-	int bad = 0;
+	int bad = 0, taken = 0;
+	/* SPI channel 0's chip select: C2 on the M32-D, A2 on the M128-S */
+	const uint8_t bind[3] = { 0x00, (uint8_t)(B.gpio_nports == 4 ? 2 : 0), 0x02 };
 
 	rng_state = 777;
 	for (int round = 0; round < 20000 && !bad; round++) {
-		uint8_t reg = (uint8_t)(2 + rnd(B.nregs - 2));
+		uint8_t reg = (uint8_t)(rnd(4) ? 2 + rnd(B.nregs - 2) : 0);
 		uint8_t n = (uint8_t)(1 + (rnd(2) ? rnd(6) : rnd(SLAVE_BUF)));
 		for (uint8_t k = 0; k < n; k++) {
 			data[k] = (uint8_t)(rnd(2) ? rnd(3) : rnd(256));
 		}
+		if (reg == B.spi_data && rnd(2)) {
+			data[0] = 0;  /* the bound channel */
+		}
 		boot();
+		bad |= !regmap_select(B.spi_config) || regmap_write(bind, 3) != REG_OK;
 		bad |= !regmap_select(reg);
 		uint8_t refused_at = 0;
 		for (uint8_t k = 1; k <= n && !refused_at; k++) {
@@ -397,13 +404,21 @@ static void test_check_agrees_with_write(void)
 				refused_at = k;
 			}
 		}
-		if (refused_at && regmap_write(data, n) == REG_OK) {
-			printf("check refused register %02X at byte %u of %u, the write took it\n",
-			       reg, refused_at, n);
-			bad = 1;
+		for (uint8_t m = refused_at ? refused_at : n; m <= n && !bad; m++) {
+			boot();
+			bad |= !regmap_select(B.spi_config) || regmap_write(bind, 3) != REG_OK;
+			bad |= !regmap_select(reg);
+			reg_status_t st = regmap_write(data, m);
+			taken += st == REG_OK;
+			if (refused_at && st == REG_OK) {
+				printf("check refused register %02X at byte %u, the write took %u\n",
+				       reg, refused_at, m);
+				bad = 1;
+			}
 		}
 	}
 	CHECK(!bad);
+	CHECK(taken > 1000);  /* the writes were not all refused anyway */
 }
 
 /* A master that gives up mid-frame: a bus error (illegal START/STOP) drops
@@ -455,6 +470,24 @@ static void test_aborted_frames(void)
 	}
 	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
 	READ(sp, 2, "00 00");
+	/* No register selected after an unmapped one, also across a bus
+	 * error: a read gives FF, the status keeps 08. */
+	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	b = 0x00;
+	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	b = 0xFE;
+	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_NACK);
+	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(b, 0xFF);
+	CHECK_EQ(twi_event(TW_ST_DATA_NACK, &b), SLAVE_ACK);
+	CHECK_EQ(twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
+	CHECK_EQ(twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(b, 0xFF);
+	CHECK_EQ(twi_event(TW_ST_DATA_NACK, &b), SLAVE_ACK);
+	CHECK_EQ(regmap_status(), REG_NO_REGISTER);
 }
 
 void xact_tests(void)
