@@ -453,6 +453,30 @@ static int bm_counters(board_model_t *bm)
 	return 0;
 }
 
+/* Servo channels on plain pins (the M32-D): "servo<n>" follows channel n's
+ * pin, so servos are named alike on every board (`12/servo2`). */
+static int bm_servo_pins(board_model_t *bm)
+{
+	const board_wiring_t *w = bm->wiring;
+	char name[16];
+
+	for (int n = 0; n < 32; n++) {
+		const board_pin_t *p = board_wiring_pin(w, BW_SERVO, n);
+		bm_port_t *port = p ? board_model_port(bm, p->port) : NULL;
+
+		if (!port) {
+			break;
+		}
+		snprintf(name, sizeof(name), "servo%d", n);
+		if (signal_add(&bm->signals, &bm->servo[n], name, port->pin[p->bit].level) < 0) {
+			return -1;
+		}
+		signal_listen(&port->pin[p->bit], bm_servo_mirror, &bm->servo[n]);
+		bm->nservo++;
+	}
+	return 0;
+}
+
 /* --- setup ----------------------------------------------------------------- */
 
 /* simavr polls a low INTn pin on every cycle ("strict" level triggering,
@@ -888,7 +912,7 @@ int board_model_init(board_model_t *bm, avr_t *avr, const board_desc_t *board,
 	bm_find_ocs(bm);
 	bm_own_timer_flags(bm);
 	bm_hook_foc(bm, mcu);
-	if (bm_counters(bm) < 0) {
+	if (bm_counters(bm) < 0 || (!w->servo_counters && bm_servo_pins(bm) < 0)) {
 		return -1;
 	}
 	bm->adc_irq = avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0);

@@ -299,8 +299,13 @@ def test_slave_servos_while_the_bus_streams_requests(rb):
         for addr in (M128S, M32D):
             b = boards[addr]
             for ch, us in ((2, 1234), (5, 2000)):
-                sig = "servo%d" % ch if b.board == "m128s" else b.lay["servo_pins"][ch]
-                pulses = b.highs(sig, t)
+                # `servo<n>` on both boards; on the M32-D it follows the pin
+                sig = "servo%d" % ch
+                until = b.now()
+                pulses = b.highs(sig, t, until)
+                if b.board == "m32d":
+                    pin = b.highs(b.lay["servo_pins"][ch], t, until)
+                    assert [p[:2] for p in pulses] == [p[:2] for p in pin]
                 assert len(pulses) >= 5, (addr, ch, pulses)
                 for _, high, _ in pulses:
                     assert abs(high / F_CPU * 1e6 - us) <= 1.1, (addr, ch, high)
