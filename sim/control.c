@@ -2,6 +2,7 @@
  * control.c: the control socket and its line protocol.
  */
 #define _GNU_SOURCE
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <inttypes.h>
@@ -474,9 +475,15 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 		}
 	} else if (!strcasecmp(cmd, "adc") && (argc == 2 || argc == 3)) {
 		uint64_t ch;
+		const char *a = argv[1];
 
-		if (parse_u64(argv[1], &ch) < 0 || ch > 7) {
-			rp(&r, "ERR adc CH [MV]: CH 0..7");
+		/* CH, or the pin of that line of the ADC port (M32-D A5, M128-S F3) */
+		if (toupper((unsigned char)a[0]) == bm->wiring->adc_port && a[1] >= '0' &&
+		    a[1] <= '7' && !a[2]) {
+			ch = (uint64_t)(a[1] - '0');
+		} else if (parse_u64(a, &ch) < 0 || ch > 7) {
+			rp(&r, "ERR adc CH [MV]: CH 0..7, or a pin of the ADC port (%c0..%c7)",
+			   bm->wiring->adc_port, bm->wiring->adc_port);
 			return 0;
 		}
 		if (argc == 2) {

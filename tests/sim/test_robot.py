@@ -337,7 +337,9 @@ def test_slave_adc_reads_an_injected_voltage(rb, addr):
     gw, boards = rb
     b = boards[addr]
     b.ctl.avcc(5000)
-    b.ctl.adc(3, 2500)
+    # the analog input by its pin, with the slave's prefix: `adc 12/A3 2500`
+    b.ctl.adc("%s3" % b.lay["adc_port"], 2500)
+    assert b.ctl.request("adc %02X/3" % addr) == "2500"
     b.wr(b.lay["adc"], bytes([0x05, 0x08]))           # AVCC, 10-bit, channel 3
     try:
         b.wait(73728)
