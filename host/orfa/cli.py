@@ -114,7 +114,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--slave", type=slave_spec, action="append", default=[],
                      metavar="BOARD:ADDR[:ELF]",
                      help="a slave board on the bus (repeatable); ELF defaults to"
-                          " build/<board>-slave/orfa.elf")
+                          " build/robot/<board>-<ADDR>/orfa.elf (make robot) if"
+                          " built, else build/<board>-slave/orfa.elf")
     sim.set_defaults(func=cmd_sim)
 
     req = sub.add_parser("request", help="send requests, print the replies")

@@ -69,12 +69,21 @@ def parse_trace(text: str) -> List[TraceEvent]:
 SlaveSpec = Tuple[str, int, Union[str, Path, None]]
 
 
+def slave_firmware_path(board: str, addr: int) -> Path:
+    """The slave build for `board` at bus address `addr`: the test robot's
+    (`make robot`, build/robot/<board>-0x<ADDR>/) when there is one, else
+    build/<board>-slave/ (`make BOARD=<board> MODE=slave ADDR=<addr>`; the
+    address is compiled in, and the simulator warns when it differs)."""
+    robot = REPO_ROOT / "build" / "robot" / ("%s-0x%02X" % (board, addr)) / "orfa.elf"
+    return robot if robot.is_file() else firmware_path(board, "slave")
+
+
 def slave_option(spec: SlaveSpec) -> str:
     """The simulator's `--slave BOARD:ADDR:ELF` value of a SlaveSpec."""
     board, addr, elf = spec
     if board not in BOARDS:
         raise ValueError("slave board must be one of %s" % (BOARDS,))
-    path = Path(elf) if elf else firmware_path(board, "slave")
+    path = Path(elf) if elf else slave_firmware_path(board, addr)
     return "%s:0x%02X:%s" % (board, addr, path)
 
 
