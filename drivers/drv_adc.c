@@ -14,8 +14,7 @@ static struct {
 	uint8_t mask;
 } adc_cfg;
 
-/* RC: [settings][mask], always both. Enabled channels take their pins
- * (input, no pull-up); all of the write or none of it. */
+/* What a write's bytes so far rule out (regmap.h): refused at once. */
 reg_status_t drv_adc_check(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	(void)data;
@@ -25,6 +24,8 @@ reg_status_t drv_adc_check(uint8_t reg, const uint8_t *data, uint8_t len)
 	return len > 2 ? REG_BAD_LENGTH : REG_OK;  /* settings, mask */
 }
 
+/* RC: [settings][mask], always both. Enabled channels take their pins
+ * (input, no pull-up); all of the write or none of it. */
 reg_status_t drv_adc_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (reg != ADC_REG_RC) {

@@ -10,8 +10,7 @@ static const ORFA_FLASH uint8_t gpio_ports[GPIO_NPORTS] = {
 #undef X
 };
 
-/* Write [value] or [value][mask]: only lines in the mask that GPIO holds
- * change; lines of other functions are left alone (not an error). */
+/* What a write's bytes so far rule out (regmap.h): refused at once. */
 reg_status_t drv_gpio_check(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	(void)reg;
@@ -19,6 +18,8 @@ reg_status_t drv_gpio_check(uint8_t reg, const uint8_t *data, uint8_t len)
 	return len > 2 ? REG_BAD_LENGTH : REG_OK;  /* value, mask */
 }
 
+/* Write [value] or [value][mask]: only lines in the mask that GPIO holds
+ * change; lines of other functions are left alone (not an error). */
 reg_status_t drv_gpio_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (len < 1 || len > 2) {

@@ -23,8 +23,7 @@ void drv_motor_init(void)
 	motor_hw_init();
 }
 
-/* A write of k bytes to register r sets registers r..r+k-1 (4 bytes to PWM1
- * set all four), all of them or none. */
+/* What a write's bytes so far rule out (regmap.h): refused at once. */
 reg_status_t drv_motor_check(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	(void)data;
@@ -33,6 +32,8 @@ reg_status_t drv_motor_check(uint8_t reg, const uint8_t *data, uint8_t len)
 	return reg + len > DRV_motor_NREGS ? REG_BAD_LENGTH : REG_OK;
 }
 
+/* A write of k bytes to register r sets registers r..r+k-1 (4 bytes to PWM1
+ * set all four), all of them or none. */
 reg_status_t drv_motor_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (len == 0 || reg + len > DRV_motor_NREGS) {

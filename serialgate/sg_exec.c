@@ -36,9 +36,10 @@ static void out_error(uint8_t err)
 }
 
 /* A frame to the board itself: the register map through the transaction
- * module, byte by byte as a TWI slave sees it, never the bus. The frame's
- * bytes stay where the parser put them: a write's data are handed over in
- * place and a read's answers land where the reply is made from. */
+ * module a TWI slave uses, never the bus; a write byte by byte as the slave
+ * sees it, a read's n byte events in one call. The frame's bytes stay where
+ * the parser put them: a write's data are handed over in place and a read's
+ * answers land where the reply is made from. */
 static uint8_t run_local(uint8_t addr, uint8_t *data, uint8_t n)
 {
 	uint8_t err = SG_OK;
