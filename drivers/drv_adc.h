@@ -13,6 +13,8 @@
 #define DRV_adc_UID 0x0040
 #define DRV_adc_MAJOR 1
 #define DRV_adc_MINOR 1
+/* The link-loss failsafe leaves it as it is. */
+#define DRV_adc_SAFE() ((void)0)
 
 void drv_adc_init(void);
 reg_status_t drv_adc_write(uint8_t reg, const uint8_t *data, uint8_t len);

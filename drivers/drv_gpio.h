@@ -13,6 +13,8 @@
 #define DRV_gpio_UID BOARD_GPIO_UID
 #define DRV_gpio_MAJOR 1
 #define DRV_gpio_MINOR 1
+/* The link-loss failsafe leaves it as it is. */
+#define DRV_gpio_SAFE() ((void)0)
 
 void drv_gpio_init(void);
 reg_status_t drv_gpio_write(uint8_t reg, const uint8_t *data, uint8_t len);

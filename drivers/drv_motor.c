@@ -80,3 +80,9 @@ uint8_t drv_motor_read(uint8_t reg, uint8_t *dst, uint8_t max)
 	}
 	return n;
 }
+
+void drv_motor_safe(void)
+{
+	const uint8_t stop[MOTOR_COUNT] = { 0, 0 };
+	(void)drv_motor_write(0, stop, MOTOR_COUNT);  /* PWM 0 is always taken */
+}

@@ -18,6 +18,8 @@
 #define DRV_spi_UID 0x0001
 #define DRV_spi_MAJOR 1
 #define DRV_spi_MINOR 1
+/* The link-loss failsafe leaves it as it is. */
+#define DRV_spi_SAFE() ((void)0)
 
 void drv_spi_init(void);
 reg_status_t drv_spi_write(uint8_t reg, const uint8_t *data, uint8_t len);

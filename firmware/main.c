@@ -7,18 +7,23 @@
 #include "firmware/mcu.h"
 #include "firmware/pins.h"
 #include "firmware/regmap.h"
+#include "firmware/sys.h"
 
 int main(void)
 {
-	mcu_watchdog_start();
+	sys_boot(mcu_watchdog_start());
 	mcu_jtag_off();
 	clock_init();
 	pins_init();
 	regmap_init();
 	front_init();
 	sei();
+	/* The only place that feeds the watchdog (besides waits that feed
+	 * on progress: uart_putc, the TWI master): a stuck main loop or a
+	 * stuck interrupt both end in a reset. */
 	for (;;) {
 		wdt_reset();
 		front_poll();
+		sys_poll();
 	}
 }

@@ -28,10 +28,12 @@ mcu_port_t mcu_port(uint8_t index)
 	return p;
 }
 
-void mcu_watchdog_start(void)
+uint8_t mcu_watchdog_start(void)
 {
+	uint8_t flags = MCU_RESET_FLAGS;
 	MCU_RESET_FLAGS = 0;
 	wdt_enable(WDTO_250MS);
+	return flags;
 }
 
 void mcu_jtag_off(void)

@@ -60,9 +60,10 @@ typedef struct {
  * board files name nothing else. */
 mcu_port_t mcu_port(uint8_t index);
 
-/* Watchdog on, reset flags cleared (simavr re-arms a fired watchdog until
- * WDRF is cleared; harmless on silicon). */
-void mcu_watchdog_start(void);
+/* Watchdog on (250 ms), reset flags cleared (simavr re-arms a fired
+ * watchdog until WDRF is cleared; harmless on silicon). Returns the reset
+ * flags as they were, so the reset cause is not lost (firmware/sys.h). */
+uint8_t mcu_watchdog_start(void);
 
 /* Frees the JTAG pins (M32-D PC2-PC5, M128-S PF4-PF7) for their board
  * functions even when the JTAGEN fuse is programmed. */

@@ -1,6 +1,7 @@
 #include "firmware/regmap.h"
 
 #include "drivers/drivers.h"
+#include "firmware/sys.h"
 
 /* Start registers, computed by the compiler: each driver starts right after
  * the last register of the one before it. */
@@ -11,6 +12,9 @@ enum {
 	REGMAP_LAST_##name = REGMAP_START_##name + DRV_##name##_NREGS - 1,
 	ORFA_DRIVER_LIST
 #undef X
+	/* sys always last: appending it moved no other register */
+	REGMAP_START_sys,
+	REGMAP_LAST_sys = REGMAP_START_sys + DRV_sys_NREGS - 1,
 	REGMAP_END
 };
 
@@ -31,6 +35,7 @@ static const ORFA_FLASH regmap_entry_t regmap_table[] = {
 #define X(name) { drv_##name##_init, drv_##name##_write, drv_##name##_read, drv_##name##_check },
 	ORFA_DRIVER_LIST
 #undef X
+	{ drv_sys_init, drv_sys_write, drv_sys_read, drv_sys_check },
 };
 
 #define REGMAP_NDRIVERS ((uint8_t)(sizeof regmap_table / sizeof regmap_table[0]))
@@ -41,6 +46,7 @@ static const ORFA_FLASH uint8_t regmap_starts[] = {
 #define X(name) REGMAP_START_##name,
 	ORFA_DRIVER_LIST
 #undef X
+	REGMAP_START_sys,
 };
 
 /* Introspection records, made by the compiler. */
@@ -53,6 +59,7 @@ static const ORFA_FLASH uint8_t regmap_records[][REGMAP_RECORD_LEN] = {
 			      REGMAP_START_##name, DRV_##name##_NREGS),
 	ORFA_DRIVER_LIST
 #undef X
+	REGMAP_RECORD(DRV_sys_UID, DRV_sys_MAJOR, DRV_sys_MINOR, REGMAP_START_sys, DRV_sys_NREGS),
 };
 
 /* rm.entry when no register is selected (after an unmapped one). */
@@ -147,6 +154,14 @@ uint8_t regmap_read(uint8_t *dst, uint8_t max)
 		return 0;
 	}
 	return got;
+}
+
+void regmap_safe(void)
+{
+	/* Each driver's DRV_<name>_SAFE(): a call, or nothing. */
+#define X(name) DRV_##name##_SAFE();
+	ORFA_DRIVER_LIST
+#undef X
 }
 
 reg_status_t regmap_status(void)

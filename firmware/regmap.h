@@ -45,6 +45,11 @@ typedef enum {
  *       puts up to `max` bytes of the register's data at `dst` and returns
  *       how many; 0 means the register cannot be read. The regmap asks again
  *       when a read frame wants more bytes than one answer gave.
+ *   DRV_name_SAFE()
+ *       a statement-like macro: the driver's link-loss safe state, applied
+ *       as if the host had written it (drv_name_safe() for motors and
+ *       servos), or ((void)0) for a driver that has none. Every driver
+ *       says which, so none is forgotten.
  * `reg` is the register's offset inside the driver's range.
  */
 
@@ -71,6 +76,10 @@ void regmap_read_start(void);
  * how many. 0: it cannot be read (status REG_NOT_READABLE). Asking again
  * gives the driver's next answer (xact.h asks when one is used up). */
 uint8_t regmap_read(uint8_t *dst, uint8_t max);
+
+/* The link-loss failsafe tripped: every driver's DRV_name_SAFE() (motors
+ * stop, servos go limp); the status register is left as it is. */
+void regmap_safe(void);
 
 /* The status register's value (what reading register 0x01 gives). */
 reg_status_t regmap_status(void);

@@ -140,7 +140,12 @@ void uart_putc(uint8_t c)
 	}
 	uint8_t head = uart.tx_head;
 	uint8_t next = (uint8_t)((head + 1) & (UART_TX_SIZE - 1));
-	while (next == uart.tx_tail) {
+	if (next == uart.tx_tail) {
+		/* Full: the UDRE interrupt frees a slot per byte sent. The
+		 * watchdog is fed only when one did (progress): a stuck UDRE
+		 * interrupt must end in a reset, not spin here fed. */
+		while (next == uart.tx_tail) {
+		}
 		wdt_reset();
 	}
 	uart.tx[head] = c;

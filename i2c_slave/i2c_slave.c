@@ -12,6 +12,7 @@
 #include <avr/io.h>
 #include <util/twi.h>
 
+#include "firmware/sys.h"
 #include "i2c_slave/slave_fsm.h"
 
 #ifndef ORFA_ADDR
@@ -60,7 +61,13 @@ ISR(TWI_vect)
 	TWCR = (uint8_t)(TWCR & ~(_BV(TWINT) | _BV(TWIE)));
 	sei();
 	uint8_t byte = TWDR;
-	slave_action_t act = slave_fsm_event(TW_STATUS, &byte);
+	uint8_t status = TW_STATUS;
+	/* Its own address (SLA+W or SLA+R) keeps the link alive; frames for
+	 * other addresses never reach here. */
+	if (status == TW_SR_SLA_ACK || status == TW_ST_SLA_ACK) {
+		SYS_HEARD();
+	}
+	slave_action_t act = slave_fsm_event(status, &byte);
 	cli();
 	slave_apply(act, byte);
 }

@@ -1,6 +1,7 @@
 /* The serial gateway front end: UART characters in, replies out. */
 #include "firmware/front.h"
 
+#include "firmware/sys.h"
 #include "firmware/twi_master.h"
 #include "firmware/uart.h"
 #include "serialgate/sg_exec.h"
@@ -31,8 +32,10 @@ void front_poll(void)
 	}
 	sg_event_t ev = sg_parse_char(&parser, (uint8_t)c);
 	if (ev == SG_REQUEST) {
+		SYS_HEARD();  /* any request line keeps the link alive */
 		sg_exec(&parser);
 	} else if (ev == SG_LOST) {
+		SYS_HEARD();
 		sg_exec_lost(&parser);
 	}
 }

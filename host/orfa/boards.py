@@ -3,13 +3,27 @@
 #: Driver UIDs each board can have, in register order. Builds may leave
 #: drivers out (`make DRIVERS=...`); introspection then lists fewer.
 BOARD_UIDS = {
-    "m32d": (0x0000, 0x0020, 0x0001, 0x0040, 0x0060, 0x0031),
-    "m128s": (0x0000, 0x0021, 0x0001, 0x0040, 0x0030),
+    "m32d": (0x0000, 0x0020, 0x0001, 0x0040, 0x0060, 0x0031, 0x0002),
+    "m128s": (0x0000, 0x0021, 0x0001, 0x0040, 0x0030, 0x0002),
 }
+
+#: The sys driver's registers (UID 0x0002, always built in and last, so
+#: they follow every other driver's; docs/registers.md "sys"): RESET and
+#: FAILSAFE of each board with all its drivers. A build that leaves drivers
+#: out moves them down: ask introspection then (Gateway.sys_register).
+SYS_REGISTER = {"m32d": 0x14, "m128s": 0x0C}
+
+#: RESET's bits (the MCU's MCUCSR layout), by cause name.
+RESET_CAUSES = {"power": 0x01, "external": 0x02, "brownout": 0x04,
+                "watchdog": 0x08, "jtag": 0x10}
+
+#: FAILSAFE's longest timeout in milliseconds (0 = off).
+FAILSAFE_MAX_MS = 18000
 
 DRIVER_NAMES = {
     0x0000: "introspection",
     0x0001: "SPI",
+    0x0002: "system (reset cause, failsafe)",
     0x0020: "GPIO (4 ports)",
     0x0021: "GPIO (2 ports)",
     0x0030: "servos (32)",

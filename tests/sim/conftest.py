@@ -202,7 +202,7 @@ SERVO_FRAME = 147456
 DRV_LAYOUT = {
     "m32d": {
         "gpio_ports": "ABCD", "gpio_val": 0x02, "gpio_mode": 0x06,
-        "spi": 0x0A, "adc": 0x0C, "motor": 0x0E, "servo": 0x12,
+        "spi": 0x0A, "adc": 0x0C, "motor": 0x0E, "servo": 0x12, "sys": 0x14,
         "servo_channels": 16, "adc_port": "A",
         "spi_pins": {"SS": "B4", "MOSI": "B5", "MISO": "B6", "SCK": "B7"},
         # channel n's pin
@@ -215,7 +215,7 @@ DRV_LAYOUT = {
     },
     "m128s": {
         "gpio_ports": "AF", "gpio_val": 0x02, "gpio_mode": 0x04,
-        "spi": 0x06, "adc": 0x08, "motor": None, "servo": 0x0A,
+        "spi": 0x06, "adc": 0x08, "motor": None, "servo": 0x0A, "sys": 0x0C,
         "servo_channels": 32, "adc_port": "F",
         "spi_pins": {"SS": "B0", "SCK": "B1", "MOSI": "B2", "MISO": "B3"},
         "servo_pins": ["servo%d" % n for n in range(32)],

@@ -14,7 +14,7 @@ M128S, M32D = 0x10, 0x12
 EEPROM, SRF08 = 0xA0, 0xE0
 OK, BAD_LENGTH, BAD_VALUE, NOT_WRITABLE, NOT_READABLE, NO_REGISTER = 0, 1, 2, 4, 5, 8
 #: docs/registers.md: the records of each board's drivers.
-COUNT = {M128S: 5, M32D: 6}
+COUNT = {M128S: 6, M32D: 7}
 
 
 @pytest.fixture(scope="module")
@@ -204,7 +204,7 @@ def test_absent_address(rb):
 def multi_start(gw):
     gw.eeprom_write(0x20, b"\x11\x22")
     req = ("S 10 00 00 S 11 01 S 12 00 00 S 13 01 S A0 20 S A1 02 S 10 00 01 S 11 06 P")
-    want = b"SWAASR05SWAASR06SWASR1122SWAASR000001000002P\r\n"
+    want = b"SWAASR06SWAASR07SWASR1122SWAASR000001000002P\r\n"
     assert ask(gw, req) == want
 
 

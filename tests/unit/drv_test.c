@@ -741,9 +741,41 @@ static void test_adc_common(void)
 	free(s);
 }
 
+/* The link-loss failsafe (regmap_safe()): every servo channel off, as a
+ * host's writes of width 0 would; other drivers left as they are (motors:
+ * test_drv_m32d.c). */
+static void test_failsafe_common(void)
+{
+	uint8_t sp = B.servo_sp;
+	uint8_t last = (uint8_t)(B.servo_channels - 1);
+	char hex[40];
+
+	boot();
+	snprintf(hex, sizeof hex, "00 05 DC %02X 03 E8", last);
+	WRITE(sp, hex, REG_OK);
+	CHECK_EQ(hw.servo_claimed[0], 1);
+	CHECK_EQ(hw.servo_claimed[last], 1);
+	unsigned applies = hw.servo_applies;
+	regmap_safe();
+	CHECK(hw.servo_applies > applies);
+	for (unsigned ch = 0; ch < B.servo_channels; ch++) {
+		CHECK_EQ(hw.servo_width[ch], 0);
+		CHECK_EQ(hw.servo_claimed[ch], 0);
+	}
+	READ(sp, 4, "00 00 00 00");
+	snprintf(hex, sizeof hex, "%02X", last);
+	WRITE(sp, hex, REG_OK);
+	READ(sp, 2, "00 00");
+	/* nothing pulsing: nothing to do, no new schedule */
+	applies = hw.servo_applies;
+	regmap_safe();
+	CHECK_EQ(hw.servo_applies, applies);
+}
+
 int main(void)
 {
 	test_intro();
+	test_failsafe_common();
 	test_gpio_common();
 	test_servo_common();
 	test_spi_common();

@@ -111,6 +111,19 @@ static struct {
 	uint8_t len;
 } fake;
 
+unsigned fake_safe_calls;
+uint16_t fake_clock;
+
+uint16_t clock_now(void)
+{
+	return fake_clock;
+}
+
+void drv_fake_safe(void)
+{
+	fake_safe_calls++;
+}
+
 void drv_fake_init(void)
 {
 	fake.len = 1;

@@ -19,6 +19,12 @@ void drv_fake_init(void);
 reg_status_t drv_fake_write(uint8_t reg, const uint8_t *data, uint8_t len);
 reg_status_t drv_fake_check(uint8_t reg, const uint8_t *data, uint8_t len);
 uint8_t drv_fake_read(uint8_t reg, uint8_t *dst, uint8_t max);
+/* Its link-loss safe state: counts the calls. */
+#define DRV_fake_SAFE() drv_fake_safe()
+void drv_fake_safe(void);
+extern unsigned fake_safe_calls;
+/* What clock_now() gives (firmware/clock.h). */
+extern uint16_t fake_clock;
 
 /* Everything the fake bus saw, as text: "S A0+ W00+ R11+ R22- P ". */
 extern char bus_log[4096];

@@ -19,6 +19,12 @@ char hw_log[8192];
 hw_rec_t hw;
 uint16_t adc_in[8];
 
+/* firmware/clock.h: the drivers' tests never let time pass. */
+uint16_t clock_now(void)
+{
+	return 0;
+}
+
 static uint8_t miso[256];
 static unsigned miso_len, miso_pos;
 

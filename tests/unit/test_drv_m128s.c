@@ -15,10 +15,10 @@ enum { PA, PB, PC, PD, PE, PF, PG };
 /* docs/registers.md, register map and introspection records. */
 const board_t B = {
 	.name = "m128s",
-	.nregs = 0x0C,
-	.ndrivers = 5,
+	.nregs = 0x0E,
+	.ndrivers = 6,
 	.intro = "00 00 01 00 00 02  00 21 01 01 02 04  00 01 01 01 06 02"
-		 "  00 40 01 01 08 02  00 30 02 00 0A 02",
+		 "  00 40 01 01 08 02  00 30 02 00 0A 02  00 02 01 00 0C 02",
 	.gpio_nports = 2,
 	.gpio_value = 0x02,
 	.gpio_mode = 0x04,
@@ -134,9 +134,9 @@ static void test_fixed_pins(void)
 	/* GPIO has all of A and F at reset. */
 	CHECK_EQ(pins_gpio_mask(PA), 0xFF);
 	CHECK_EQ(pins_gpio_mask(PF), 0xFF);
-	/* No motor driver: registers stop at 0B. */
+	/* No motor driver: sys follows the servos at 0C-0D, the map ends there. */
 	CHECK(regmap_select(0x0B));
-	CHECK(!regmap_select(0x0C));
+	CHECK(regmap_select(0x0D));
 	CHECK(!regmap_select(0x0E));
 }
 

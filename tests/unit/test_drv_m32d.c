@@ -13,10 +13,11 @@ enum { PA, PB, PC, PD };
 /* docs/registers.md, register map and introspection records. */
 const board_t B = {
 	.name = "m32d",
-	.nregs = 0x14,
-	.ndrivers = 6,
+	.nregs = 0x16,
+	.ndrivers = 7,
 	.intro = "00 00 01 00 00 02  00 20 01 01 02 08  00 01 01 01 0A 02"
-		 "  00 40 01 01 0C 02  00 60 01 01 0E 04  00 31 02 00 12 02",
+		 "  00 40 01 01 0C 02  00 60 01 01 0E 04  00 31 02 00 12 02"
+		 "  00 02 01 00 14 02",
 	.gpio_nports = 4,
 	.gpio_value = 0x02,
 	.gpio_mode = 0x06,
@@ -209,6 +210,29 @@ static void test_all_or_nothing(void)
 	free(s);
 }
 
+/* The link-loss failsafe stops both motors (PWM 0, directions kept), as a
+ * host's write of 00 00 to PWM1 would; a servo on a motor's line goes off. */
+static void test_motor_failsafe(void)
+{
+	boot();
+	WRITE(PWM1, "80 60 01 00", REG_OK);
+	regmap_safe();
+	READ(PWM1, 4, "00 00 01 00");
+	CHECK_EQ(hw.motor_pwm[0], 0);
+	CHECK_EQ(hw.motor_pwm[1], 0);
+	CHECK_EQ(hw.motor_dir[0], 1);
+	CHECK_EQ(pins_owner(PIN(PD, 5)), PIN_MOTOR_IDLE);
+	CHECK_EQ(pins_owner(PIN(PD, 4)), PIN_MOTOR_IDLE);
+	/* servo 14 on PWM1's line */
+	WRITE(SP, "0E 05 DC", REG_OK);
+	CHECK_EQ(pins_owner(PIN(PD, 5)), PIN_SERVO);
+	regmap_safe();
+	WRITE(SP, "0E", REG_OK);
+	READ(SP, 2, "00 00");
+	CHECK_EQ(pins_owner(PIN(PD, 5)), PIN_MOTOR_IDLE);
+	WRITE(PWM1, "10", REG_OK);
+}
+
 static void test_motors(void)
 {
 	snap_t *s = malloc(sizeof *s);
@@ -363,6 +387,7 @@ static void test_servo_pins(void)
 
 void board_tests(void)
 {
+	test_motor_failsafe();
 	test_gpio_held();
 	test_all_or_nothing();
 	test_motors();

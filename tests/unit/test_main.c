@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fakes.h"
+#include "firmware/sys.h"
 #include "firmware/twi_rate.h"
 #include "serialgate/sg_exec.h"
 #include "serialgate/sg_parse.h"
@@ -123,7 +124,7 @@ static void test_local_address(void)
 	expect("L\r", "LAA\r\n", "");
 	/* The local address moves: requests to the old one go to the bus. */
 	expect("L A0\r", "LA0\r\n", "");
-	expect("S A0 00 S A1 01 P\r", "SWASR02P\r\n", "");
+	expect("S A0 00 S A1 01 P\r", "SWASR03P\r\n", "");
 	expect("S AA P\r", "ERROR 06\r\n", "S AA- P ");
 }
 
@@ -295,6 +296,89 @@ static void test_limits(void)
 	expect(line, "V1.1\r\n", "");
 }
 
+/* The sys driver (registers 0x05 RESET, 0x06 FAILSAFE here): reset causes
+ * kept over resets, the failsafe's timing on a fake clock. */
+static void test_sys(void)
+{
+	/* power-on: fresh, whatever SRAM held */
+	sys_boot(0x01);
+	boot();
+	expect("S AA 05 S AB 01 P\r", "SWASR01P\r\n", "");
+	/* a watchdog reset and an external one before the host clears: both */
+	sys_boot(0x08);
+	sys_boot(0x02);
+	boot();
+	expect("S AA 05 S AB 01 P\r", "SWASR0BP\r\n", "");
+	/* writing clears the bits set in the byte */
+	expect("S AA 05 08 P\r", "SWAAP\r\n", "");
+	expect("S AA 05 S AB 01 P\r", "SWASR03P\r\n", "");
+	expect("S AA 05 FF P\r", "SWAAP\r\n", "");
+	expect("S AA 05 S AB 01 P\r", "SWASR00P\r\n", "");
+	/* a later power-on forgets what came before */
+	sys_boot(0x08);
+	sys_boot(0x01);
+	expect("S AA 05 S AB 01 P\r", "SWASR01P\r\n", "");
+	/* one byte only */
+	expect("S AA 05 01 02 P\r", "ERROR 07\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR01P\r\n", "");
+	expect("S AA 05 P\r", "SWAP\r\n", "");
+
+	/* FAILSAFE: off after reset; two bytes; up to 18000 ms */
+	expect("S AA 06 S AB 02 P\r", "SWASR0000P\r\n", "");
+	expect("S AA 06 00 P\r", "ERROR 07\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR01P\r\n", "");
+	expect("S AA 06 00 64 00 P\r", "ERROR 07\r\n", "");
+	expect("S AA 06 46 51 P\r", "ERROR 07\r\n", "");
+	expect("S AA 01 S AB 01 P\r", "SWASR02P\r\n", "");
+	expect("S AA 06 S AB 02 P\r", "SWASR0000P\r\n", "");
+	expect("S AA 06 46 50 P\r", "SWAAAP\r\n", "");
+	expect("S AA 06 S AB 02 P\r", "SWASR4650P\r\n", "");
+
+	/* 100 ms = 360 ticks: trips at 360 quiet ticks, once */
+	fake_clock = 65000;  /* across the clock's wrap */
+	fake_safe_calls = 0;
+	expect("S AA 06 00 64 P\r", "SWAAAP\r\n", "");
+	fake_clock = (uint16_t)(65000 + 359);
+	sys_poll();
+	check(fake_safe_calls == 0, "quiet for 359 ticks: not yet", NULL);
+	fake_clock = (uint16_t)(65000 + 360);
+	sys_poll();
+	check(fake_safe_calls == 1, "quiet for 360 ticks: tripped", NULL);
+	fake_clock += 5000;
+	sys_poll();
+	check(fake_safe_calls == 1, "tripped once per quiet spell", NULL);
+	/* a request heard starts the time again */
+	SYS_HEARD();
+	sys_poll();
+	fake_clock += 359;
+	sys_poll();
+	check(fake_safe_calls == 1, "heard: 359 ticks are not enough", NULL);
+	SYS_HEARD();
+	sys_poll();
+	fake_clock += 359;
+	sys_poll();
+	check(fake_safe_calls == 1, "heard again", NULL);
+	fake_clock += 1;
+	sys_poll();
+	check(fake_safe_calls == 2, "then 360 quiet ticks trip it again", NULL);
+	/* 0: off, never trips */
+	expect("S AA 06 00 00 P\r", "SWAAAP\r\n", "");
+	fake_clock += 30000;
+	sys_poll();
+	check(fake_safe_calls == 2, "FAILSAFE 0 never trips", NULL);
+	/* 1 ms = 4 ticks (3.6 rounded up) */
+	expect("S AA 06 00 01 P\r", "SWAAAP\r\n", "");
+	fake_clock += 3;
+	sys_poll();
+	check(fake_safe_calls == 2, "1 ms: not after 3 ticks", NULL);
+	fake_clock += 1;
+	sys_poll();
+	check(fake_safe_calls == 3, "1 ms: after 4 ticks", NULL);
+	/* reset: off again */
+	boot();
+	expect("S AA 06 S AB 02 P\r", "SWASR0000P\r\n", "");
+}
+
 static void test_lost_characters(void)
 {
 	boot();
@@ -325,27 +409,28 @@ static void test_lost_characters(void)
 static void test_registers(void)
 {
 	boot();
-	/* introspection: intro + the fake driver */
-	expect("S AA 00 00 S AB 01 P\r", "SWAASR02P\r\n", "");
+	/* introspection: intro + the fake driver + sys (always last) */
+	expect("S AA 00 00 S AB 01 P\r", "SWAASR03P\r\n", "");
 	expect("S AA 00 01 S AB 06 P\r", "SWAASR000001000002P\r\n", "");
 	expect("S AA 00 02 S AB 06 P\r", "SWAASR0F0F02030203P\r\n", "");
 	expect("S AA 00 01 S AB 0C P\r", "SWAASR0000010000020F0F02030203P\r\n", "");
 	/* status after a clean read */
 	expect("S AA 01 S AB 01 P\r", "SWASR00P\r\n", "");
 	/* the count read moves nothing: every byte and frame gives it again */
-	expect("S AA 00 00 S AB 03 P\r", "SWAASR020202P\r\n", "");
-	expect("S AB 01 S AB 01 P\r", "SR02SR02P\r\n", "");
+	expect("S AA 00 00 S AB 03 P\r", "SWAASR030303P\r\n", "");
+	expect("S AB 01 S AB 01 P\r", "SR03SR03P\r\n", "");
 	/* reading past the last driver goes on with driver 1, status 06 */
-	expect("S AA 00 02 S AB 0C P\r", "SWAASR0F0F02030203000001000002P\r\n", "");
+	expect("S AA 00 03 S AB 06 P\r", "SWAASR000201000502P\r\n", "");
+	expect("S AA 00 03 S AB 0C P\r", "SWAASR000201000502000001000002P\r\n", "");
 	expect("S AA 01 S AB 01 P\r", "SWASR06P\r\n", "");
 	/* N above the count: ERROR 07, status 02, next read gives driver 1 */
-	expect("S AA 00 03 P\r", "ERROR 07\r\n", "");
+	expect("S AA 00 04 P\r", "ERROR 07\r\n", "");
 	expect("S AA 01 S AB 01 P\r", "SWASR02P\r\n", "");
 	expect("S AA 00 S AB 06 P\r", "SWASR000001000002P\r\n", "");
 	/* each read frame asks afresh; a short frame drops the rest */
 	expect("S AA 00 01 S AB 02 S AB 06 P\r", "SWAASR0000SR0F0F02030203P\r\n", "");
 	/* unmapped registers */
-	expect("S AA 05 P\r", "ERROR 07\r\n", "");
+	expect("S AA 07 P\r", "ERROR 07\r\n", "");
 	expect("S AA FF 00 P\r", "ERROR 07\r\n", "");
 	/* the fake driver: +0 at 0x02 read/write, +1 at 0x03 read-only,
 	 * +2 at 0x04 write-only */
@@ -370,10 +455,10 @@ static void test_registers(void)
 	expect("S AA 02 P\r", "SWAP\r\n", "");
 	expect("S AA 01 S AB 01 P\r", "SWASR04P\r\n", "");
 	/* local and bus frames mixed: STOP only for the bus part */
-	expect("S AA 00 00 S A0 00 S AB 01 P\r", "SWAASWASR02P\r\n", "S A0+ W00+ P ");
+	expect("S AA 00 00 S A0 00 S AB 01 P\r", "SWAASWASR03P\r\n", "S A0+ W00+ P ");
 	/* local probe */
 	expect("S AA P\r", "SWP\r\n", "");
-	expect("S AB 01 P\r", "SR02P\r\n", "");  /* the count read moved nothing */
+	expect("S AB 01 P\r", "SR03P\r\n", "");  /* the count read moved nothing */
 	/* an unmapped register: ERROR 07, and the status register says why */
 	expect("S AA 7F P\r", "ERROR 07\r\n", "");
 	expect("S AA 01 S AB 01 P\r", "SWASR08P\r\n", "");
@@ -474,6 +559,7 @@ int main(void)
 	test_limits();
 	test_lost_characters();
 	test_registers();
+	test_sys();
 	test_fuzz();
 	printf("%d passed, %d failed\n", passed, failed);
 	return failed ? 1 : 0;
