@@ -491,9 +491,11 @@ static void bm_no_strict_level(avr_t *avr)
 }
 
 /* Stack painting: SRAM keeps its contents over a reset, as on silicon, so
- * the simulator fills it with BM_PAINT before the firmware starts; the
- * startup code then initialises .data and .bss, and the stack overwrites
- * the paint as deep as it ever goes. */
+ * the simulator fills it with BM_PAINT at power-on (start-up and `reset
+ * power`), before the firmware starts; the startup code then initialises
+ * .data and .bss, and the stack overwrites the paint as deep as it ever
+ * goes. Other resets (watchdog, external, brown-out) keep SRAM: .noinit
+ * data survive them, and the stack peak counts from power-on. */
 static void bm_paint_sram(avr_t *avr)
 {
 	for (uint32_t a = avr->ioend + 1u; a <= avr->ramend; a++) {
@@ -506,19 +508,26 @@ static void bm_reset(avr_io_t *io)
 	board_model_t *bm = (board_model_t *)io;
 	avr_t *avr = bm->avr;
 
-	/* avr_reset cleared the port registers without telling the IRQs. */
+	/* avr_reset cleared the port registers without telling the IRQs: their
+	 * values are the old registers', and simavr raises a filtered IRQ only
+	 * when the value changes, so a firmware writing after a watchdog reset
+	 * what it wrote before went unseen. The IRQs learn the reset values. */
 	for (int i = 0; i < bm->nports; i++) {
 		bm_port_t *p = &bm->ports[i];
 
 		p->ddr = avr->data[p->io->r_ddr];
 		p->port = avr->data[p->io->r_port];
+		p->irq[IOPORT_IRQ_REG_PORT].value = p->port;
+		p->irq[IOPORT_IRQ_DIRECTION_ALL].value = p->ddr;
 		bm_port_update(p, avr->cycle);
 	}
 	avr->avcc = bm->avcc;
 	avr->vcc = bm->avcc;
 	avr->aref = bm->aref;
 	bm_no_strict_level(avr);
-	bm_paint_sram(avr);
+	if (bm->reset_cause && !strcmp(bm->reset_cause, "power")) {
+		bm_paint_sram(avr);
+	}
 }
 
 static int bm_find_ports(board_model_t *bm)

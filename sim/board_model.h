@@ -111,6 +111,11 @@ typedef struct bm_flag_reg_t {
 typedef struct board_model_t {
 	avr_io_t io;			/* first: reset hook */
 	avr_t *avr;
+	/* A reset the control socket asks for (fault.h): its cause while
+	 * avr_reset runs ("external", "power", "brownout"), else NULL (the
+	 * watchdog's). A power-on paints SRAM again; other resets keep it,
+	 * as silicon does, so .noinit data live on. */
+	const char *reset_cause;
 	const board_desc_t *board;
 	const board_wiring_t *wiring;
 	trace_t *trace;

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "control.h"
+#include "fault.h"
 #include "isr_watch.h"
 #include "srf08_ctl.h"
 
@@ -283,7 +284,8 @@ static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
 	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx CYCLE HEX... | signals | "
-	"srf08 ADDR [range MM [MM2] | light N] | help; "
+	"srf08 ADDR [range MM [MM2] | light N] | fault hang | reset external|power|brownout | "
+	"help; "
 	"a slave board's pins, signals and inputs as 10/A5, other requests with @10 "
 	"first (stack @10 FROM)";
 
@@ -574,6 +576,27 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 
 		srf08_control(c->srf08, c->srf08_count, c->avr->cycle, argc, argv, text, sizeof(text));
 		rp(&r, "%s", text);
+	} else if (!strcasecmp(cmd, "fault") && argc == 2 && !strcasecmp(argv[1], "hang")) {
+		/* the board stops running its program; its watchdog resets it */
+		if (fault_hang(avr) < 0) {
+			rp(&r, "ERR fault hang: no free flash word for the loop");
+			return 0;
+		}
+		rp(&r, "%" PRIu64, (uint64_t)c->avr->cycle);
+	} else if (!strcasecmp(cmd, "reset") && argc == 2) {
+		static const char *const causes[] = { "external", "power", "brownout" };
+		const char *cause = NULL;
+
+		for (unsigned i = 0; i < sizeof(causes) / sizeof(causes[0]); i++) {
+			if (!strcasecmp(argv[1], causes[i])) {
+				cause = causes[i];
+			}
+		}
+		if (!cause || fault_reset(avr, bm, cause) < 0) {
+			rp(&r, "ERR reset external|power|brownout");
+			return 0;
+		}
+		rp(&r, "%" PRIu64, (uint64_t)c->avr->cycle);
 	} else if (!strcasecmp(cmd, "help") && argc == 1) {
 		rp(&r, "%s", control_help);
 	} else {

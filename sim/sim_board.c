@@ -6,6 +6,8 @@
 #include <string.h>
 
 #include "sim_elf.h"
+#include "sim_regbit.h"
+#include "avr_watchdog.h"
 
 #include "sim_board.h"
 
@@ -30,12 +32,55 @@ static void sim_board_sleep(avr_t *avr, avr_cycle_count_t how_long)
 static void sim_board_reset_hook(avr_io_t *io)
 {
 	sim_board_t *b = (sim_board_t *)((char *)io - offsetof(sim_board_t, reset_watch));
+	/* A reset the control socket asked for names its cause; any other is
+	 * the watchdog's (its reset hook, first in the list, set WDRF). */
+	const char *cause = b->bm.reset_cause;
 
-	/* the gateway's line keeps its old form; a slave's names the slave */
+	if (!cause) {
+		cause = (b->wd && avr_regbit_get(io->avr, b->wd->wdrf)) ? "watchdog" : "other";
+	}
 	if (b->addr) {
-		trace_event(b->trace, io->avr->cycle, "reset %02X", b->addr);
+		trace_event(b->trace, io->avr->cycle, "reset %02X %s", b->addr, cause);
 	} else {
-		trace_event(b->trace, io->avr->cycle, "reset");
+		trace_event(b->trace, io->avr->cycle, "reset %s", cause);
+	}
+}
+
+/* simavr 1.6 keeps a running watchdog's period when the firmware changes
+ * the prescaler (it compares the new WDP bits with themselves), and it
+ * restarts the watchdog at 16 ms after a watchdog reset: the firmware's
+ * 250 ms never took after the first watchdog reset. Chained after
+ * simavr's WDTCR handler: the period follows WDP, from the next WDR on
+ * (every WDR restarts the timer with this period). */
+static void sim_board_wdtcr_write(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *param)
+{
+	sim_board_t *b = param;
+	uint8_t wdp;
+
+	b->wdtcr_prev(avr, addr, v, b->wdtcr_prev_param);
+	wdp = avr_regbit_get_array(avr, b->wd->wdp, 4);
+	b->wd->cycle_count = ((avr_cycle_count_t)2048 << wdp) * avr->frequency / 128000;
+}
+
+static void sim_board_watchdog_period(sim_board_t *b)
+{
+	avr_t *avr = b->avr;
+
+	for (avr_io_t *io = avr->io_port; io; io = io->next) {
+		if (io->kind && !strcmp(io->kind, "watchdog")) {
+			b->wd = (avr_watchdog_t *)io;
+		}
+	}
+	if (!b->wd || !b->wd->wdce.reg) {
+		return;
+	}
+	avr_io_addr_t io = AVR_DATA_TO_IO(b->wd->wdce.reg);
+
+	b->wdtcr_prev = avr->io[io].w.c;
+	b->wdtcr_prev_param = avr->io[io].w.param;
+	if (b->wdtcr_prev) {
+		avr->io[io].w.c = sim_board_wdtcr_write;
+		avr->io[io].w.param = b;
 	}
 }
 
@@ -110,6 +155,7 @@ int sim_board_init(sim_board_t *b, const board_desc_t *board, const char *elf,
 	b->reset_watch.reset = sim_board_reset_hook;
 	mcu_register_io_last(b->avr, &b->reset_watch);
 	sim_board_watchdog_first(b->avr);
+	sim_board_watchdog_period(b);
 	return 0;
 }
 

@@ -27,7 +27,10 @@ typedef struct sim_board_t {
 	const board_desc_t *board;
 	const mcu_desc_t *mcu;
 	avr_t *avr;
-	avr_io_t reset_watch;		/* traces "reset" on a watchdog reset */
+	avr_io_t reset_watch;		/* traces "reset <cause>" on every reset */
+	struct avr_watchdog_t *wd;	/* simavr's watchdog (its period fix) */
+	avr_io_write_t wdtcr_prev;	/* simavr's WDTCR write handler */
+	void *wdtcr_prev_param;
 	trace_t *trace;
 	usart_t usart;
 	twi_t twi;
