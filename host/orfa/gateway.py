@@ -7,10 +7,11 @@ pseudo-terminal path (the simulator's link) and a real port are the same.
 from __future__ import annotations
 
 import time
-from typing import Iterable, List, Optional, Sequence
+from typing import Dict, FrozenSet, Iterable, List, Optional, Sequence
 
 import serial
 
+from . import boards
 from . import protocol as p
 
 
@@ -22,6 +23,7 @@ class Gateway:
         self.timeout = timeout
         self.local = local_address
         self.serial = serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
+        self._sys_reg: Dict[int, int] = {}
 
     # --- lifetime -----------------------------------------------------------
     def close(self) -> None:
@@ -126,18 +128,64 @@ class Gateway:
         results = self.transaction(p.register_read_frames(addr, reg, count))
         return results[-1].data
 
-    def drivers(self) -> List[p.DriverRecord]:
-        """The gateway's own introspection records, driver 1 first."""
-        (count,) = self.transaction([p.Write(self.local, b"\x00\x00"),
-                                     p.Read(self.local, 1)])[-1].data
+    def drivers(self, addr: Optional[int] = None) -> List[p.DriverRecord]:
+        """The introspection records of addr (None: the gateway itself), driver 1 first."""
+        addr = self.local if addr is None else addr
+        (count,) = self.transaction([p.Write(addr, b"\x00\x00"),
+                                     p.Read(addr, 1)])[-1].data
         records: List[p.DriverRecord] = []
         per_read = 10
         for first in range(1, count + 1, per_read):
             n = min(per_read, count + 1 - first)
-            data = self.transaction([p.Write(self.local, bytes([0x00, first])),
-                                     p.Read(self.local, 6 * n)])[-1].data
+            data = self.transaction([p.Write(addr, bytes([0x00, first])),
+                                     p.Read(addr, 6 * n)])[-1].data
             records += p.DriverRecord.parse_many(data)
         return records
+
+    # --- the sys driver (docs/registers.md "sys") ---------------------------------
+    def sys_register(self, addr: Optional[int] = None) -> int:
+        """The RESET register of addr's sys driver (FAILSAFE follows it), from
+        its introspection record (asked once per address)."""
+        addr = self.local if addr is None else addr
+        if addr not in self._sys_reg:
+            recs = [r for r in self.drivers(addr) if r.uid == boards.SYS_UID]
+            if not recs:
+                raise p.OrfaError("0x%02X has no sys driver (UID %04X)" % (addr, boards.SYS_UID))
+            self._sys_reg[addr] = recs[0].start
+        return self._sys_reg[addr]
+
+    def reset_cause(self, addr: Optional[int] = None) -> FrozenSet[str]:
+        """Why addr (None: the gateway) reset since the causes were last
+        cleared: a set of "power", "external", "brownout", "watchdog", "jtag"."""
+        byte = self.read_register(addr, self.sys_register(addr), 1)[0]
+        return boards.reset_causes(byte)
+
+    def clear_reset_cause(self, addr: Optional[int] = None,
+                          causes: Optional[Iterable[str]] = None) -> None:
+        """Forget the reset causes (all, or the names given)."""
+        bits = boards.RESET_CAUSES_ALL if causes is None else boards.reset_cause_bits(causes)
+        self._sys_write(addr, 0, bytes([bits]))
+
+    def failsafe(self, addr: Optional[int] = None) -> int:
+        """The link-loss failsafe's timeout in milliseconds (0: off)."""
+        data = self.read_register(addr, self.sys_register(addr) + 1, 2)
+        return data[0] << 8 | data[1]
+
+    def set_failsafe(self, addr: Optional[int], ms: int) -> None:
+        """Motors stop and servos go limp when no request has reached addr
+        (None: the gateway) for `ms` milliseconds; 0 turns it off."""
+        if not 0 <= ms <= boards.FAILSAFE_MAX_MS:
+            raise ValueError("failsafe: 0..%d ms, not %r" % (boards.FAILSAFE_MAX_MS, ms))
+        self._sys_write(addr, 1, bytes([ms >> 8, ms & 0xFF]))
+
+    def _sys_write(self, addr: Optional[int], offset: int, data: bytes) -> None:
+        addr = self.local if addr is None else addr
+        self.write_register(addr, self.sys_register(addr) + offset, data)
+        if addr != self.local:
+            # a slave acknowledges before its driver decides: ask it
+            status = self.read_register(addr, 0x01, 1)[0]
+            if status:
+                raise p.OrfaError("0x%02X refused the sys write: status %02X" % (addr, status))
 
     def status(self) -> int:
         """The gateway's status register (result of the last register access)."""

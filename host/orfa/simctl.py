@@ -176,6 +176,16 @@ class SimControl:
             raise ValueError("rx takes 1..%d bytes, not %d" % (RX_MAX, len(data)))
         return int(self.request("rx %d %s" % (cycle, bytes(data).hex().upper())))
 
+    def fault_hang(self) -> int:
+        """The board stops running its program (interrupts off, the PC on an
+        endless loop) until its watchdog resets it; returns the cycle."""
+        return int(self.request(self._board("fault hang")))
+
+    def reset(self, cause: str = "external") -> int:
+        """Reset the board now: "external" (the RESET pin), "power" (a
+        power cycle: SRAM lost) or "brownout"; returns the cycle."""
+        return int(self.request(self._board("reset %s" % cause)))
+
     def peek(self, addr: int, n: int = 1) -> bytes:
         """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
         return bytes.fromhex(self.request(self._board("peek %d %d" % (addr, n))))

@@ -160,6 +160,11 @@ def running(sim: SimBoard, make_bench=Bench):
         b.close()
         status = sim.stop()
         assert status == 0, "orfa-sim exited with %r" % status
+        # The watchdog never fires in normal use: no reset in the whole
+        # run, unless the test made one on purpose (test_watchdog.py).
+        if sim.want_trace and not getattr(sim, "expect_resets", False):
+            resets = sim.trace_events(kinds=["reset"])
+            assert resets == [], "the board reset: %r" % resets
 
 
 @pytest.fixture(scope="module", params=BOARDS)
