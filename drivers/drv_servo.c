@@ -150,17 +150,15 @@ uint8_t drv_servo_read(uint8_t reg, uint8_t *dst, uint8_t max)
 
 void drv_servo_safe(void)
 {
-	/* Through the host's own path, one SP write of 16 [ch][00][00]
-	 * triples per 16 channels: servo_hw_apply() keeps its one caller (it
-	 * is inlined there) and the failsafe is exactly a host's write. */
-	uint8_t t[3 * SERVO_MAX_TRIPLES];
-	_Static_assert(SERVO_CHANNELS % SERVO_MAX_TRIPLES == 0, "whole writes of 16 triples");
-	for (uint8_t first = 0; first < SERVO_CHANNELS; first += SERVO_MAX_TRIPLES) {
-		for (uint8_t i = 0; i < SERVO_MAX_TRIPLES; i++) {
-			t[3 * i] = (uint8_t)(first + i);
-			t[3 * i + 1] = 0;
-			t[3 * i + 2] = 0;
+	/* Through the host's own path, a [ch][00][00] write for each channel
+	 * that pulses: servo_write_sp() and servo_hw_apply() keep their one
+	 * caller each (inlined there),
+	 * no buffer of 16 triples sits on the stack (this may be inlined into
+	 * the main loop), and the failsafe is exactly a host's writes. */
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+		if (servo.width[ch]) {
+			const uint8_t off[3] = { ch, 0, 0 };
+			(void)drv_servo_write(SERVO_REG_SP, off, sizeof off);  /* width 0: always taken */
 		}
-		(void)drv_servo_write(SERVO_REG_SP, t, sizeof t);  /* width 0 is always taken */
 	}
 }

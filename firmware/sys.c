@@ -22,7 +22,7 @@ volatile uint8_t sys_heard;
 static struct {
 	uint16_t ms;       /* FAILSAFE as written; 0 = off */
 	uint16_t ticks;    /* the same in clock ticks */
-	uint16_t last;     /* clock_now() when a request was last heard */
+	uint16_t last;     /* the clock when a request was last heard */
 	uint8_t tripped;   /* the safe state is applied for this quiet spell */
 } sys;
 
@@ -30,6 +30,19 @@ static void sys_keep(uint8_t causes)
 {
 	sys_kept.causes = causes;
 	sys_kept.check = (uint8_t)~causes;
+}
+
+/* clock_now() without turning interrupts off: on the M32-D a main loop
+ * that does so now and then delays the servo edge interrupt past its exact
+ * cycle (measured: 200 streamed servo writes fell behind the wire). Two
+ * equal readings in a row are not torn: the wraps are 2048 cycles apart. */
+__attribute__((noinline)) static uint16_t sys_clock(void)
+{
+	uint16_t t;
+	do {
+		t = clock_wraps;
+	} while (t != clock_wraps);
+	return t;
 }
 
 void sys_boot(uint8_t reset_flags)
@@ -75,8 +88,9 @@ reg_status_t drv_sys_write(uint8_t reg, const uint8_t *data, uint8_t len)
 	sys.ms = ms;
 	/* rounded up: never early (18000 ms are 64800 ticks) */
 	sys.ticks = (uint16_t)(((uint32_t)ms * CLOCK_HZ + 999u) / 1000u);
-	sys.last = clock_now();
+	sys.last = sys_clock();
 	sys.tripped = 0;
+	sys_heard = 0;
 	return REG_OK;
 }
 
@@ -96,16 +110,17 @@ uint8_t drv_sys_read(uint8_t reg, uint8_t *dst, uint8_t max)
 
 void sys_poll(void)
 {
+	/* Off (the default): the main loop pays one test. */
+	if (!sys.ticks) {
+		return;
+	}
 	if (sys_heard) {
 		sys_heard = 0;
-		sys.last = clock_now();
+		sys.last = sys_clock();
 		sys.tripped = 0;
 		return;
 	}
-	if (!sys.ticks || sys.tripped) {
-		return;
-	}
-	if ((uint16_t)(clock_now() - sys.last) >= sys.ticks) {
+	if (!sys.tripped && (uint16_t)(sys_clock() - sys.last) >= sys.ticks) {
 		sys.tripped = 1;
 		regmap_safe();
 	}

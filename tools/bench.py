@@ -325,6 +325,8 @@ def bench_board(board, count):
 ROBOT = [("m128s", 0x10), ("m32d", 0x12), ("m128s", 0x14), ("m32d", 0x16),
          ("m128s", 0x18), ("m32d", 0x1A), ("m128s", 0x1C), ("m32d", 0x1E)]
 SLAVE_OF = {"m128s": 0x10, "m32d": 0x12}
+#: Drivers each board lists (introspection and sys included).
+DRIVER_COUNT = {"m128s": 6, "m32d": 7}
 SLAVE_PIPELINE = 200
 #: Simulated cycles each speed row runs for.
 SPEED_CYCLES = 2 * F_CPU
@@ -413,7 +415,7 @@ def bench_slave(board, count):
             lat, _ = latency(events, win[name], replies[name][0])
             start, stop, stretch = bus_window(events, win[name][1])
             rows[name] = (lat, stop - start, INTRO_READ_PERIODS * scl_period(khz), stretch)
-        want = b"SWAASR%02XP\r\n" % (5 if board == "m128s" else 6)
+        want = b"SWAASR%02XP\r\n" % DRIVER_COUNT[board]
         correct, cycles, rx_bytes = pipeline(events, win["pipeline"], win["servo16"][0],
                                              replies["pipeline"], want,
                                              len("S %02X 00 00 S %02X 01 P\r" % (addr, addr | 1))
@@ -440,6 +442,132 @@ def bench_speed(nboards):
         c1 = ctl.wait(SPEED_CYCLES)
         wall = time.monotonic() - t0
     return (c1 - c0) / wall / 1e6
+
+
+# --- watchdog recovery and link-loss failsafe (issue 8) ---------------------
+#
+# A section of its own (bench_watchdog, print_watchdog), called once from
+# main(). Each target gets a fresh simulator: its own drivers behind its
+# gateway, and the board as the test robot's slave behind an M32-D gateway.
+
+WD_MS = F_CPU // 1000
+#: docs/registers.md "sys": each board's RESET register (FAILSAFE = +1),
+#: its servo SP register and a servo pin.
+WD_SYS = {"m32d": 0x14, "m128s": 0x0C}
+WD_SERVO = {"m32d": (0x13, "A3"), "m128s": (0x0B, "servo3")}
+WD_FAILSAFE_MS = 100
+
+
+def wd_stream(ctl, start, line, until):
+    """`line` again and again on the serial line from `start` to `until`."""
+    per = RX_MAX // len(line)
+    at = end = start
+    while at < until:
+        end = ctl.rx(at, line * per)
+        at = end
+    return end
+
+
+def wd_replies(events, since):
+    """[(cycle of the first byte, line)] the gateway sent from `since` on."""
+    out, cur, first = [], bytearray(), None
+    for e in events:
+        if e.kind != "uart tx" or e.cycle < since:
+            continue
+        if not cur:
+            first = e.cycle
+        cur.append(int(e.fields[0], 16))
+        if cur.endswith(b"\r\n"):
+            out.append((first, bytes(cur[:-2]).decode("ascii", "replace")))
+            cur = bytearray()
+    return out
+
+
+def bench_watchdog(board, slave):
+    """{"reset": hang to the watchdog's reset, "answer": hang to the first
+    correct reply (cycles), "servo"/"motor": failsafe trip latency, from
+    the last request the board heard to the last edge of the pin}."""
+    addr = SLAVE_OF[board] if slave else 0xAA
+    gw_board = "m32d" if slave else board
+    slaves = [(board, addr, robot_elf(board, addr))] if slave else []
+    w, r = "%02X" % addr, "%02X" % (addr | 1)
+    rows = {}
+    with SimBoard(gw_board, control=True, slaves=slaves) as sim, \
+            serial.Serial(sim.port, 115200, timeout=30) as port:
+        ctl = sim.control
+        tctl = ctl.slave(addr) if slave else ctl
+        tag = "%s/" % w if slave else ""
+
+        def ask(req):
+            port.write(req.encode() + b"\r")
+            return port.readline().strip().decode()
+
+        # hang: requests every 2.8 ms from just before the watchdog's reset
+        req = "S %s 00 00 S %s 01 P" % (w, r)
+        want = "SWAASR%02XP" % DRIVER_COUNT[board]
+        assert ask(req) == want
+        t0 = tctl.fault_hang()
+        line = (req + " " * (31 - len(req)) + "\r").encode()
+        end = wd_stream(ctl, t0 + 240 * WD_MS, line, t0 + 600 * WD_MS)
+        ctl.wait(end - ctl.time() + 20 * WD_MS)
+        events = parse_trace(sim.trace_text())
+        resets = [e.cycle for e in events if e.kind == "reset" and e.cycle >= t0]
+        good = [c for c, text in wd_replies(events, t0) if text == want]
+        if not resets or not good:
+            raise SystemExit("bench: %s%s did not come back from a hang" % (tag, board))
+        rows["reset"], rows["answer"] = resets[0] - t0, good[0] - t0
+        port.reset_input_buffer()
+        port.write(b"\nV\r")
+        while port.readline() != b"V1.1\r\n":
+            pass
+
+        # failsafe: 100 ms, requests every 5 ms for 200 ms, then none
+        sp, pin = WD_SERVO[board]
+        assert ask("S %s %02X 03 05 DC P" % (w, sp)).startswith("SW")
+        if board == "m32d":
+            assert ask("S %s 0E 80 P" % w).startswith("SW")
+        assert ask("S %s %02X %04X P" % (w, WD_SYS[board] + 1, WD_FAILSAFE_MS)) == "SWAAAP"
+        ctl.wait(3 * 147456)
+        req = "S %s 01 S %s 01 P" % (w, r)
+        start = ctl.time() + 30 * WD_MS
+        end = wd_stream(ctl, start, (req + " " * (36 - len(req)) + "\r").encode(),
+                        start + 200 * WD_MS)
+        ctl.wait(end - ctl.time() + 300 * WD_MS)
+        events = parse_trace(sim.trace_text())
+        if slave:
+            heard = max(e.cycle for e in events if e.kind == "twi addr" and e.cycle >= start
+                        and e.fields[0] in (w, r) and e.fields[1] == "ack")
+        else:
+            heard = end
+        rows["servo"] = ctl.edges(tag + pin, start)[-1][0] - heard
+        rows["motor"] = (ctl.edges(tag + "D5", start)[-1][0] - heard) if board == "m32d" else None
+    return rows
+
+
+def print_watchdog(boards, width):
+    cols = [(b, False) for b in boards] + [(b, True) for b in boards]
+    res = {c: bench_watchdog(*c) for c in cols}
+    print()
+    print("Watchdog and link-loss failsafe (issue 8; each board alone and as a slave)")
+    print()
+    print("%-*s" % (width, "figure") + "".join(
+        "%12s" % ("%s@%02X" % (b, SLAVE_OF[b]) if s else b) for b, s in cols) + "%10s" % "target")
+
+    def row(label, get, target=""):
+        print("%-*s" % (width, label) + "".join("%12s" % get(res[c]) for c in cols)
+              + "%10s" % target)
+
+    row("hang -> watchdog reset (ms)", lambda r: "%.1f" % (r["reset"] / WD_MS))
+    row("hang -> first correct reply (ms)", lambda r: "%.1f" % (r["answer"] / WD_MS), "<= 500")
+    row("failsafe %d ms: last servo pulse ends (ms)" % WD_FAILSAFE_MS,
+        lambda r: "%.1f" % (r["servo"] / WD_MS), "<= 124")
+    row("failsafe %d ms: motor PWM low after (ms)" % WD_FAILSAFE_MS,
+        lambda r: "-" if r["motor"] is None else "%.2f" % (r["motor"] / WD_MS), "<= 101")
+    print()
+    print("Recovery runs from `fault hang` to the first byte of the first correct reply")
+    print("(requests every 2.8 ms); the failsafe's from the last request the board")
+    print("heard (the gateway: its line's end; a slave: its address on the bus) to")
+    print("the pin's last edge (a servo ends the 20 ms frame it is in).")
 
 
 def main():
@@ -559,6 +687,7 @@ def main():
     print("reply's first; wire time counts SCL periods (a byte and its ACK: 9). The write's")
     print("stretch is how long the slave held SCL before the read right after the write.")
     ok = ok and all(slaves[b]["pipeline"][0] == SLAVE_PIPELINE for b in args.boards)
+    print_watchdog(args.boards, width)
     return 0 if ok else 1
 
 

@@ -23,8 +23,9 @@ uint8_t drv_fake_read(uint8_t reg, uint8_t *dst, uint8_t max);
 #define DRV_fake_SAFE() drv_fake_safe()
 void drv_fake_safe(void);
 extern unsigned fake_safe_calls;
-/* What clock_now() gives (firmware/clock.h). */
-extern uint16_t fake_clock;
+/* The time base's count (firmware/clock.h), set by the tests. */
+extern volatile uint16_t clock_wraps;
+#define fake_clock clock_wraps
 
 /* Everything the fake bus saw, as text: "S A0+ W00+ R11+ R22- P ". */
 extern char bus_log[4096];
