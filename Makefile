@@ -76,7 +76,7 @@ FW_SRC := firmware/main.c firmware/regmap.c firmware/xact.c firmware/intro.c \
 	$(foreach d,$(DRIVERS),drivers/drv_$(d).c $(DRV_HW_$(d)))
 ifeq ($(MODE),gate)
 FW_SRC += firmware/uart.c firmware/twi_master.c firmware/twi_rate.c \
-	serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
+	serialgate/sg_rx.c serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
 else ifeq ($(MODE),slave)
 FW_SRC += i2c_slave/slave_fsm.c i2c_slave/i2c_slave.c
 else
