@@ -51,7 +51,9 @@ DRIVERS ?= $(BOARD_DRIVERS)
 
 # BUILD=dir puts one more build elsewhere (the test robot's slaves at their addresses).
 BUILD ?= build/$(BOARD)-$(MODE)
-FW_OPT ?= -Os
+# -fno-move-loop-invariants -mstrict-X: 130 bytes less on the M32-D gateway,
+# no slower where it counts (make bench).
+FW_OPT ?= -Os -fno-move-loop-invariants -mstrict-X
 CC := avr-gcc
 OBJCOPY := avr-objcopy
 AVR_SIZE := avr-size
