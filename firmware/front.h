@@ -4,6 +4,8 @@
 #define ORFA_FRONT_H
 
 void front_init(void);
+/* One step of the front end's work; when it has none, it calls sys_poll()
+ * (the link-loss failsafe): the busy path pays nothing for it. */
 void front_poll(void);
 
 #endif

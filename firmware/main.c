@@ -20,10 +20,10 @@ int main(void)
 	sei();
 	/* The only place that feeds the watchdog (besides waits that feed
 	 * on progress: uart_putc, the TWI master): a stuck main loop or a
-	 * stuck interrupt both end in a reset. */
+	 * stuck interrupt both end in a reset. The front end watches the
+	 * link-loss failsafe when it is idle (sys_poll()). */
 	for (;;) {
 		wdt_reset();
 		front_poll();
-		sys_poll();
 	}
 }

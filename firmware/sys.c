@@ -110,9 +110,8 @@ uint8_t drv_sys_read(uint8_t reg, uint8_t *dst, uint8_t max)
 
 void sys_poll(void)
 {
-	/* Off (the default): the main loop pays one test. */
 	if (!sys.ticks) {
-		return;
+		return;  /* off */
 	}
 	if (sys_heard) {
 		sys_heard = 0;

@@ -44,8 +44,9 @@ void sys_boot(uint8_t reset_flags);
 extern volatile uint8_t sys_heard;
 #define SYS_HEARD() (sys_heard = 1)
 
-/* From the main loop: trips the failsafe when the link has been quiet for
- * the FAILSAFE time. */
+/* From the front end's idle path: trips the failsafe when the link has
+ * been quiet for the FAILSAFE time. While it is off (the default) this is
+ * one byte test. */
 void sys_poll(void);
 
 void drv_sys_init(void);

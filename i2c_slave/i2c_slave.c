@@ -82,6 +82,7 @@ void front_init(void)
 void front_poll(void)
 {
 	if (!slave_deferred) {
+		sys_poll();  /* idle: the failsafe's turn */
 		return;
 	}
 	/* The interrupt is off until slave_apply() turns it on again. */

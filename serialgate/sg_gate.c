@@ -39,6 +39,10 @@ void front_poll(void)
 	int16_t c = sg_rx_get();
 	if (c < 0) {
 		if (!sg_rx_losing()) {
+			/* Idle: the failsafe's turn. Not on the busy path, where
+			 * the M32-D's streamed servo writes have no cycle to spare
+			 * (characters always leave the loop idle in between). */
+			sys_poll();
 			return;
 		}
 		ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
