@@ -462,7 +462,7 @@ def wd_stream(ctl, start, line, until):
     """`line` again and again on the serial line from `start` (or a little
     after now, should the simulation have passed it while we asked) to
     `until`; returns (the first line's start, the last one's end)."""
-    per = RX_MAX // len(line)
+    per = RX_MAX // len(line) if until else 1
     while True:
         try:
             end = ctl.rx(start, line * per)
@@ -539,12 +539,14 @@ def bench_watchdog(board, slave):
         assert ask("S %s %02X 03 05 DC P" % (w, sp)).startswith("SW")
         if board == "m32d":
             assert ask("S %s 0E 80 P" % w).startswith("SW")
-        assert ask("S %s %02X %04X P" % (w, WD_SYS[board] + 1, WD_FAILSAFE_MS)) == "SWAAAP"
         ctl.wait(3 * 147456)
+        # FAILSAFE on, then requests every 5 ms: all on the line at chosen
+        # cycles, so no wall-clock pause between them can trip it early
+        fs = ("S %s %02X %04X P\r" % (w, WD_SYS[board] + 1, WD_FAILSAFE_MS)).encode()
         req = "S %s 01 S %s 01 P" % (w, r)
-        start, end = wd_stream(ctl, ctl.time() + 30 * WD_MS,
-                               (req + " " * (36 - len(req)) + "\r").encode(),
-                               ctl.time() + 230 * WD_MS)
+        start, fs_end = wd_stream(ctl, ctl.time() + 30 * WD_MS, fs, 0)
+        _, end = wd_stream(ctl, fs_end, (req + " " * (36 - len(req)) + "\r").encode(),
+                           fs_end + 200 * WD_MS)
         ctl.wait(end - ctl.time() + 300 * WD_MS)
         events = parse_trace(sim.trace_text())
         if slave:

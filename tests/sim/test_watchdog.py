@@ -84,7 +84,7 @@ def stream(b, start, line, until):
     the simulation have passed it while we asked) until `until`; returns
     the cycle the last one's terminator arrives."""
     ctl = b.sim.control
-    per = RX_MAX // len(line)
+    per = RX_MAX // len(line) if until else 1
     while True:
         try:
             end = ctl.rx(start, line * per)
@@ -277,10 +277,14 @@ def test_failsafe_trips_when_the_link_goes_quiet(fresh, other):
         pytest.skip("requests to another address reach a gateway too")
     lay = b.lay
     set_everything(b)
-    b.gw.set_failsafe(b.addr, FAILSAFE_MS)
-    line = keepalive_line(b)
+    # FAILSAFE on, then the requests, all on the line at chosen cycles: no
+    # wall-clock pause between them can trip it early
+    fs = b.req("S AA %02X %04X P" % (sys_reg(b) + 1, FAILSAFE_MS)).encode() + b"\r"
     start = b.now() + 30 * MS
-    end = stream(b, start, line, start + 400 * MS)
+    fs_end = stream(b, start, fs, 0)
+    start = min(start, fs_end - len(fs) * BYTE)
+    line = keepalive_line(b)
+    end = stream(b, fs_end, line, fs_end + 400 * MS)
     if other:
         # the bus stays busy, but never with the slave's own address
         miss = b"S 1C 00 S 1D 01 P" + b" " * 40 + b"\r"
