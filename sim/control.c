@@ -282,7 +282,7 @@ static void cmd_spi(board_model_t *bm, reply_t *r)
 static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
-	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx CYCLE HEX... | signals | "
+	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx CYCLE HEX... | line | signals | "
 	"srf08 ADDR [range MM [MM2] | light N] | help; "
 	"a slave board's pins, signals and inputs as 10/A5, other requests with @10 "
 	"first (stack @10 FROM)";
@@ -538,6 +538,17 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 			cmd_measure(c, &r, s, nmax > SIGNAL_RING ? SIGNAL_RING : (unsigned)nmax,
 				    argc == 4, since);
 		}
+	} else if (!strcasecmp(cmd, "line") && argc == 1) {
+		usart_t *u = c->usart;
+
+		if (cb != &c->board[0]) {
+			rp(&r, "ERR line: only the gateway's serial line reaches the PC");
+			return 0;
+		}
+		rp(&r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u",
+		   (unsigned)u->host_baud, (unsigned)u->host_bit, (unsigned)usart_board_bit(u),
+		   (unsigned)u->ubrr, !!(u->avr->data[u->regs->ucsrb] & (1u << 4)),
+		   (uint64_t)u->rxen_since, (unsigned)u->fe_read);
 	} else if (!strcasecmp(cmd, "rx")) {
 		if (cb != &c->board[0]) {
 			rp(&r, "ERR rx: only the gateway's serial line reaches the PC");

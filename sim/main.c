@@ -599,8 +599,12 @@ static int sim_run(sim_t *sim)
 	while (!sim_stop && rc == 0) {
 		uint8_t buf[512];
 		size_t room = usart_host_room(&sim->gateway.usart);
-		size_t n = pty_read(&sim->pty, buf, room < sizeof(buf) ? room : sizeof(buf));
+		size_t n;
 
+		/* The PC's rate, before its bytes go on the line (and before a
+		 * control client schedules some with `rx`). */
+		usart_set_host_baud(&sim->gateway.usart, pty_baud(&sim->pty));
+		n = pty_read(&sim->pty, buf, room < sizeof(buf) ? room : sizeof(buf));
 		if (n) {
 			usart_host_send(&sim->gateway.usart, buf, n);
 		}
