@@ -6,15 +6,8 @@
 
 #include "firmware/mcu.h"
 
-#ifndef ORFA_BAUD
-#define ORFA_BAUD 115200
-#endif
-
-#define UART_UBRR ((F_CPU + 8UL * ORFA_BAUD) / (16UL * ORFA_BAUD) - 1)
-
 _Static_assert(UART_RX_SIZE == 256, "rx indices are uint8_t and wrap at 256");
 _Static_assert((UART_TX_SIZE & (UART_TX_SIZE - 1)) == 0, "tx size is a power of two");
-_Static_assert(UART_UBRR < 4096, "baud rate too low for this clock");
 
 static struct {
 	uint8_t rx[UART_RX_SIZE];
@@ -29,16 +22,9 @@ static struct {
 	uint8_t content;     /* the line being received has a non-space */
 } uart;
 
-void uart_init(void)
-{
-	MCU_UBRRH = (uint8_t)(UART_UBRR >> 8);
-	MCU_UBRRL = (uint8_t)UART_UBRR;
-	/* 8N1 is the reset value of the frame format on both MCUs. */
-	MCU_UCSRB = _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
-}
-
 ISR(MCU_UART_RX_vect)
 {
+	uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
 	uint8_t c = MCU_UDR;
 	uint8_t head = uart.rx_head;
 	uint8_t room = (uint8_t)(uart.rx_tail - head - 1);

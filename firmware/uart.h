@@ -26,7 +26,9 @@
 #define UART_LOST_LINES 0x7F
 #define UART_LOST_TAIL  0x80
 
-void uart_init(void);
+/* uart_init() (set the rate, enable the USART) is the line's: see
+ * firmware/uart_line.h. */
+#include "firmware/uart_line.h"
 
 /* The next received byte, or -1 if none is waiting. */
 int16_t uart_getc(void);

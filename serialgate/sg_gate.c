@@ -25,12 +25,18 @@ void front_init(void)
 
 void front_poll(void)
 {
+	if (uart_line_poll()) {
+		/* No rate yet (autobaud): a line begun before is noise. */
+		sg_parse_init(&parser);
+		return;
+	}
 	int16_t c = uart_getc();
 	if (c < 0) {
 		return;
 	}
 	sg_event_t ev = sg_parse_char(&parser, (uint8_t)c);
 	if (ev == SG_REQUEST) {
+		uart_line_confirm();
 		sg_exec(&parser);
 	} else if (ev == SG_LOST) {
 		sg_exec_lost(&parser);
