@@ -9,14 +9,22 @@
  * disturbed; an interrupt can only shorten a measured run, and a frame
  * that no longer fits the pattern is simply not taken.
  *
- *   DETECT  two frames in a row fit 0x0D at the same of the ten rates, then
- *           the line is quiet for AB_IDLE_BITS bit times (the preamble is
- *           over: the USART starts on an idle line, in step with the next
- *           start bit): UBRR is set and the receiver turned on;
- *   FRESH   no request accepted yet: one frame with FE means the rate was
- *           wrong (noise locked it): back to DETECT;
- *   TALK    a request was accepted: AB_FE_RUN frames with FE in a row (no
- *           good frame between) send it back to DETECT.
+ *   DETECT  the pin's runs are recorded from a falling edge until the line
+ *           is quiet for AB_QUIET (6.7 ms; the host waits 20 ms after its
+ *           preamble); a record with two frames in a row that last nine
+ *           bits of the same of the ten rates, one of them 0x0D's shape,
+ *           gives the rate: UBRR is set and the receiver turned on while
+ *           the line is quiet, so it starts in step with the next start bit;
+ *   FRESH   no good request yet: the pin is still recorded whenever the main
+ *           loop is idle (received bytes wait in the ring), and a preamble
+ *           at another rate moves the rate (noise that looked like a
+ *           preamble locked a wrong one); one frame with FE sends it back
+ *           to DETECT;
+ *   TALK    a request parsed without error proves the rate: only AB_FE_RUN
+ *           frames with FE in a row (no good frame between) send it back
+ *           to DETECT.
+ * Going back drops what the receiver took at the old rate and the line the
+ * parser holds.
  */
 #include "firmware/uart_line.h"
 
@@ -82,6 +90,7 @@ enum { AB_DETECT, AB_FRESH, AB_TALK };
 
 static struct {
 	uint8_t state;
+	uint8_t rate;		/* index + 1 of the rate in use */
 	volatile uint8_t lost;	/* set by the receive interrupt */
 	uint8_t fe_run;
 } ab;
@@ -236,35 +245,29 @@ static void ab_deaf(void)
 	ab.state = AB_DETECT;
 }
 
-/* Record the line until it is quiet for AB_QUIET (or 53 ms without an
- * edge: go round the main loop, 0). A record that holds two 0x0D in a row
- * at one rate and ends quiet gives that rate (index + 1); the last such
- * pair wins (a fresh run at another rate replaces an earlier one). */
-static uint8_t ab_detect(void)
+/* Record the line once, until it is quiet (AB_QUIET) or the record is
+ * full, or 53 ms without an edge (*HEARD = 0). A record that holds two
+ * 0x0D in a row at one rate and ends quiet gives that rate (index + 1);
+ * the last such pair wins (a fresh run at another rate replaces an earlier
+ * one). 0: no rate. */
+static uint8_t ab_scan(uint8_t *heard)
 {
 	uint16_t run[AB_MAX_RUNS];
+	uint8_t why;
+	uint8_t found = 0;
+	uint8_t n;
 
-	for (;;) {
-		uint8_t why;
-		uint8_t n;
-		uint8_t found = 0;
+	wdt_reset();
+	n = ab_record(run, &why);
+	*heard = n;
+	for (uint8_t i = 0; i + AB_PAIR <= n; i += 2) {
+		uint8_t r = ab_check(run + i);
 
-		wdt_reset();
-		n = ab_record(run, &why);
-		if (n == 0) {
-			return 0;
-		}
-		for (uint8_t i = 0; i + AB_PAIR <= n; i += 2) {
-			uint8_t r = ab_check(run + i);
-
-			if (r) {
-				found = r;
-			}
-		}
-		if (found && why == AB_END_QUIET) {
-			return found;
+		if (r) {
+			found = r;
 		}
 	}
+	return why == AB_END_QUIET ? found : 0;
 }
 
 void uart_init(void)
@@ -274,24 +277,40 @@ void uart_init(void)
 
 uint8_t uart_line_poll(void)
 {
+	uint8_t r;
+	uint8_t heard;
+
 	if (ab.lost) {
 		ab_deaf();
 	}
-	if (ab.state != AB_DETECT) {
+	if (ab.state == AB_TALK) {
 		return 0;
 	}
-	/* What the receiver took at a wrong rate is noise. */
+	if (ab.state == AB_FRESH) {
+		/* Until a request proves the rate, the pin is still watched
+		 * (the receiver runs on): a preamble at another rate after a
+		 * wrong lock (noise that looked like one) moves the rate. The
+		 * bytes the receiver takes meanwhile wait in the ring. */
+		r = ab_scan(&heard);
+		if (r == 0 || r == ab.rate) {
+			return 0;
+		}
+	} else {
+		do {
+			r = ab_scan(&heard);
+		} while (r == 0 && heard);
+	}
+	/* What the receiver took before (at a wrong rate) is noise. */
 	while (uart_getc() >= 0) {
 	}
-	uint8_t r = ab_detect();
-
 	if (r == 0) {
-		return 1;
+		return 1;	/* quiet for 53 ms: round the main loop */
 	}
+	ab.rate = r;
 	ab.fe_run = 0;
 	ab.state = AB_FRESH;
 	ab_listen(ab_rates[r - 1].ubrr);
-	return 0;
+	return 1;
 }
 
 void uart_line_rx(void)

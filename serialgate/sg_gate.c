@@ -36,7 +36,9 @@ void front_poll(void)
 	}
 	sg_event_t ev = sg_parse_char(&parser, (uint8_t)c);
 	if (ev == SG_REQUEST) {
-		uart_line_confirm();
+		if (parser.err == SG_OK) {
+			uart_line_confirm();	/* a good request proves the rate */
+		}
 		sg_exec(&parser);
 	} else if (ev == SG_LOST) {
 		sg_exec_lost(&parser);
