@@ -176,6 +176,14 @@ class SimControl:
             raise ValueError("rx takes 1..%d bytes, not %d" % (RX_MAX, len(data)))
         return int(self.request("rx %d %s" % (cycle, bytes(data).hex().upper())))
 
+    def line(self) -> Dict[str, int]:
+        """The gateway's serial line: `pc` the PC's rate (its port's termios),
+        `bit` its bit time and `board` the board's (UBRR/U2X), in cycles;
+        `ubrr`, `rxen`, `since` (the cycle RXEN last went on), `fe` (frames
+        with FE the firmware took from UDR)."""
+        words = self.request(self._board("line")).split()
+        return {k: int(v) for k, v in zip(words[::2], words[1::2])}
+
     def peek(self, addr: int, n: int = 1) -> bytes:
         """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
         return bytes.fromhex(self.request(self._board("peek %d %d" % (addr, n))))

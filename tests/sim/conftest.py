@@ -8,6 +8,7 @@ sees another's state. Each simulator has its own temp dir and link path.
 
 import contextlib
 import re
+import subprocess
 import time
 from pathlib import Path
 
@@ -30,6 +31,34 @@ def require_builds(boards=BOARDS):
     if missing:
         pytest.fail("missing %s: %s" % (", ".join(map(str, missing)), BUILD_HINT),
                     pytrace=False)
+
+
+def build_gateway(board: str, baud) -> Path:
+    """A gateway firmware for `board` at `baud` (a rate, or "auto"), built
+    once per session into build/test-baud/<board>-<baud>/ (the default
+    builds stay as they are); its ELF."""
+    out = ROOT / "build" / "test-baud" / ("%s-%s" % (board, baud))
+    if out not in _BUILT:
+        r = subprocess.run(["make", "--no-print-directory", "-s", "BOARD=" + board, "MODE=gate",
+                            "BAUD=%s" % baud, "BUILD=%s" % out.relative_to(ROOT)],
+                           cwd=ROOT, capture_output=True, text=True, timeout=300)
+        if r.returncode != 0:
+            pytest.fail("building %s BAUD=%s failed:\n%s" % (board, baud, r.stderr), pytrace=False)
+        _BUILT.add(out)
+    return out / "orfa.elf"
+
+
+_BUILT = set()
+
+
+def line_after(sim: SimBoard, port, cycles: int) -> bytes:
+    """Everything the board sent to the PC by `cycles` simulated cycles from
+    now: the simulator hands its output to the pty before it answers a
+    `wait`, so simulated time decides; the short sleep is only the kernel's
+    pty hand-over (a work queue) to the reading side."""
+    sim.control.wait(cycles)
+    time.sleep(0.05)
+    return port.read(port.in_waiting)
 
 
 class Bench:
