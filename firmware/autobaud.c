@@ -42,7 +42,8 @@
  * cycles: 6.7 ms, 16 bit times at 2400 baud; a host waits at least 20 ms),
  * so the USART starts on an idle line, in step with the next start bit. */
 #define AB_QUIET 8192
-/* Runs recorded at most in one go (two per character, stack bytes x2). */
+/* Runs kept of a record (up to five per character; stack bytes x2): the
+ * eight 0x0D of a preamble are 47. */
 #define AB_MAX_RUNS 64
 /* Framing errors in a row that end a proven rate. */
 #define AB_FE_RUN 3
@@ -60,7 +61,7 @@ _Static_assert(AB_RX_PORT >= 'A' && AB_RX_PORT <= 'D', "RXD on ports A-D");
 _Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart");
 
 /* Cycles of one counting iteration (sbic/sbis skipping 2, adiw 2, brne 2)
- * and of the step from one run to the next in ab_record (11 or 12). */
+ * and of the step from one run to the next in ab_record. */
 #define AB_LOOP_CYCLES 6
 #define AB_STEP_CYCLES 12
 
@@ -96,15 +97,21 @@ static struct {
 } ab;
 
 /* Wait up to 65535 iterations (53 ms) for RXD to fall, then count the
- * iterations of up to AB_MAX_RUNS runs, low and high in turn, into RUN,
- * until RXD stays high for AB_QUIET iterations (the line is quiet: the
- * high run is not stored) or low for 65535 (a break), or RUN is full. A
- * high run's counter starts at -AB_QUIET so that its overflow is the
- * quiet. Returns the runs stored; *WHY the end. One block of assembly so
- * that every step from one run to the next has the same fixed cost. */
-static uint8_t __attribute__((noinline)) ab_record(uint16_t *run, uint8_t *why)
+ * iterations of runs, low and high in turn, into the ring RUN of
+ * AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations (the line is
+ * quiet: that high run is not stored) or low for 65535 (a break). A high
+ * run's counter starts at -AB_QUIET so that its overflow is the quiet. The
+ * ring keeps the last AB_MAX_RUNS runs before the end, however long the
+ * line was busy. Returns *WHY the end; *LEFT the free slots before the
+ * next write position, *WRAPPED whether the ring went round. One block of
+ * assembly so that every step from one run to the next costs the same
+ * (AB_STEP_CYCLES). */
+static void __attribute__((noinline)) ab_record(uint16_t *run, uint8_t *why,
+						uint8_t *left_out, uint8_t *wrapped_out)
 {
+	uint16_t *p = run;
 	uint8_t left = AB_MAX_RUNS;
+	uint8_t wrapped = 0;
 	uint8_t end;
 	uint16_t n;
 
@@ -125,42 +132,54 @@ static uint8_t __attribute__((noinline)) ab_record(uint16_t *run, uint8_t *why)
 		     "3:	st %a[p]+, %A[n]\n\t"
 		     "	st %a[p]+, %B[n]\n\t"
 		     "	dec %[left]\n\t"
-		     "	breq 7f\n\t"
-		     "	ldi %A[n], lo8(%[q])\n\t"
+		     "	brne 4f\n\t"
+		     "	movw %[p], %[base]\n\t"
+		     "	ldi %[left], %[max]\n\t"
+		     "	ldi %[wr], 1\n"
+		     "4:	ldi %A[n], lo8(%[q])\n\t"
 		     "	ldi %B[n], hi8(%[q])\n"
-		     "4:	sbis %[pin], %[bit]\n\t"
-		     "	rjmp 5f\n\t"
+		     "5:	sbis %[pin], %[bit]\n\t"
+		     "	rjmp 6f\n\t"
 		     "	adiw %[n], 1\n\t"
-		     "	brne 4b\n\t"
+		     "	brne 5b\n\t"
 		     "	rjmp 8f\n"
-		     "5:	st %a[p]+, %A[n]\n\t"
+		     "6:	st %a[p]+, %A[n]\n\t"
 		     "	st %a[p]+, %B[n]\n\t"
 		     "	dec %[left]\n\t"
-		     "	brne 1b\n"
-		     "7:	ldi %[end], %[full]\n\t"
-		     "	rjmp 10f\n"
+		     "	brne 1b\n\t"
+		     "	movw %[p], %[base]\n\t"
+		     "	ldi %[left], %[max]\n\t"
+		     "	ldi %[wr], 1\n\t"
+		     "	rjmp 1b\n"
 		     "8:	ldi %[end], %[quiet]\n\t"
 		     "	rjmp 10f\n"
 		     "9:	ldi %[end], %[brk]\n"
 		     "10:\n"
-		     : [n] "=&w" (n), [p] "+e" (run), [left] "+r" (left), [end] "=&d" (end)
-		     : [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
-		       [q] "i" (0x10000L - AB_QUIET), [full] "M" (AB_END_FULL),
+		     : [n] "=&w" (n), [p] "+e" (p), [left] "+d" (left), [wr] "+d" (wrapped),
+		       [end] "=&d" (end)
+		     : [base] "r" (run), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
+		       [q] "i" (0x10000L - AB_QUIET), [max] "M" (AB_MAX_RUNS),
 		       [quiet] "M" (AB_END_QUIET), [brk] "M" (AB_END_BREAK)
 		     : "memory");
 	*why = end;
-	return (uint8_t)(AB_MAX_RUNS - left);
+	*left_out = left;
+	*wrapped_out = wrapped;
 }
 
-/* Run I's length in cycles (the step to the next run included); 0xFFFF
- * for one longer than any run of a 0x0D. */
-static uint16_t ab_cycles(const uint16_t *run, uint8_t i)
+static void ab_reverse(uint16_t *a, uint8_t n)
 {
-	uint16_t count = run[i];
+	for (uint8_t i = 0, j = (uint8_t)(n - 1); i < j; i++, j--) {
+		uint16_t t = a[i];
 
-	if (i & 1) {
-		count = (uint16_t)(count - (uint16_t)(0x10000L - AB_QUIET));
+		a[i] = a[j];
+		a[j] = t;
 	}
+}
+
+/* A run's length in cycles (the step to the next run included) from its
+ * iterations; 0xFFFF for one longer than any run of a 0x0D. */
+static uint16_t ab_cycles(uint16_t count)
+{
 	return count > 4000 ? 0xFFFF : (uint16_t)(count * AB_LOOP_CYCLES + AB_STEP_CYCLES);
 }
 
@@ -171,7 +190,7 @@ static uint8_t ab_frame(const uint16_t *run)
 	uint16_t total = 0;
 
 	for (uint8_t i = 0; i < 5; i++) {
-		uint16_t c = ab_cycles(run, i);
+		uint16_t c = ab_cycles(run[i]);
 
 		if (c == 0xFFFF) {
 			return 0;
@@ -194,7 +213,7 @@ static uint8_t ab_shape(const uint16_t *run, uint16_t bit)
 {
 	for (uint8_t i = 0; i < 5; i++) {
 		uint16_t want = (uint16_t)(ab_pattern[i] * bit);
-		uint16_t c = ab_cycles(run, i);
+		uint16_t c = ab_cycles(run[i]);
 
 		if ((c > want ? c - want : want - c) > bit / 3) {
 			return 0;
@@ -220,7 +239,7 @@ static uint8_t ab_check(const uint16_t *run)
 	}
 	uint16_t bit = ab_rates[r - 1].bit;
 
-	if (ab_cycles(run, 5) < bit / 2) {
+	if (ab_cycles(run[5]) < bit / 2) {
 		return 0;
 	}
 	return (ab_shape(run, bit) || ab_shape(run + 6, bit)) ? r : 0;
@@ -233,6 +252,9 @@ static void ab_listen(uint8_t ubrr)
 		MCU_UBRRL = ubrr;
 		/* |=: the transmitter's UDRIE may be set (a reply going out). */
 		MCU_UCSRB |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
+		/* Framing errors seen so far were at the old rate. */
+		ab.lost = 0;
+		ab.fe_run = 0;
 	}
 }
 
@@ -245,29 +267,44 @@ static void ab_deaf(void)
 	ab.state = AB_DETECT;
 }
 
-/* Record the line once, until it is quiet (AB_QUIET) or the record is
- * full, or 53 ms without an edge (*HEARD = 0). A record that holds two
- * 0x0D in a row at one rate and ends quiet gives that rate (index + 1);
- * the last such pair wins (a fresh run at another rate replaces an earlier
- * one). 0: no rate. */
+/* Record the line once, until it is quiet (AB_QUIET), or 53 ms without an
+ * edge (*HEARD = 0). If the last AB_MAX_RUNS runs before the quiet hold two
+ * 0x0D in a row at one rate, that rate (index + 1); the last such pair wins
+ * (a fresh run at another rate replaces an earlier one). 0: no rate. */
 static uint8_t ab_scan(uint8_t *heard)
 {
 	uint16_t run[AB_MAX_RUNS];
-	uint8_t why;
+	uint8_t why, left, wrapped, n, first;
 	uint8_t found = 0;
-	uint8_t n;
 
 	wdt_reset();
-	n = ab_record(run, &why);
-	*heard = n;
-	for (uint8_t i = 0; i + AB_PAIR <= n; i += 2) {
+	ab_record(run, &why, &left, &wrapped);
+	n = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
+	*heard = n || wrapped;
+	if (why != AB_END_QUIET) {
+		return 0;
+	}
+	/* High runs (odd positions) counted from -AB_QUIET. */
+	for (uint8_t i = 1; i < (wrapped ? AB_MAX_RUNS : n); i += 2) {
+		run[i] = (uint16_t)(run[i] + AB_QUIET);
+	}
+	first = 0;
+	if (wrapped) {
+		/* oldest first: rotate the ring left by n */
+		ab_reverse(run, n);
+		ab_reverse(run + n, (uint8_t)(AB_MAX_RUNS - n));
+		ab_reverse(run, AB_MAX_RUNS);
+		first = n & 1;		/* a frame starts on a low run */
+		n = AB_MAX_RUNS;
+	}
+	for (uint8_t i = first; i + AB_PAIR <= n; i += 2) {
 		uint8_t r = ab_check(run + i);
 
 		if (r) {
 			found = r;
 		}
 	}
-	return why == AB_END_QUIET ? found : 0;
+	return found;
 }
 
 void uart_init(void)
@@ -287,6 +324,9 @@ uint8_t uart_line_poll(void)
 		return 0;
 	}
 	if (ab.state == AB_FRESH) {
+		if (!uart_rx_empty()) {
+			return 0;	/* the front end takes what came first */
+		}
 		/* Until a request proves the rate, the pin is still watched
 		 * (the receiver runs on): a preamble at another rate after a
 		 * wrong lock (noise that looked like one) moves the rate. The
@@ -307,7 +347,6 @@ uint8_t uart_line_poll(void)
 		return 1;	/* quiet for 53 ms: round the main loop */
 	}
 	ab.rate = r;
-	ab.fe_run = 0;
 	ab.state = AB_FRESH;
 	ab_listen(ab_rates[r - 1].ubrr);
 	return 1;

@@ -133,3 +133,9 @@ void uart_putc(uint8_t c)
 	uart.tx_head = next;
 	MCU_UCSRB |= _BV(UDRIE);
 }
+
+/* For the line's rate keeper (uart_line.h): nothing waits in the ring. */
+uint8_t uart_rx_empty(void)
+{
+	return uart.rx_tail == uart.rx_head && !uart.lost;
+}

@@ -33,6 +33,9 @@
 /* The next received byte, or -1 if none is waiting. */
 int16_t uart_getc(void);
 
+/* Nothing received waits to be taken (uart_getc would give -1). */
+uint8_t uart_rx_empty(void);
+
 /* Queue one byte for sending; waits only while the transmit ring is full. */
 void uart_putc(uint8_t c);
 
