@@ -442,6 +442,64 @@ def bench_speed(nboards):
     return (c1 - c0) / wall / 1e6
 
 
+# --- autobaud (issue 8) -------------------------------------------------------
+# Kept in one block, called once from main(), so it merges apart from the rest.
+
+def autobaud_elf(board):
+    """The BAUD=auto gateway of `board`, built into build/bench-auto/."""
+    out = "build/bench-auto/%s-gate" % board
+    subprocess.run(["make", "--no-print-directory", "-s", "BOARD=" + board, "MODE=gate",
+                    "BAUD=auto", "BUILD=" + out], cwd=ROOT, check=True)
+    return ROOT / out / "orfa.elf"
+
+
+def autobaud_detection(board, rate, elf):
+    """Cycles from the first falling edge of the preamble (eight 0x0D put
+    on the line with `rx` at cycle START, at `rate`) to the firmware's
+    receiver being on at the detected rate (RXEN set, the simulator's
+    `line rxen` moment), and whether that rate is `rate`. A fresh simulator:
+    the same cycles every run."""
+    from orfa.protocol import AUTOBAUD_PREAMBLE
+    with SimBoard(board, firmware=elf, trace=False, control=True) as sim, \
+            serial.Serial(sim.port, rate):
+        ctl = sim.control
+        ctl.wait(1000)                       # the simulator reads the port's rate
+        end = ctl.rx(START, AUTOBAUD_PREAMBLE)
+        line = ctl.line()
+        while not line["rxen"] and line.get("bit") and ctl.time() < end + F_CPU // 10:
+            ctl.wait(F_CPU // 1000)
+            line = ctl.line()
+        if not line["rxen"]:
+            return None, False
+        return line["since"] - START, line["board"] == F_CPU // rate
+
+
+def bench_autobaud(boards):
+    """Detection time per rate and board (docs/protocol.md, Autobaud)."""
+    from orfa.protocol import BAUD_RATES
+    elfs = {b: autobaud_elf(b) for b in boards}
+    res = {(b, r): autobaud_detection(b, r, elfs[b]) for b in boards for r in BAUD_RATES}
+    width = 38
+    print()
+    print("Autobaud (BAUD=auto): cycles from the preamble's first falling edge to the")
+    print("receiver on at the detected rate (80 bit times of preamble, the quiet of")
+    print("49152 cycles that ends it, the analysis)")
+    print()
+    print("%-*s" % (width, "rate") + "".join("%14s" % b for b in boards) + "%14s" % "preamble")
+    for r in BAUD_RATES:
+        cells = []
+        for b in boards:
+            cyc, right = res[(b, r)]
+            cells.append("%14s" % ("missed" if cyc is None else
+                                   ("%d" % cyc) + ("" if right else " WRONG")))
+        print("%-*s" % (width, "%d baud" % r) + "".join(cells) + "%14d" % (80 * F_CPU // r))
+    print("%-*s" % (width, "flash / static RAM (B)") + "".join(
+        "%14s" % ("%d/%d" % footprint_of(elfs[b])) for b in boards))
+    return all(c is not None and ok for c, ok in res.values())
+
+# --- end autobaud ----------------------------------------------------------------
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--boards", nargs="+", default=["m32d", "m128s"])
@@ -559,6 +617,7 @@ def main():
     print("reply's first; wire time counts SCL periods (a byte and its ACK: 9). The write's")
     print("stretch is how long the slave held SCL before the read right after the write.")
     ok = ok and all(slaves[b]["pipeline"][0] == SLAVE_PIPELINE for b in args.boards)
+    ok = bench_autobaud(args.boards) and ok
     return 0 if ok else 1
 
 
