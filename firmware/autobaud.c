@@ -36,7 +36,6 @@
 #include "firmware/board_pins.h"
 #include "firmware/flash.h"
 #include "firmware/mcu.h"
-#include "firmware/uart.h"
 
 /* The preamble is over when RXD stays high this long (iterations of 6
  * cycles: 6.7 ms, 16 bit times at 2400 baud; a host waits at least 20 ms),
@@ -324,9 +323,6 @@ uint8_t uart_line_poll(void)
 		return 0;
 	}
 	if (ab.state == AB_FRESH) {
-		if (!uart_rx_empty()) {
-			return 0;	/* the front end takes what came first */
-		}
 		/* Until a request proves the rate, the pin is still watched
 		 * (the receiver runs on): a preamble at another rate after a
 		 * wrong lock (noise that looked like one) moves the rate. The
@@ -339,9 +335,6 @@ uint8_t uart_line_poll(void)
 		do {
 			r = ab_scan(&heard);
 		} while (r == 0 && heard);
-	}
-	/* What the receiver took before (at a wrong rate) is noise. */
-	while (uart_getc() >= 0) {
 	}
 	if (r == 0) {
 		return 1;	/* quiet for 53 ms: round the main loop */

@@ -14,10 +14,9 @@
 /* After reset: the fixed rate's USART on, or autobaud armed. */
 void uart_init(void);
 
-/* From the main loop, before taking received bytes: nonzero while the line
- * has no rate (autobaud detecting; may take up to ~60 ms per call; bytes
- * received at a wrong rate are dropped); the front end then drops the line
- * it holds. */
+/* From the main loop when nothing received waits: nonzero when the line
+ * has no rate or a new one (autobaud detecting; may take up to ~60 ms per
+ * call); the front end then drops what it holds of the line. */
 uint8_t uart_line_poll(void);
 
 /* From the receive interrupt, before UDR is read (UCSRA still holds the
