@@ -5,7 +5,7 @@
  * 0x0D in 8N1 is, in bit times: low 1 (start), high 1, low 1, high 2,
  * low 4, then the stop bit. The RXD pin is timed by counting loop
  * iterations of a known cycle count (no timer: the M32-D's three are the
- * servos' and motors'), with interrupts on, so the drivers are never
+ * servos', the motors' and the time base's), with interrupts on, so the drivers are never
  * disturbed; an interrupt can only shorten a measured run, and a frame
  * that no longer fits the pattern is simply not taken.
  *
@@ -23,8 +23,8 @@
  *   TALK    a request parsed without error proves the rate: only AB_FE_RUN
  *           frames with FE in a row (no good frame between) send it back
  *           to DETECT.
- * Going back drops what the receiver took at the old rate and the line the
- * parser holds.
+ * A new rate (uart_line_poll gives 1) makes the front end drop what the
+ * receiver took at the old one and the line the parser holds.
  */
 #include "firmware/uart_line.h"
 
@@ -84,7 +84,7 @@ static const ORFA_FLASH uint8_t ab_pattern[5] = { 1, 1, 1, 2, 4 };
 #define AB_PAIR 11
 
 /* Why a record ended. */
-enum { AB_END_FULL, AB_END_QUIET, AB_END_BREAK };
+enum { AB_END_QUIET = 1, AB_END_BREAK };
 
 enum { AB_DETECT, AB_FRESH, AB_TALK };
 
