@@ -68,6 +68,12 @@ typedef struct twi_t {
 	uint8_t sl_data;
 	avr_cycle_count_t sl_at;	/* ... at this cycle */
 	uint8_t sl_addr;		/* TWAR address it answered (trace) */
+
+	/* SCL/SDA as port pins while TWEN is off (twi_wire_pins) */
+	twi_pins_t pins;
+	int pins_wired;
+	uint8_t pin_scl, pin_sda;	/* bit numbers */
+	uint8_t pin_ddr, pin_port;	/* shadows of the port's DDR/PORT */
 } twi_t;
 
 #define TWI_SLAVE_RX 1
@@ -75,6 +81,12 @@ typedef struct twi_t {
 
 /* Take over the TWI described by REGS on AVR (after avr_init). */
 void twi_init(twi_t *t, avr_t *avr, const mcu_twi_regs_t *regs, twi_bus_t *bus);
+
+/* The TWI's lines are pins SCL and SDA of port PORT ('C'): while TWEN is
+ * off the firmware drives them as port pins (DDR 1 and PORT 0 pulls the
+ * line low; anything else releases it to the external pull-ups), and the
+ * bus's wired-AND lines hear it. 0, or -1 when the port is not found. */
+int twi_wire_pins(twi_t *t, char port, int scl, int sda);
 
 /* One SCL period in cycles with the current TWBR and TWPS. */
 avr_cycle_count_t twi_scl_period(const twi_t *t);

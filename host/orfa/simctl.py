@@ -187,6 +187,23 @@ class SimControl:
         w = self.request(self._board("isr clear" if clear else "isr")).split()
         return {"longest": int(w[2]), "count": int(w[4]), "total": int(w[6])}
 
+    def i2c_stuck(self, pulses: int) -> None:
+        """A device on the I2C bus holds SDA low until it has seen `pulses`
+        more SCL pulses (falling edges), as a slave does whose byte a master
+        abandoned; 0 lets SDA go."""
+        self.request("i2c stuck %d" % pulses)
+
+    def i2c_hold_scl(self, on: bool) -> None:
+        """A device on the I2C bus holds SCL low (on) or lets it go."""
+        self.request("i2c hold-scl %s" % ("on" if on else "off"))
+
+    def i2c(self) -> Dict[str, int]:
+        """The bus lines: {"sda", "scl" (levels), "stuck" (pulses the stuck
+        device still waits for), "hold_scl" (0/1)}."""
+        w = self.request("i2c").split()
+        return {"sda": int(w[1]), "scl": int(w[3]), "stuck": int(w[5]),
+                "hold_scl": int(w[7] == "on")}
+
     def srf08_range(self, addr: int, mm: int, mm2: Optional[int] = None) -> None:
         """What the SRF08 at 8-bit address `addr` sees at its next ping: a
         target `mm` millimetres away (0: none), optionally a second one."""
