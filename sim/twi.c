@@ -80,6 +80,14 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 	/* The bus events carry the exact completion cycle, not the cycle
 	 * simavr got round to calling us (1-4 later). */
 	when = t->op_end;
+	if (t->op != TWI_OP_NONE && !t->bus->scl_ext) {
+		/* SCL held low under the operation: its clock stops; it ends
+		 * one period after the release (the bit position is not kept). */
+		t->op_periods = 1;
+		if (!twi_bus_begin(t->bus, &t->master, TWI_BUS_DATA, when)) {
+			return 0;
+		}
+	}
 	switch (t->op) {
 	case TWI_OP_START:
 		twi_bus_start(t->bus, when);

@@ -61,6 +61,26 @@ class SimControl:
             raise SimControlError(text)
         return text
 
+    def requests(self, lines: List[str]) -> List[str]:
+        """Send several requests at once and return their replies. The
+        simulator answers them in order, each as soon as the one before it
+        is answered: a `wait` followed by another request has that request
+        act at the wait's cycle."""
+        self.sock.sendall("".join(line + "\n" for line in lines).encode())
+        replies = []
+        for _ in lines:
+            while b"\n" not in self._buf:
+                chunk = self.sock.recv(65536)
+                if not chunk:
+                    raise SimControlError("orfa-sim closed the control socket")
+                self._buf += chunk
+            reply, self._buf = self._buf.split(b"\n", 1)
+            replies.append(reply.decode())
+        bad = [r for r in replies if r.startswith("ERR")]
+        if bad:
+            raise SimControlError(bad[0])
+        return replies
+
     # --- commands -------------------------------------------------------------
     def time(self) -> int:
         return int(self.request("time"))
@@ -234,6 +254,9 @@ class _SlaveView(SimControl):
 
     def request(self, line: str) -> str:
         return self._parent.request(line)
+
+    def requests(self, lines: List[str]) -> List[str]:
+        return self._parent.requests(lines)
 
     def close(self) -> None:
         pass
