@@ -17,6 +17,11 @@
  * repeated START); while it is set the slave holds SCL low (twi_bus_hold)
  * and the master's next operation waits until the firmware clears TWINT,
  * then takes its normal time from that release (clock stretching).
+ *
+ * Lines (twi_bus.h): with TWEN off the board's SCL/SDA port pins drive the
+ * bus's wired-AND lines (twi_wire_pins). A START waits while SDA is low; an
+ * operation waits while SCL is held low, and one under way when SCL is
+ * held ends one period after the release.
  */
 #ifndef SIM_TWI_H
 #define SIM_TWI_H
