@@ -7,7 +7,7 @@ with up to nine SCL pulses, seen on the pin; the board never resets."""
 
 import pytest
 
-from conftest import EEPROM, F_CPU, require_builds, running
+from conftest import DRV_LAYOUT, EEPROM, F_CPU, require_builds, require_slave, running
 from orfa.sim import BOARDS, SimBoard
 
 MS = F_CPU // 1000
@@ -229,3 +229,49 @@ def test_slow_bus_keeps_the_watchdog_fed(sb):
     ev = sb.events(mark, ["twi"])
     assert ev[-1].cycle - ev[0].cycle > F_CPU // 4
     assert sb.ask("C0064") == b"C0063\r\n"
+
+
+# --- a slave board left in the middle of a frame ----------------------------------
+
+@pytest.fixture(scope="module")
+def robot():
+    """An M32-D gateway with an M128-S slave at 0x10 and an M32-D slave at
+    0x12 (the test robot's firmware, `make robot`)."""
+    require_builds(["m32d"])
+    slaves = [("m128s", 0x10, require_slave("m128s", 0x10)),
+              ("m32d", 0x12, require_slave("m32d", 0x12))]
+    sim = SimBoard("m32d", eeproms=(EEPROM,), trace=True, control=True, slaves=slaves)
+    with running(sim) as b:
+        yield b
+
+
+@pytest.mark.parametrize("addr", [0x10, 0x12])
+def test_slave_left_mid_frame_lets_go(robot, addr):
+    """The gateway gives up on a frame to a slave (SCL held after some data
+    bytes: ERROR 07) and never sends its STOP. The slave, addressed with no
+    bus event for 25-35 ms (SMBus's bound), resets its TWI (`twi off <SS>`),
+    so it never holds the bus for good; then it answers as before."""
+    b = robot
+    ctl = b.sim.control
+    b.gw.serial.reset_input_buffer()
+    mark = b.mark()
+    rs = DRV_LAYOUT["m128s" if addr == 0x10 else "m32d"]["servo"]   # takes anything
+    try:
+        assert b.ask("C0001") == b"C0000\r\n"
+        req = ("S %02X %02X %s P\n" % (addr, rs, " ".join(["00"] * 7))).encode()
+        end = ctl.rx(ctl.time() + 50 * MS, req)
+        ctl.requests(["wait %d" % (end + 40 * MS - ctl.time()), "i2c hold-scl on"])
+        assert b.read_lines(1) == b"ERROR 07\r\n"
+        ctl.wait(40 * MS)
+        ev = b.events(mark)
+        off = [e for e in ev if e.kind == "twi off"]
+        assert [e.fields for e in off] == [(), ("%02X" % addr,)], off   # gateway, slave
+        last = max(e.cycle for e in ev if e.kind in ("twi addr", "twi write")
+                   and e.cycle < off[1].cycle)
+        print("slave %02X let go %d cycles after its last event" % (addr, off[1].cycle - last))
+        assert 25 * MS <= off[1].cycle - last <= 35 * MS, off[1].cycle - last
+    finally:
+        ctl.i2c_hold_scl(False)
+    b.restore()
+    assert b.ask("S %02X 00 00 S %02X 01 P" % (addr, addr | 1)).startswith(b"SWAASR")
+    assert b.events(mark, ["reset"]) == []
