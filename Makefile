@@ -51,7 +51,9 @@ DRIVERS ?= $(BOARD_DRIVERS)
 
 # BUILD=dir puts one more build elsewhere (the test robot's slaves at their addresses).
 BUILD ?= build/$(BOARD)-$(MODE)
-FW_OPT ?= -Os
+# -fno-move-loop-invariants -mstrict-X: 130 bytes less on the M32-D gateway,
+# no slower where it counts (make bench).
+FW_OPT ?= -Os -fno-move-loop-invariants -mstrict-X
 CC := avr-gcc
 OBJCOPY := avr-objcopy
 AVR_SIZE := avr-size
@@ -76,7 +78,7 @@ FW_SRC := firmware/main.c firmware/regmap.c firmware/xact.c firmware/intro.c \
 	$(foreach d,$(DRIVERS),drivers/drv_$(d).c $(DRV_HW_$(d)))
 ifeq ($(MODE),gate)
 FW_SRC += firmware/uart.c firmware/twi_master.c firmware/twi_rate.c \
-	serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
+	serialgate/sg_rx.c serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
 else ifeq ($(MODE),slave)
 FW_SRC += i2c_slave/slave_fsm.c i2c_slave/i2c_slave.c
 else
