@@ -275,3 +275,19 @@ def test_slave_left_mid_frame_lets_go(robot, addr):
     b.restore()
     assert b.ask("S %02X 00 00 S %02X 01 P" % (addr, addr | 1)).startswith(b"SWAASR")
     assert b.events(mark, ["reset"]) == []
+
+
+def test_x_keeps_the_clock(sb):
+    """X turns the TWI off and on again; TWBR/TWPS stay: the bytes after it
+    still take 9 periods of the clock `C` set (400 kHz asked, 368.64 made)."""
+    from orfa import protocol as p
+    assert sb.ask("C0190") == b"C0170\r\n"
+    sb.sim.control.i2c_stuck(3)
+    assert sb.ask("X") == b"X\r\n"
+    _, _, twbr, twps = p.twi_clock(0x190)
+    period = 16 + 2 * twbr * 4 ** twps
+    mark = sb.mark()
+    assert sb.ask("S A0 78 01 02 03 04 P") == b"SWAAAAAP\r\n"
+    writes = [e.cycle for e in sb.events(mark, ["twi write"])]
+    gaps = [b2 - a for a, b2 in zip(writes, writes[1:])]
+    assert len(gaps) == 4 and all(9 * period <= g < 9 * period + 200 for g in gaps), gaps
