@@ -542,6 +542,7 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	}
 	sim->control.srf08 = w->srf08;	/* control_open clears control_t */
 	sim->control.srf08_count = w->nsrf08;
+	sim->control.bus = &w->bus;
 	return 0;
 }
 

@@ -114,6 +114,17 @@ int sim_board_init(sim_board_t *b, const board_desc_t *board, const char *elf,
 		fprintf(stderr, "orfa-sim: cannot build the %s board model\n", board->name);
 		return 2;
 	}
+	/* SCL/SDA as pins: the firmware's port drivers and the line levels */
+	{
+		const board_pin_t *scl = board_wiring_pin(board->wiring, BW_TWI_SCL, 0);
+		const board_pin_t *sda = board_wiring_pin(board->wiring, BW_TWI_SDA, 0);
+
+		if (!scl || !sda || twi_wire_pins(&b->twi, scl->port, scl->bit, sda->bit) < 0 ||
+		    board_model_wire_twi(&b->bm, bus) < 0) {
+			fprintf(stderr, "orfa-sim: cannot wire the %s's TWI pins\n", board->name);
+			return 2;
+		}
+	}
 	if (!addr) {
 		const board_pin_t *rxd = board_wiring_pin(board->wiring, BW_UART_RX, 0);
 

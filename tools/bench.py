@@ -500,6 +500,63 @@ def bench_autobaud(boards):
 # --- end autobaud ----------------------------------------------------------------
 
 
+# --- Bus faults (issue 8): ERROR latency with a stuck or missing device ------
+#
+# The requests are scheduled with `rx` at fixed cycles; each fault is set
+# through the control socket half a gap before its request (a `wait` and the
+# `i2c` requests sent together act at the wait's cycle, give or take the
+# control socket's round trip, far less than half a gap), so the figures
+# repeat exactly.
+
+BUS_FAULTS = [
+    # (row, control requests that set the fault, request, its reply)
+    ("stuck SDA", ["i2c stuck 5"], "S A0 70 S A1 01 P\r", b"ERROR 06\r\n"),
+    ("held SCL", ["i2c stuck 0", "i2c hold-scl on"], "S A0 70 S A1 01 P\r",
+     b"ERROR 06\r\n"),
+    ("missing device", ["i2c hold-scl off"], "S 42 P\r", b"ERROR 06\r\n"),
+]
+#: Between two fault requests: far longer than an ERROR takes (10 ms).
+BUS_FAULT_GAP = 1 << 19
+
+
+def bench_bus_faults(board):
+    """{row: cycles from the request's last byte to its ERROR's first byte}."""
+    with SimBoard(board, eeproms=(0xA0,), control=True) as sim:
+        ctl = sim.control
+        sched = Schedule(ctl, START)
+        windows = [sched.send(req.encode(), gap=BUS_FAULT_GAP) for _, _, req, _ in BUS_FAULTS]
+        lines, at = [], ctl.time()
+        for (_, faults, _, _), (start, _) in zip(BUS_FAULTS, windows):
+            lines += ["wait %d" % (start - BUS_FAULT_GAP // 2 - at)] + faults
+            at = start - BUS_FAULT_GAP // 2
+        if int(lines[0].split()[1]) <= 0:
+            raise SystemExit("bench: the %s simulator passed the fault schedule" % board)
+        with serial.Serial(sim.port, 115200, timeout=30) as port:
+            ctl.requests(lines)        # returns when the last fault is set
+            replies = read_replies(port, len(BUS_FAULTS))
+        events = parse_trace(sim.trace_text())
+    rows = {}
+    for (name, _, _, want), window, reply in zip(BUS_FAULTS, windows, replies):
+        if reply != want:
+            raise SystemExit("bench: %s on %s answered %r" % (name, board, reply))
+        rows[name] = latency(events, window, reply)[0]
+    return rows
+
+
+def print_bus_faults(boards, width=38):
+    results = {b: bench_bus_faults(b) for b in boards}
+    print()
+    print("Bus faults: request end to ERROR (cycles, ms); target < 10 ms")
+    print()
+    for name, _, _, _ in BUS_FAULTS:
+        print("%-*s" % (width, "ERROR latency, %s" % name) + "".join(
+            "%14s" % ("%d %.2f" % (results[b][name], results[b][name] * 1e3 / F_CPU))
+            for b in boards) + "%10s" % "< 73728")
+    return all(results[b][n] < F_CPU // 100 for b in boards for n, _, _, _ in BUS_FAULTS)
+
+# --- end of bus faults ----------------------------------------------------------
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--boards", nargs="+", default=["m32d", "m128s"])
@@ -618,6 +675,7 @@ def main():
     print("stretch is how long the slave held SCL before the read right after the write.")
     ok = ok and all(slaves[b]["pipeline"][0] == SLAVE_PIPELINE for b in args.boards)
     ok = bench_autobaud(args.boards) and ok
+    ok = print_bus_faults(args.boards) and ok
     return 0 if ok else 1
 
 

@@ -238,6 +238,7 @@ DRV_LAYOUT = {
         "servo_pins": ["A0", "A1", "A2", "A3", "A4", "A5", "A6", "A7",
                        "C7", "C6", "C5", "C4", "B3", "B2", "D5", "D4"],
         # pins of functions that GPIO never has (UART, TWI, SPI, motors)
+        "fixed_scl": "C0",
         "fixed_pins": {"D0": "UART", "D1": "UART", "C0": "TWI", "C1": "TWI",
                        "B4": "SPI", "B5": "SPI", "B6": "SPI", "B7": "SPI",
                        "D5": "MOTOR", "D4": "MOTOR", "B0": "MOTOR", "B1": "MOTOR"},
@@ -248,6 +249,7 @@ DRV_LAYOUT = {
         "servo_channels": 32, "adc_port": "F",
         "spi_pins": {"SS": "B0", "SCK": "B1", "MOSI": "B2", "MISO": "B3"},
         "servo_pins": ["servo%d" % n for n in range(32)],
+        "fixed_scl": "D0",
         "fixed_pins": {"D2": "UART", "D3": "UART", "D0": "TWI", "D1": "TWI",
                        "B0": "SPI", "B1": "SPI", "B2": "SPI", "B3": "SPI",
                        "E3": "SERVO", "E4": "SERVO", "E5": "SERVO", "B7": "SERVO",
@@ -353,6 +355,17 @@ class DrvBench(Bench):
     # --- the pins ---------------------------------------------------------------
     def pin(self, name: str):
         return self.ctl.pin(name)
+
+    def read_levels(self, port: str) -> int:
+        """What the board's GPIO value register reads for `port`: its pin
+        levels, except that a slave board reads its own SCL low, since it
+        holds SCL (clock stretching) while it answers the read. The TWI
+        pins show the bus's wired-AND lines (docs/simulator.md)."""
+        value = sum(self.pin("%s%d" % (port, l))[0] << l for l in range(8))
+        scl = self.lay["fixed_scl"]
+        if self.slave and scl[0] == port:
+            value &= ~(1 << int(scl[1]))
+        return value
 
     def drive(self, name: str, value) -> None:
         self.ctl.drive(name, value)
