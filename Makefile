@@ -1,6 +1,6 @@
 # ORFA firmware, simulator and tests.
 #
-#   make [BOARD=m32d|m128s] [MODE=gate|slave] [BAUD=115200] [ADDR=0x10] [DRIVERS="..."]
+#   make [BOARD=m32d|m128s] [MODE=gate|slave] [BAUD=115200|...|auto] [ADDR=0x10] [DRIVERS="..."]
 #   make all-boards     every board and mode
 #   make robot          the slave boards of the simulated test robot
 #   make size           flash and static RAM of every build in build/
@@ -18,6 +18,12 @@ BAUD ?= 115200
 ADDR ?= 0x10
 
 BOARDS := m32d m128s
+# The serial rates of SPEC section 2: a fixed-rate build takes one, BAUD=auto
+# detects them all (firmware/autobaud.c, host/orfa/boards.py reads this line).
+BAUD_RATES := 2400 4800 9600 14400 19200 28800 38400 57600 76800 115200
+ifeq ($(filter $(BAUD),$(BAUD_RATES) auto),)
+$(error BAUD=$(BAUD) is not a rate of the line: use one of $(BAUD_RATES), or auto)
+endif
 MODES := gate slave
 
 ifeq ($(wildcard boards/$(BOARD)/board.mk),)
@@ -59,7 +65,8 @@ CC := avr-gcc
 OBJCOPY := avr-objcopy
 AVR_SIZE := avr-size
 
-FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) -DORFA_BAUD=$(BAUD) \
+FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) \
+	$(if $(filter auto,$(BAUD)),'-DORFA_BAUD_RATES(X)=$(foreach r,$(BAUD_RATES),X($(r)))',-DORFA_BAUD=$(BAUD)) \
 	-DORFA_ADDR=$(ADDR) -DORFA_MODE_$(MODE) \
 	-std=gnu99 $(FW_OPT) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
 	-fshort-enums -I. -Iboards/$(BOARD) \
@@ -78,7 +85,8 @@ FW_SRC := firmware/main.c firmware/regmap.c firmware/xact.c firmware/intro.c fir
 	firmware/mcu.c firmware/clock.c firmware/pins.c firmware/board_pins.c firmware/port_io_avr.c \
 	$(foreach d,$(DRIVERS),drivers/drv_$(d).c $(DRV_HW_$(d)))
 ifeq ($(MODE),gate)
-FW_SRC += firmware/uart.c firmware/twi_master.c firmware/twi_rate.c \
+FW_SRC += firmware/uart.c $(if $(filter auto,$(BAUD)),firmware/autobaud.c,firmware/uart_rate.c) \
+	firmware/twi_master.c firmware/twi_rate.c \
 	serialgate/sg_rx.c serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
 else ifeq ($(MODE),slave)
 FW_SRC += i2c_slave/slave_fsm.c i2c_slave/i2c_slave.c
@@ -87,7 +95,7 @@ $(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 
-.PHONY: firmware all-boards robot size sim unit test bench soak demo demo-robot clean setup
+.PHONY: print-baud-rates firmware all-boards robot size sim unit test bench soak demo demo-robot clean setup
 .DEFAULT_GOAL := firmware
 
 firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
@@ -122,6 +130,9 @@ robot:
 
 size:
 	@tools/size.sh build
+
+print-baud-rates:
+	@echo $(BAUD_RATES)
 
 # --- simulator (host C, Debian's libsimavr) --------------------------------
 SIM_SRC := $(wildcard sim/*.c sim/parts/*.c)

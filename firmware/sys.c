@@ -3,7 +3,7 @@
 #include "firmware/clock.h"
 #include "firmware/flash.h"
 
-_Static_assert((uint32_t)SYS_FAILSAFE_MAX_MS * CLOCK_HZ / 1000u < 65536u,
+_Static_assert((uint32_t)SYS_FAILSAFE_MAX_MS * CLOCK_HZ / 1000u + 1u < 65536u,
 	       "the longest FAILSAFE fits the 16-bit clock");
 
 #define SYS_REG_RESET    0
@@ -86,8 +86,10 @@ reg_status_t drv_sys_write(uint8_t reg, const uint8_t *data, uint8_t len)
 		return REG_BAD_VALUE;
 	}
 	sys.ms = ms;
-	/* rounded up: never early (18000 ms are 64800 ticks) */
-	sys.ticks = (uint16_t)(((uint32_t)ms * CLOCK_HZ + 999u) / 1000u);
+	/* Rounded up, and one tick more: the clock is read in whole ticks, so
+	 * the request may have come up to a tick after the one counted from.
+	 * Never early, at most two ticks (0.56 ms) late. */
+	sys.ticks = ms ? (uint16_t)(((uint32_t)ms * CLOCK_HZ + 999u) / 1000u + 1u) : 0;
 	sys.last = sys_clock();
 	sys.tripped = 0;
 	sys_heard = 0;

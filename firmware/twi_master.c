@@ -6,23 +6,22 @@
 #include <util/twi.h>
 
 #include "board.h"
+#include "firmware/clock.h"
 #include "firmware/mcu.h"
 #include "firmware/twi_rate.h"
 
-/* Cycles of one twi_wait() polling loop at least (avr-gcc 5.4 -Os: 9 on
- * the ATmega32, 10 on the ATmega128, more with interrupts). */
-#define TWI_LOOP_CYCLES 9
-/* The longest SCL stretch a slave is waited for: an ORFA slave holds SCL
- * while it applies a write; the longest is an SPI exchange of the 60 bytes a
- * request can carry at the slowest SPI clock (F_CPU/128: 1024 cycles a
- * byte), about 8.5 ms with the servo interrupts; 16 servo triples on an
- * M32-D take about 5.6 ms. Interrupts only make a loop longer. */
-#define TWI_STRETCH_MAX_US 12000UL
-#define TWI_STRETCH_LOOPS \
-	(TWI_STRETCH_MAX_US * (F_CPU / 1000UL) / (1000UL * TWI_LOOP_CYCLES))
+/* How long one step waits for the bus: a slave may stretch SCL while it
+ * applies a write, the longest an SPI exchange of 57 bytes at F_CPU/128
+ * with the servo interrupts (61213 cycles, 30 ticks, measured in the
+ * simulator); on top, the step's own bus time (twi_set_khz). A wait ends
+ * more than TWI_WAIT_TICKS and at most one tick more after it began:
+ * 8.9-9.2 ms at 100 kHz and faster, so an ERROR leaves within 10 ms. */
+#define TWI_WAIT_TICKS 32
+_Static_assert(CLOCK_TICKS_MS(8.5) <= TWI_WAIT_TICKS && TWI_WAIT_TICKS < CLOCK_TICKS_MS(9.3),
+	       "a wait of 8.5-9.5 ms");
 
 static struct {
-	uint32_t timeout;  /* polling loops before a step counts as hung */
+	uint8_t ticks;  /* clock ticks a step may take before it has failed */
 } twi;
 
 void twi_init(void)
@@ -36,24 +35,44 @@ uint16_t twi_set_khz(uint16_t khz)
 	twi_rate_t r = twi_rate_for_khz(F_CPU, khz);
 	TWBR = r.twbr;
 	TWSR = r.twps;  /* only the prescaler bits are writable */
-	/* A polling loop takes at least TWI_LOOP_CYCLES: 3 periods of loops
-	 * cover a whole byte (9 periods) twice over; on top, the time a slave
-	 * may stretch SCL (an ORFA slave applies a write while it holds SCL). */
-	twi.timeout = 3 * r.period + 256 + TWI_STRETCH_LOOPS;
+	/* On top of TWI_WAIT_TICKS, 8 SCL periods (period >> 8 ticks): a
+	 * byte takes 9, the ninth fits in TWI_WAIT_TICKS with the short
+	 * stretch a slave makes before a read; the long one (a write being
+	 * applied) delays a START or STOP, one period. At most 32 + 127
+	 * ticks (TWBR 255, TWPS 3): below 256. */
+	twi.ticks = (uint8_t)(TWI_WAIT_TICKS + (r.period >> 8));
 	return r.khz;
+}
+
+/* Waits until the TWCR bits in `mask` read `want`, within the bound. A step
+ * that gets nowhere resets the TWI (off and on again; TWBR/TWPS stay), so
+ * the next request starts clean. The watchdog is fed only when the bus
+ * made progress: a wait that never ends cannot keep a hung board alive. */
+/* The clock's low byte (AVR: little-endian): a bound is below 256 ticks,
+ * so it suffices, and one load of it needs no interrupts held off. */
+static uint8_t twi_ticks_now(void)
+{
+	return *(volatile const uint8_t *)&clock_wraps;
+}
+
+static bool twi_wait_for(uint8_t mask, uint8_t want)
+{
+	uint8_t t0 = twi_ticks_now();
+	while ((TWCR & mask) != want) {
+		if ((uint8_t)(twi_ticks_now() - t0) > twi.ticks) {
+			TWCR = 0;
+			TWCR = _BV(TWEN);
+			return false;
+		}
+	}
+	wdt_reset();
+	return true;
 }
 
 /* Waits for TWINT; false on timeout. */
 static bool twi_wait(void)
 {
-	uint32_t n = twi.timeout;
-	while (!(TWCR & _BV(TWINT))) {
-		if (--n == 0) {
-			return false;
-		}
-	}
-	wdt_reset();  /* a slow bus makes progress: don't let the watchdog bite */
-	return true;
+	return twi_wait_for(_BV(TWINT), _BV(TWINT));
 }
 
 twi_result_t twi_start(uint8_t addr8)
@@ -110,15 +129,7 @@ twi_result_t twi_read(uint8_t *byte, bool ack)
 void twi_stop(void)
 {
 	TWCR = _BV(TWINT) | _BV(TWSTO) | _BV(TWEN);
-	uint32_t n = twi.timeout;
-	while (TWCR & _BV(TWSTO)) {
-		if (--n == 0) {
-			/* The TWI is wedged: restart it. */
-			TWCR = 0;
-			TWCR = _BV(TWEN);
-			return;
-		}
-	}
+	twi_wait_for(_BV(TWSTO), 0);
 }
 
 /* Open-drain lines by hand: low = output 0, released = input with pull-up. */
@@ -134,7 +145,7 @@ static void line_release(const mcu_port_t *p, uint8_t bit)
 	*p->port |= bit;
 }
 
-void twi_clear_bus(void)
+bool twi_clear_bus(void)
 {
 	mcu_port_t port = mcu_port(BOARD_TWI_PORT - 'A');
 	const mcu_port_t *p = &port;
@@ -151,15 +162,22 @@ void twi_clear_bus(void)
 		line_release(p, scl);
 		_delay_us(5);
 	}
-	/* STOP: SDA rises while SCL is high. */
-	line_low(p, scl);
-	line_low(p, sda);
-	_delay_us(5);
-	line_release(p, scl);
-	_delay_us(5);
-	line_release(p, sda);
-	_delay_us(5);
-	/* Back to the TWI, pins as after reset. */
+	/* SDA still low after nine clocks: no STOP can be made. */
+	bool free = false;
+	if (*p->pin & sda) {
+		/* STOP: SDA rises while SCL is high. */
+		line_low(p, scl);
+		line_low(p, sda);
+		_delay_us(5);
+		line_release(p, scl);
+		_delay_us(5);
+		line_release(p, sda);
+		_delay_us(5);
+		/* SDA was free; is SCL? */
+		free = *p->pin & scl;
+	}
+	/* Back to the TWI, pins as after reset; TWBR/TWPS were kept. */
 	*p->port &= (uint8_t)~(scl | sda);
 	TWCR = _BV(TWEN);
+	return free;
 }

@@ -1,6 +1,8 @@
 /*
- * TWI (I2C) master, polled, with a timeout on every step so that a missing or
- * stuck device gives an error within milliseconds, never a hang.
+ * TWI (I2C) master, polled, with a time bound on every step (clock.h ticks:
+ * about 9 ms plus the step's own bus time) so that a missing or stuck
+ * device gives an error within 10 ms, never a hang. A step that times out
+ * resets the TWI (TWBR/TWPS kept).
  */
 #ifndef ORFA_TWI_MASTER_H
 #define ORFA_TWI_MASTER_H
@@ -11,7 +13,7 @@
 typedef enum {
 	TWI_ACK = 0,   /* the byte was acknowledged */
 	TWI_NACK,      /* it was not */
-	TWI_FAIL,      /* bus error, arbitration lost or timeout */
+	TWI_FAIL,      /* bus error, arbitration lost or timeout (TWI reset) */
 } twi_result_t;
 
 void twi_init(void);
@@ -28,7 +30,9 @@ twi_result_t twi_read(uint8_t *byte, bool ack);
 void twi_stop(void);
 
 /* Frees a bus held by a slave: clocks SCL until SDA is released (at most 9
- * clocks), then a STOP; the TWI is re-enabled afterwards. */
-void twi_clear_bus(void);
+ * clocks), then a STOP; the TWI is re-enabled afterwards (clock kept).
+ * True when both lines are high at the end, false when SDA stayed low
+ * after nine clocks or SCL is held low. */
+bool twi_clear_bus(void);
 
 #endif

@@ -5,14 +5,7 @@
 
 #include "firmware/mcu.h"
 
-#ifndef ORFA_BAUD
-#define ORFA_BAUD 115200
-#endif
-
-#define UART_UBRR ((F_CPU + 8UL * ORFA_BAUD) / (16UL * ORFA_BAUD) - 1)
-
 _Static_assert((UART_TX_SIZE & (UART_TX_SIZE - 1)) == 0, "tx size is a power of two");
-_Static_assert(UART_UBRR < 4096, "baud rate too low for this clock");
 
 static struct {
 	uint8_t tx[UART_TX_SIZE];
@@ -20,16 +13,9 @@ static struct {
 	volatile uint8_t tx_tail;
 } uart;
 
-void uart_init(void)
-{
-	MCU_UBRRH = (uint8_t)(UART_UBRR >> 8);
-	MCU_UBRRL = (uint8_t)UART_UBRR;
-	/* 8N1 is the reset value of the frame format on both MCUs. */
-	MCU_UCSRB = _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
-}
-
 ISR(MCU_UART_RX_vect)
 {
+	uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
 	uart_received(MCU_UDR);
 }
 

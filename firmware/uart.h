@@ -12,7 +12,9 @@
  * rarely waits for the wire. Power of two. */
 #define UART_TX_SIZE 128
 
-void uart_init(void);
+/* uart_init() (set the rate, enable the USART) is the line's: see
+ * firmware/uart_line.h. */
+#include "firmware/uart_line.h"
 
 /* Each received byte, from the receive interrupt: the front end's. */
 void uart_received(uint8_t c);

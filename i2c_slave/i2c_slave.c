@@ -12,6 +12,7 @@
 #include <avr/io.h>
 #include <util/twi.h>
 
+#include "firmware/clock.h"
 #include "firmware/sys.h"
 #include "i2c_slave/slave_fsm.h"
 
@@ -26,6 +27,13 @@ _Static_assert(ORFA_ADDR >= 0x10 && ORFA_ADDR < 0xF0, "ADDR is an I2C reserved a
 #define SLAVE_TWCR (_BV(TWEN) | _BV(TWIE) | _BV(TWEA))
 
 static volatile uint8_t slave_deferred;
+/* Low byte of the clock tick of the last TWI event. */
+static volatile uint8_t slave_seen;
+
+/* A frame left open with no bus event for this long: its master is gone
+ * (reset in the middle of it). SMBus allows a device 25-35 ms. */
+#define SLAVE_STALL_TICKS CLOCK_TICKS_MS(30)
+_Static_assert(SLAVE_STALL_TICKS < 250, "the low byte of the clock suffices");
 
 static void slave_apply(slave_action_t act, uint8_t byte)
 {
@@ -59,6 +67,7 @@ ISR(TWI_vect)
 	/* TWIE off before interrupts are on again, or this one would come
 	 * back at once: TWINT is a level. Writing TWINT 0 leaves it set. */
 	TWCR = (uint8_t)(TWCR & ~(_BV(TWINT) | _BV(TWIE)));
+	slave_seen = (uint8_t)clock_now();
 	sei();
 	uint8_t byte = TWDR;
 	uint8_t status = TW_STATUS;
@@ -79,9 +88,29 @@ void front_init(void)
 	TWCR = SLAVE_TWCR;
 }
 
+/* Is the frame open and silent for SLAVE_STALL_TICKS? */
+static bool slave_stalled(void)
+{
+	return slave_fsm_in_frame() &&
+	       (uint8_t)((uint8_t)clock_now() - slave_seen) > SLAVE_STALL_TICKS;
+}
+
 void front_poll(void)
 {
 	if (!slave_deferred) {
+		/* A master gone in the middle of a frame must not leave this
+		 * TWI addressed for good (a transmitter could hold SDA low):
+		 * start again, the frame dropped (a write is not applied).
+		 * Checked again with interrupts off: an event may just come. */
+		if (slave_stalled()) {
+			cli();
+			if (slave_stalled()) {
+				TWCR = 0;
+				slave_fsm_init();
+				TWCR = SLAVE_TWCR;
+			}
+			sei();
+		}
 		sys_poll();  /* idle: the failsafe's turn */
 		return;
 	}

@@ -15,6 +15,7 @@ static struct {
 	uint8_t buf[SLAVE_BUF_SIZE];
 	uint8_t work;      /* slave_work_t deferred to the main loop */
 	uint8_t in_write;  /* a write frame is open (TW_SR_STOP ends it) */
+	uint8_t in_frame;  /* addressed, the frame not ended yet */
 } slave;
 
 void slave_fsm_init(void)
@@ -22,6 +23,12 @@ void slave_fsm_init(void)
 	xact_init();
 	slave.work = WORK_NONE;
 	slave.in_write = 0;
+	slave.in_frame = 0;
+}
+
+bool slave_fsm_in_frame(void)
+{
+	return slave.in_frame;
 }
 
 static slave_action_t slave_defer(slave_work_t work)
@@ -44,6 +51,11 @@ static slave_action_t slave_end_write(void)
 
 slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 {
+	/* addressed until a frame's end: STOP or repeated START, a refused
+	 * byte, the master's NACK or the last byte sent */
+	slave.in_frame = status == TW_SR_SLA_ACK || status == TW_SR_ARB_LOST_SLA_ACK ||
+			 status == TW_SR_DATA_ACK || status == TW_ST_SLA_ACK ||
+			 status == TW_ST_ARB_LOST_SLA_ACK || status == TW_ST_DATA_ACK;
 	switch (status) {
 	case TW_SR_SLA_ACK:
 	case TW_SR_ARB_LOST_SLA_ACK:

@@ -42,6 +42,10 @@ void slave_fsm_init(void);
  * data and receives the byte to send for SLAVE_SEND. */
 slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte);
 
+/* True while the TWI is addressed in a frame that has not ended (no STOP,
+ * repeated START, refused byte or last byte yet). */
+bool slave_fsm_in_frame(void);
+
 /* The deferred work of the last SLAVE_DEFER; returns SLAVE_ACK or
  * SLAVE_SEND (with *byte) to release the bus with. */
 slave_action_t slave_fsm_work(uint8_t *byte);

@@ -69,6 +69,7 @@ static uint8_t run_bus(uint8_t addr, uint8_t *data, uint8_t n)
 {
 	twi_result_t r = twi_start(addr);
 	if (r != TWI_ACK) {
+		/* no ACK, or the bus could not be had (held, lost, timeout) */
 		return SG_ERR_ADDR_NACK;
 	}
 	for (uint8_t i = 0; i < n; i++) {
@@ -77,11 +78,10 @@ static uint8_t run_bus(uint8_t addr, uint8_t *data, uint8_t n)
 		} else {
 			r = twi_write(data[i]);
 		}
-		if (r == TWI_NACK) {
-			return SG_ERR_DATA_NACK;
-		}
 		if (r != TWI_ACK) {
-			return SG_ERR_ADDR_NACK;  /* bus lost or stuck */
+			/* refused, or the bus was lost or stuck after the
+			 * address was acknowledged */
+			return SG_ERR_DATA_NACK;
 		}
 	}
 	return SG_OK;
@@ -161,7 +161,10 @@ void sg_exec(sg_parser_t *p)
 		sg_out('1');
 		break;
 	case SG_CMD_CLEAR:
-		twi_clear_bus();
+		if (!twi_clear_bus()) {
+			out_error(SG_ERR_ADDR_NACK);  /* the bus is still held */
+			return;
+		}
 		sg_out('X');
 		break;
 	case SG_CMD_LOCAL:

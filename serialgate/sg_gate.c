@@ -39,6 +39,14 @@ void front_poll(void)
 	int16_t c = sg_rx_get();
 	if (c < 0) {
 		if (!sg_rx_losing()) {
+			if (uart_line_poll()) {
+				/* The line's rate changed (autobaud): what the ring
+				 * and the parser hold came at the old one. */
+				ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+					sg_rx_init();
+				}
+				sg_parse_init(&parser);
+			}
 			/* Idle: the failsafe's turn. Not on the busy path, where
 			 * the M32-D's streamed servo writes have no cycle to spare
 			 * (characters always leave the loop idle in between). */
@@ -56,6 +64,9 @@ void front_poll(void)
 	sg_event_t ev = sg_parse_char(&parser, (uint8_t)c);
 	if (ev == SG_REQUEST) {
 		SYS_HEARD();  /* any request line keeps the link alive */
+		if (parser.err == SG_OK) {
+			uart_line_confirm();	/* a good request proves the rate */
+		}
 		sg_exec(&parser);
 	} else if (ev == SG_LOST) {
 		SYS_HEARD();

@@ -109,6 +109,11 @@ static int bm_pin_level(const bm_port_t *p, int bit)
 {
 	uint8_t m = (uint8_t)(1u << bit);
 
+	if (p->wired & m) {
+		const board_model_t *bm = p->bm;
+
+		return bit == bm->twi_scl ? bm->twi_bus->scl : bm->twi_bus->sda;
+	}
 	if (p->ddr & m) {
 		if (p->spi_mask & m) {
 			return !!(p->spi_level & m);
@@ -151,7 +156,9 @@ static uint8_t bm_read_pin(avr_t *avr, avr_io_addr_t addr, void *param)
 	for (int b = 0; b < 8; b++) {
 		levels |= (uint8_t)(p->pin[b].level << b);
 	}
-	v = (uint8_t)((v & ~p->ddr) | (levels & p->ddr));
+	uint8_t own = (uint8_t)(p->ddr | p->wired);
+
+	v = (uint8_t)((v & ~own) | (levels & own));
 	avr->data[addr] = v;
 	return v;
 }
@@ -943,6 +950,31 @@ int board_model_init(board_model_t *bm, avr_t *avr, const board_desc_t *board,
 	bm_no_strict_level(avr);
 	bm_paint_sram(avr);
 	bm->activity = 0;
+	return 0;
+}
+
+static void bm_twi_lines(void *param, uint64_t cycle)
+{
+	board_model_t *bm = param;
+
+	bm_port_update(bm->twi_port, cycle);
+}
+
+int board_model_wire_twi(board_model_t *bm, twi_bus_t *bus)
+{
+	const board_pin_t *scl = board_wiring_pin(bm->wiring, BW_TWI_SCL, 0);
+	const board_pin_t *sda = board_wiring_pin(bm->wiring, BW_TWI_SDA, 0);
+	bm_port_t *p = scl && sda ? board_model_port(bm, scl->port) : NULL;
+
+	if (!p || sda->port != scl->port || twi_bus_listen(bus, bm_twi_lines, bm) < 0) {
+		return -1;
+	}
+	bm->twi_bus = bus;
+	bm->twi_port = p;
+	bm->twi_scl = scl->bit;
+	bm->twi_sda = sda->bit;
+	p->wired = (uint8_t)((1u << scl->bit) | (1u << sda->bit));
+	bm_port_update(p, bm->avr->cycle);
 	return 0;
 }
 

@@ -28,6 +28,7 @@
 #include "signals.h"
 #include "spi.h"
 #include "trace.h"
+#include "twi_bus.h"
 #include "parts/cd4017.h"
 #include "parts/eeprom25.h"
 #include "parts/mcp3008.h"
@@ -57,6 +58,7 @@ typedef struct bm_port_t {
 	uint8_t ddr, port;		/* shadows of DDRx/PORTx */
 	uint8_t ext_mask, ext_value;	/* driven from outside */
 	uint8_t spi_mask, spi_level;	/* driven by the SPI master */
+	uint8_t wired;			/* the I2C bus's lines (board_model_wire_twi) */
 	signal_t pin[8];
 	bm_oc_t *oc[8][2];
 	int noc[8];
@@ -153,6 +155,10 @@ typedef struct board_model_t {
 	mcp3008_t mcp[BM_MAX_SPI_DEV];
 	int nee, nmcp;
 	uint32_t activity;		/* control-visible changes */
+
+	twi_bus_t *twi_bus;		/* the TWI pins show its lines */
+	bm_port_t *twi_port;
+	int twi_scl, twi_sda;
 } board_model_t;
 
 /* Build the model around AVR (after avr_init, before the run). 0 or -1. */
@@ -183,6 +189,11 @@ void board_model_set_aref(board_model_t *bm, uint32_t mv);
  * FROM (the end of the firmware's static data, __heap_start; 0 = guess) that
  * the stack has written. *deepest = that address. -1 if FROM is not SRAM. */
 int board_model_stack_peak(board_model_t *bm, uint32_t from, uint32_t *deepest);
+
+/* The board's TWI pins (its wiring's TWI_SCL/TWI_SDA) show BUS's wired-AND
+ * lines: their signals follow the line levels and PINx reads them, whoever
+ * pulls (this board's pins or TWI, another board, a stuck device). */
+int board_model_wire_twi(board_model_t *bm, twi_bus_t *bus);
 
 /* "1 out", "0 in", "1 in pullup", "0 in ext", ... */
 void board_model_pin_text(board_model_t *bm, bm_port_t *p, int bit, char *buf, int size);

@@ -283,9 +283,9 @@ static void cmd_spi(board_model_t *bm, reply_t *r)
 static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
-	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx CYCLE HEX... | signals | "
-	"srf08 ADDR [range MM [MM2] | light N] | fault hang | reset external|power|brownout | "
-	"help; "
+	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx CYCLE HEX... | line | signals | "
+	"srf08 ADDR [range MM [MM2] | light N] | i2c [stuck N | hold-scl on|off] | fault hang | "
+	"reset external|power|brownout | help; "
 	"a slave board's pins, signals and inputs as 10/A5, other requests with @10 "
 	"first (stack @10 FROM)";
 
@@ -540,6 +540,17 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 			cmd_measure(c, &r, s, nmax > SIGNAL_RING ? SIGNAL_RING : (unsigned)nmax,
 				    argc == 4, since);
 		}
+	} else if (!strcasecmp(cmd, "line") && argc == 1) {
+		usart_t *u = c->usart;
+
+		if (cb != &c->board[0]) {
+			rp(&r, "ERR line: only the gateway's serial line reaches the PC");
+			return 0;
+		}
+		rp(&r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u",
+		   (unsigned)u->host_baud, (unsigned)u->host_bit, (unsigned)usart_board_bit(u),
+		   (unsigned)u->ubrr, !!(u->avr->data[u->regs->ucsrb] & (1u << 4)),
+		   (uint64_t)u->rxen_since, (unsigned)u->fe_read);
 	} else if (!strcasecmp(cmd, "rx")) {
 		if (cb != &c->board[0]) {
 			rp(&r, "ERR rx: only the gateway's serial line reaches the PC");
@@ -597,6 +608,26 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 			return 0;
 		}
 		rp(&r, "%" PRIu64, (uint64_t)c->avr->cycle);
+	} else if (!strcasecmp(cmd, "i2c") && argc <= 3 && c->bus) {
+		twi_bus_t *bus = c->bus;
+
+		if (argc == 3 && !strcasecmp(argv[1], "stuck")) {
+			if (parse_u64(argv[2], &u) < 0 || u > 1000000) {
+				rp(&r, "ERR i2c stuck N: N SCL pulses, 0..1000000 (0: SDA free)");
+				return 0;
+			}
+			twi_bus_stuck(bus, (uint32_t)u, c->avr->cycle);
+			rp(&r, "OK");
+		} else if (argc == 3 && !strcasecmp(argv[1], "hold-scl") &&
+			   (!strcasecmp(argv[2], "on") || !strcasecmp(argv[2], "off"))) {
+			twi_bus_hold_scl(bus, !strcasecmp(argv[2], "on"), c->avr->cycle);
+			rp(&r, "OK");
+		} else if (argc == 1) {
+			rp(&r, "sda %d scl %d stuck %" PRIu32 " hold-scl %s", bus->sda, bus->scl,
+			   bus->stuck, bus->hold_scl ? "on" : "off");
+		} else {
+			rp(&r, "ERR i2c [stuck N | hold-scl on|off]");
+		}
 	} else if (!strcasecmp(cmd, "help") && argc == 1) {
 		rp(&r, "%s", control_help);
 	} else {

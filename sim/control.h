@@ -14,6 +14,7 @@
 #include "sim_avr.h"
 
 #include "board_model.h"
+#include "twi_bus.h"
 #include "usart.h"
 
 struct srf08_t;
@@ -55,6 +56,7 @@ typedef struct control_t {
 	uint32_t activity;		/* bumps on every request */
 	struct srf08_t *srf08;		/* the --srf08 devices (`srf08`), set */
 	int srf08_count;		/* by main.c after control_open */
+	twi_bus_t *bus;			/* the I2C bus (`i2c`), set by main.c too */
 } control_t;
 
 /* Listen on PATH (an existing socket file there is replaced). 0 or -1. */

@@ -542,6 +542,7 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	}
 	sim->control.srf08 = w->srf08;	/* control_open clears control_t */
 	sim->control.srf08_count = w->nsrf08;
+	sim->control.bus = &w->bus;
 	return 0;
 }
 
@@ -599,8 +600,12 @@ static int sim_run(sim_t *sim)
 	while (!sim_stop && rc == 0) {
 		uint8_t buf[512];
 		size_t room = usart_host_room(&sim->gateway.usart);
-		size_t n = pty_read(&sim->pty, buf, room < sizeof(buf) ? room : sizeof(buf));
+		size_t n;
 
+		/* The PC's rate, before its bytes go on the line (and before a
+		 * control client schedules some with `rx`). */
+		usart_set_host_baud(&sim->gateway.usart, pty_baud(&sim->pty));
+		n = pty_read(&sim->pty, buf, room < sizeof(buf) ? room : sizeof(buf));
 		if (n) {
 			usart_host_send(&sim->gateway.usart, buf, n);
 		}

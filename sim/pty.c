@@ -38,6 +38,8 @@ int pty_open(pty_t *p)
 	}
 	if (tcgetattr(p->slave, &tio) == 0) {
 		cfmakeraw(&tio);
+		/* ORFA's default rate, until the PC sets its own. */
+		cfsetspeed(&tio, B115200);
 		tcsetattr(p->slave, TCSANOW, &tio);
 	}
 	fcntl(p->master, F_SETFL, fcntl(p->master, F_GETFL) | O_NONBLOCK);

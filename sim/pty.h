@@ -31,6 +31,10 @@ size_t pty_read(pty_t *p, uint8_t *buf, size_t n);
 void pty_write(pty_t *p, uint8_t byte);
 void pty_flush(pty_t *p);
 
+/* The PC's rate: the output speed of the pty's termios in baud (pyserial's
+ * `baudrate`, standard or set through BOTHER), 0 if unknown. */
+unsigned pty_baud(const pty_t *p);
+
 /* Remove the link and close everything. */
 void pty_close(pty_t *p);
 

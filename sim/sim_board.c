@@ -106,6 +106,14 @@ static void sim_board_watchdog_first(avr_t *avr)
 	}
 }
 
+/* The PC's waveform on the gateway's RXD pin. */
+static void sim_board_rxd(void *param, int level)
+{
+	sim_board_t *b = param;
+
+	board_model_drive(&b->bm, b->rxd_port, b->rxd_bit, level);
+}
+
 int sim_board_init(sim_board_t *b, const board_desc_t *board, const char *elf,
 		   uint8_t addr, twi_bus_t *bus, trace_t *trace,
 		   usart_to_host_t to_host, void *to_host_param)
@@ -150,6 +158,26 @@ int sim_board_init(sim_board_t *b, const board_desc_t *board, const char *elf,
 	if (board_model_init(&b->bm, b->avr, board, b->mcu, local_trace) < 0) {
 		fprintf(stderr, "orfa-sim: cannot build the %s board model\n", board->name);
 		return 2;
+	}
+	/* SCL/SDA as pins: the firmware's port drivers and the line levels */
+	{
+		const board_pin_t *scl = board_wiring_pin(board->wiring, BW_TWI_SCL, 0);
+		const board_pin_t *sda = board_wiring_pin(board->wiring, BW_TWI_SDA, 0);
+
+		if (!scl || !sda || twi_wire_pins(&b->twi, scl->port, scl->bit, sda->bit) < 0 ||
+		    board_model_wire_twi(&b->bm, bus) < 0) {
+			fprintf(stderr, "orfa-sim: cannot wire the %s's TWI pins\n", board->name);
+			return 2;
+		}
+	}
+	if (!addr) {
+		const board_pin_t *rxd = board_wiring_pin(board->wiring, BW_UART_RX, 0);
+
+		b->rxd_port = rxd ? board_model_port(&b->bm, rxd->port) : NULL;
+		if (b->rxd_port) {
+			b->rxd_bit = rxd->bit;
+			usart_set_pin(&b->usart, sim_board_rxd, b);
+		}
 	}
 	b->reset_watch.kind = "orfa-reset";
 	b->reset_watch.reset = sim_board_reset_hook;

@@ -35,6 +35,8 @@ typedef struct sim_board_t {
 	usart_t usart;
 	twi_t twi;
 	board_model_t bm;
+	bm_port_t *rxd_port;		/* gateway: its RXD pin, driven by the PC */
+	int rxd_bit;
 	uint8_t addr;			/* slave: 8-bit bus address (--slave); 0: gateway */
 	char prefix[4];			/* "": gateway; "10": a slave's signal prefix */
 } sim_board_t;

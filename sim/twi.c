@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "sim_regbit.h"
+#include "avr_ioport.h"
 
 #include "twi.h"
 
@@ -79,6 +80,14 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 	/* The bus events carry the exact completion cycle, not the cycle
 	 * simavr got round to calling us (1-4 later). */
 	when = t->op_end;
+	if (t->op != TWI_OP_NONE && !t->bus->scl_ext) {
+		/* SCL held low under the operation: its clock stops; it ends
+		 * one period after the release (the bit position is not kept). */
+		t->op_periods = 1;
+		if (!twi_bus_begin(t->bus, &t->master, TWI_BUS_DATA, when)) {
+			return 0;
+		}
+	}
 	switch (t->op) {
 	case TWI_OP_START:
 		twi_bus_start(t->bus, when);
@@ -323,6 +332,56 @@ static const twi_dev_ops_t twi_dev_ops = {
 	.bus_start = twi_dev_end,
 };
 
+/* --- the pins ------------------------------------------------------------- */
+
+/* This board's pull on the lines: with TWEN set the TWI owns the pins (its
+ * own SCL holds are the bus device's); with TWEN off, the port pins. */
+static void twi_pins_update(twi_t *t)
+{
+	int sda_low = 0, scl_low = 0;
+
+	if (t->pins_wired && !(*twi_reg(t, t->regs->twcr) & BIT(TWCR_TWEN))) {
+		uint8_t low = (uint8_t)(t->pin_ddr & ~t->pin_port);
+
+		scl_low = !!(low & BIT(t->pin_scl));
+		sda_low = !!(low & BIT(t->pin_sda));
+	}
+	twi_bus_pins(t->bus, &t->pins, sda_low, scl_low, t->avr->cycle);
+}
+
+static void twi_on_port(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+	twi_t *t = param;
+
+	(void)irq;
+	t->pin_port = (uint8_t)value;
+	twi_pins_update(t);
+}
+
+static void twi_on_ddr(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+	twi_t *t = param;
+
+	(void)irq;
+	t->pin_ddr = (uint8_t)value;
+	twi_pins_update(t);
+}
+
+int twi_wire_pins(twi_t *t, char port, int scl, int sda)
+{
+	avr_irq_t *irq = avr_io_getirq(t->avr, AVR_IOCTL_IOPORT_GETIRQ(port), 0);
+
+	if (!irq) {
+		return -1;
+	}
+	t->pins_wired = 1;
+	t->pin_scl = (uint8_t)scl;
+	t->pin_sda = (uint8_t)sda;
+	avr_irq_register_notify(irq + IOPORT_IRQ_REG_PORT, twi_on_port, t);
+	avr_irq_register_notify(irq + IOPORT_IRQ_DIRECTION_ALL, twi_on_ddr, t);
+	return 0;
+}
+
 /* TWINT was cleared with TWEN set: start what TWSTA/TWSTO and the state
  * ask for. */
 static void twi_action(twi_t *t, uint8_t cr)
@@ -388,6 +447,11 @@ static void twi_write_twcr(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *para
 
 	if (!(v & BIT(TWCR_TWEN))) {
 		/* TWI off: transfers end, the lines are released. */
+		if (t->op != TWI_OP_NONE || t->owner) {
+			trace_event(t->bus->trace, avr->cycle, "twi off");
+		} else if (t->addressed) {
+			trace_event(t->bus->trace, avr->cycle, "twi off %02X", t->sl_addr);
+		}
 		avr_cycle_timer_cancel(avr, twi_timer, t);
 		twi_bus_cancel(t->bus, &t->master);
 		twi_slave_abandon(t);
@@ -401,6 +465,9 @@ static void twi_write_twcr(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *para
 		twi_action(t, cr);
 	}
 	twi_sync(t);
+	if (!(old & BIT(TWCR_TWEN)) != !(v & BIT(TWCR_TWEN))) {
+		twi_pins_update(t);
+	}
 }
 
 static void twi_write_twdr(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *param)
@@ -464,6 +531,9 @@ static void twi_reset(avr_io_t *io)
 	avr->data[t->regs->twdr] = 0xff;
 	avr->data[t->regs->twcr] = 0;
 	twi_sync(t);
+	/* avr_reset cleared the ports without telling their IRQs */
+	t->pin_ddr = t->pin_port = 0;
+	twi_pins_update(t);
 }
 
 void twi_init(twi_t *t, avr_t *avr, const mcu_twi_regs_t *regs, twi_bus_t *bus)
@@ -478,6 +548,7 @@ void twi_init(twi_t *t, avr_t *avr, const mcu_twi_regs_t *regs, twi_bus_t *bus)
 	t->dev.ops = &twi_dev_ops;
 	t->dev.name = "avr-twi";
 	twi_bus_attach(bus, &t->dev);
+	twi_bus_attach_pins(bus, &t->pins);
 
 	t->vect_twi = (avr_int_vector_t) {
 		.vector = regs->vect_twi,

@@ -17,6 +17,11 @@
  * repeated START); while it is set the slave holds SCL low (twi_bus_hold)
  * and the master's next operation waits until the firmware clears TWINT,
  * then takes its normal time from that release (clock stretching).
+ *
+ * Lines (twi_bus.h): with TWEN off the board's SCL/SDA port pins drive the
+ * bus's wired-AND lines (twi_wire_pins). A START waits while SDA is low; an
+ * operation waits while SCL is held low, and one under way when SCL is
+ * held ends one period after the release.
  */
 #ifndef SIM_TWI_H
 #define SIM_TWI_H
@@ -68,6 +73,12 @@ typedef struct twi_t {
 	uint8_t sl_data;
 	avr_cycle_count_t sl_at;	/* ... at this cycle */
 	uint8_t sl_addr;		/* TWAR address it answered (trace) */
+
+	/* SCL/SDA as port pins while TWEN is off (twi_wire_pins) */
+	twi_pins_t pins;
+	int pins_wired;
+	uint8_t pin_scl, pin_sda;	/* bit numbers */
+	uint8_t pin_ddr, pin_port;	/* shadows of the port's DDR/PORT */
 } twi_t;
 
 #define TWI_SLAVE_RX 1
@@ -75,6 +86,12 @@ typedef struct twi_t {
 
 /* Take over the TWI described by REGS on AVR (after avr_init). */
 void twi_init(twi_t *t, avr_t *avr, const mcu_twi_regs_t *regs, twi_bus_t *bus);
+
+/* The TWI's lines are pins SCL and SDA of port PORT ('C'): while TWEN is
+ * off the firmware drives them as port pins (DDR 1 and PORT 0 pulls the
+ * line low; anything else releases it to the external pull-ups), and the
+ * bus's wired-AND lines hear it. 0, or -1 when the port is not found. */
+int twi_wire_pins(twi_t *t, char port, int scl, int sda);
 
 /* One SCL period in cycles with the current TWBR and TWPS. */
 avr_cycle_count_t twi_scl_period(const twi_t *t);

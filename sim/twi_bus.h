@@ -67,6 +67,18 @@ typedef struct twi_bus_master_t {
 	void (*resume)(struct twi_bus_master_t *m, uint64_t cycle);
 } twi_bus_master_t;
 
+/* A board's port-pin drivers of the lines (its TWI off, the firmware
+ * driving SDA/SCL as port pins): set through twi_bus_pins only. */
+typedef struct twi_pins_t {
+	struct twi_pins_t *next;
+	int sda_low, scl_low;
+} twi_pins_t;
+
+/* Told when a line's level changes (a board model's pin signals). */
+typedef void (*twi_line_fn)(void *param, uint64_t cycle);
+
+#define TWI_BUS_LISTENERS 16
+
 typedef struct twi_bus_t {
 	twi_dev_t *devs;
 	twi_dev_t *selected;	/* device that acknowledged the address */
@@ -82,6 +94,16 @@ typedef struct twi_bus_t {
 	uint64_t released_all;		/* last release of a TWI_HOLD_ALL */
 	uint64_t released_addr;		/* last release of a TWI_HOLD_ADDR */
 	uint8_t released_all_by, released_addr_by;	/* their slaves' addresses */
+
+	/* SDA and SCL as wired-AND lines (1 = released, the pull-ups) */
+	int sda, scl;
+	int scl_ext;		/* SCL without the TWIs' clock stretching (traced) */
+	uint32_t stuck;		/* SCL pulses the stuck device still waits for (0: off) */
+	int hold_scl;		/* a device holds SCL low */
+	twi_pins_t *pins;
+	twi_line_fn listener[TWI_BUS_LISTENERS];
+	void *listener_param[TWI_BUS_LISTENERS];
+	int nlisteners;
 } twi_bus_t;
 
 void twi_bus_init(twi_bus_t *bus, trace_t *trace);
@@ -108,5 +130,35 @@ void twi_bus_hold(twi_bus_t *bus, twi_dev_t *dev, twi_hold_t how);
 /* DEV (answering at ADDR8, for the trace) lets SCL go at CYCLE. A master
  * that waited on it gets a `twi stretch ADDR8 CYCLES` trace line. */
 void twi_bus_release(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle, uint8_t addr8);
+
+/* --- the lines ------------------------------------------------------------
+ *
+ * SDA and SCL are wired-AND: a line is high (pull-ups) unless something
+ * pulls it low: a board's firmware driving the pin as a port pin while its
+ * TWI is off (twi_pins_t), a board's TWI holding SCL after an acknowledge
+ * (TWI_HOLD_ALL), the stuck device (SDA) or the SCL-holding device.
+ * While SCL is held low by a device or a pin, every master operation waits
+ * (the TWI's SCL never rises: TWINT never sets); while SDA is low, a START
+ * waits for the bus to be free (the TWI waits for a STOP; the release of
+ * SDA with SCL high is one). */
+
+/* Attach a board's pin drivers (both released). */
+void twi_bus_attach_pins(twi_bus_t *bus, twi_pins_t *pins);
+
+/* The pins' drivers changed at CYCLE. */
+void twi_bus_pins(twi_bus_t *bus, twi_pins_t *pins, int sda_low, int scl_low, uint64_t cycle);
+
+/* Call FN(PARAM, cycle) whenever a line changes level. 0, -1 when full. */
+int twi_bus_listen(twi_bus_t *bus, twi_line_fn fn, void *param);
+
+/* The stuck device holds SDA low until it has seen PULSES more SCL pulses
+ * (falling edges); 0 lets SDA go at once. */
+void twi_bus_stuck(twi_bus_t *bus, uint32_t pulses, uint64_t cycle);
+
+/* The SCL-holding device holds SCL low (ON) or lets it go. */
+void twi_bus_hold_scl(twi_bus_t *bus, int on, uint64_t cycle);
+
+/* Recompute the lines at CYCLE (after any driver changed). */
+void twi_bus_lines(twi_bus_t *bus, uint64_t cycle);
 
 #endif

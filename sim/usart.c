@@ -39,6 +39,17 @@ avr_cycle_count_t usart_byte_cycles(const usart_t *u)
 	return (avr_cycle_count_t)bits * per_bit * (u->ubrr + 1u);
 }
 
+uint32_t usart_board_bit(const usart_t *u)
+{
+	return ((u->ucsra & BIT(UCSRA_U2X)) ? 8u : 16u) * (u->ubrr + 1u);
+}
+
+/* The PC sends 8N1 at its own rate. */
+static avr_cycle_count_t usart_host_byte_cycles(const usart_t *u)
+{
+	return 10ull * u->host_bit;
+}
+
 static uint8_t usart_ucsra(const usart_t *u)
 {
 	uint8_t v = u->ucsra & (BIT(UCSRA_TXC) | BIT(UCSRA_UDRE) |
@@ -48,6 +59,9 @@ static uint8_t usart_ucsra(const usart_t *u)
 		v |= BIT(UCSRA_RXC);
 		if (u->rx_fifo[0].dor) {
 			v |= BIT(UCSRA_DOR);
+		}
+		if (u->rx_fifo[0].fe) {
+			v |= BIT(UCSRA_FE);
 		}
 	}
 	return v;
@@ -92,22 +106,110 @@ static void usart_rx_flush(usart_t *u)
 	u->rx_dor = 0;
 }
 
-static void usart_rx_deliver(usart_t *u, uint8_t byte)
+static void usart_rx_deliver(usart_t *u, uint8_t byte, int fe)
 {
 	if (u->rx_fifo_len < 2) {
 		u->rx_fifo[u->rx_fifo_len].data = byte;
 		u->rx_fifo[u->rx_fifo_len].dor = 0;
+		u->rx_fifo[u->rx_fifo_len].fe = (uint8_t)fe;
 		u->rx_fifo_len++;
 	} else if (!u->rx_shift_full) {
 		u->rx_shift_full = 1;
 		u->rx_shift_byte = byte;
+		u->rx_shift_fe = (uint8_t)fe;
 	} else {
 		/* Overrun: the frame waiting in the shifter is overwritten.
 		 * The next frame to enter the FIFO carries DOR ("frames lost
 		 * between the last frame read and the next one"). */
 		u->rx_shift_byte = byte;
+		u->rx_shift_fe = (uint8_t)fe;
 		u->rx_dor = 1;
 	}
+}
+
+/* --- the PC's waveform: RXD pin and the board's receiver when rates differ */
+
+static avr_cycle_count_t usart_pin_timer(avr_t *avr, avr_cycle_count_t when,
+					 void *param)
+{
+	usart_t *u = param;
+	int level = uart_frame_bit(u->pin_byte, u->pin_k);
+
+	(void)avr;
+	(void)when;
+	if (level != u->pin_level) {
+		u->pin_level = level;
+		u->pin(u->pin_param, level);
+	}
+	while (++u->pin_k <= 9) {
+		if (uart_frame_bit(u->pin_byte, u->pin_k) != level) {
+			return u->pin_start + (avr_cycle_count_t)u->pin_k * u->pin_bit;
+		}
+	}
+	return 0;
+}
+
+/* Draw a frame on RXD from its start bit, which begins now. */
+static void usart_pin_frame(usart_t *u, uint8_t byte, avr_cycle_count_t start)
+{
+	avr_cycle_count_t next;
+
+	if (!u->pin) {
+		return;
+	}
+	avr_cycle_timer_cancel(u->avr, usart_pin_timer, u);
+	u->pin_start = start;
+	u->pin_bit = u->host_bit;
+	u->pin_byte = byte;
+	u->pin_k = 0;
+	next = usart_pin_timer(u->avr, start, u);
+	if (next) {
+		avr_cycle_timer_register(u->avr, next - u->avr->cycle, usart_pin_timer, u);
+	}
+}
+
+static void usart_rx_dec_emit(void *param, avr_cycle_count_t when,
+			      avr_cycle_count_t t0, uint8_t byte, int fe)
+{
+	usart_t *u = param;
+
+	if ((usart_ucsrb(u) & BIT(UCSRB_RXEN)) && t0 >= u->rxen_since) {
+		trace_event(u->trace, when, fe ? "uart rx %02X fe" : "uart rx %02X", byte);
+		usart_rx_deliver(u, byte, fe);
+		usart_sync(u);
+	}
+	u->activity++;
+}
+
+static avr_cycle_count_t usart_rx_dec_timer(avr_t *avr, avr_cycle_count_t when,
+					    void *param);
+
+/* Run the board's receiver over the line up to now and plan its next run. */
+static void usart_rx_dec_kick(usart_t *u)
+{
+	avr_t *avr = u->avr;
+	avr_cycle_count_t next = uart_dec_run(&u->rx_dec, &u->rx_line, usart_board_bit(u),
+					      avr->cycle, usart_rx_dec_emit, u);
+
+	if (u->rx_dec_armed) {
+		avr_cycle_timer_cancel(avr, usart_rx_dec_timer, u);
+	}
+	u->rx_dec_armed = next != 0;
+	if (next) {
+		avr_cycle_timer_register(avr, next - avr->cycle, usart_rx_dec_timer, u);
+	}
+}
+
+static avr_cycle_count_t usart_rx_dec_timer(avr_t *avr, avr_cycle_count_t when,
+					    void *param)
+{
+	usart_t *u = param;
+	avr_cycle_count_t next = uart_dec_run(&u->rx_dec, &u->rx_line, usart_board_bit(u),
+					      when, usart_rx_dec_emit, u);
+
+	(void)avr;
+	u->rx_dec_armed = next != 0;
+	return next;
 }
 
 /*
@@ -116,12 +218,29 @@ static void usart_rx_deliver(usart_t *u, uint8_t byte)
  * A scheduled byte owns the wire from its start; a host byte goes on the
  * idle wire only if it ends by the next scheduled start, else it waits.
  */
-static void usart_rx_begin(usart_t *u, uint8_t byte, avr_cycle_count_t end)
+static void usart_rx_begin(usart_t *u, uint8_t byte, avr_cycle_count_t start,
+			   avr_cycle_count_t end)
 {
 	u->rx_wire_byte = byte;
 	u->rx_wire_busy = 1;
 	u->rx_wire_end = end;
 	u->rx_wire_valid = !!(usart_ucsrb(u) & BIT(UCSRB_RXEN));
+	/* Fast path: the rates agree and the receiver is not inside a frame
+	 * of its own, so it takes this byte whole at the end of its stop bit
+	 * (exactly as before the line had rates). Otherwise the receiver
+	 * decodes the waveform. */
+	if (u->rx_dec_armed) {
+		usart_rx_dec_kick(u);
+	}
+	u->rx_wire_fast = usart_board_bit(u) == u->host_bit && !u->rx_dec.busy;
+	if (u->rx_wire_fast) {
+		uart_dec_skip_to(&u->rx_dec, end);
+	}
+	uart_line_push(&u->rx_line, start, u->host_bit, byte, u->rx_wire_fast);
+	usart_pin_frame(u, byte, start);
+	if (!u->rx_wire_fast) {
+		usart_rx_dec_kick(u);
+	}
 }
 
 /* Put the next byte on the idle wire at NOW. Returns the cycle the wire
@@ -130,11 +249,11 @@ static void usart_rx_begin(usart_t *u, uint8_t byte, avr_cycle_count_t end)
 static avr_cycle_count_t usart_rx_next(usart_t *u, avr_cycle_count_t now)
 {
 	const usart_inject_t *inj = u->inj_len ? &u->inj_q[u->inj_head] : NULL;
-	avr_cycle_count_t bt = usart_byte_cycles(u);
+	avr_cycle_count_t bt = usart_host_byte_cycles(u);
 
 	u->rx_wire_busy = 0;
 	if (inj && inj->start <= now) {
-		usart_rx_begin(u, inj->byte, inj->start + inj->cycles);
+		usart_rx_begin(u, inj->byte, inj->start, inj->start + inj->cycles);
 		u->inj_head = (u->inj_head + 1) % USART_INJECT_QUEUE;
 		u->inj_len--;
 		return u->rx_wire_end;
@@ -144,7 +263,7 @@ static avr_cycle_count_t usart_rx_next(usart_t *u, avr_cycle_count_t now)
 
 		u->host_head = (u->host_head + 1) % USART_HOST_QUEUE;
 		u->host_len--;
-		usart_rx_begin(u, byte, now + bt);
+		usart_rx_begin(u, byte, now, now + bt);
 		return u->rx_wire_end;
 	}
 	return inj ? inj->start : 0;
@@ -158,9 +277,10 @@ static avr_cycle_count_t usart_rx_timer(avr_t *avr, avr_cycle_count_t when,
 
 	(void)avr;
 	if (u->rx_wire_busy) {
-		if (u->rx_wire_valid && (usart_ucsrb(u) & BIT(UCSRB_RXEN))) {
+		if (u->rx_wire_fast && u->rx_wire_valid &&
+		    (usart_ucsrb(u) & BIT(UCSRB_RXEN))) {
 			trace_event(u->trace, when, "uart rx %02X", u->rx_wire_byte);
-			usart_rx_deliver(u, u->rx_wire_byte);
+			usart_rx_deliver(u, u->rx_wire_byte, 0);
 			usart_sync(u);
 		}
 		u->activity++;
@@ -229,7 +349,7 @@ size_t usart_inject_pending(const usart_t *u)
 avr_cycle_count_t usart_inject(usart_t *u, avr_cycle_count_t start,
 			       const uint8_t *buf, size_t n)
 {
-	uint32_t bt = (uint32_t)usart_byte_cycles(u);
+	uint32_t bt = (uint32_t)usart_host_byte_cycles(u);
 
 	if (n == 0 || n > usart_inject_room(u) || start < usart_inject_free_at(u)) {
 		return 0;
@@ -249,6 +369,47 @@ avr_cycle_count_t usart_inject(usart_t *u, avr_cycle_count_t start,
 
 /* --- transmitter --------------------------------------------------------- */
 
+static void usart_pc_emit(void *param, avr_cycle_count_t when,
+			  avr_cycle_count_t t0, uint8_t byte, int fe)
+{
+	usart_t *u = param;
+
+	(void)when;
+	(void)t0;
+	/* Linux hands the reader a character with a framing error as 0x00
+	 * (IGNPAR and PARMRK off, as pyserial leaves them). */
+	if (u->to_host) {
+		u->to_host(u->to_host_param, fe ? 0 : byte);
+	}
+}
+
+static avr_cycle_count_t usart_pc_dec_timer(avr_t *avr, avr_cycle_count_t when,
+					    void *param)
+{
+	usart_t *u = param;
+	avr_cycle_count_t next = uart_dec_run(&u->pc_dec, &u->tx_line, u->host_bit,
+					      when, usart_pc_emit, u);
+
+	(void)avr;
+	u->pc_dec_armed = next != 0;
+	return next;
+}
+
+static void usart_pc_dec_kick(usart_t *u)
+{
+	avr_t *avr = u->avr;
+	avr_cycle_count_t next = uart_dec_run(&u->pc_dec, &u->tx_line, u->host_bit,
+					      avr->cycle, usart_pc_emit, u);
+
+	if (u->pc_dec_armed) {
+		avr_cycle_timer_cancel(avr, usart_pc_dec_timer, u);
+	}
+	u->pc_dec_armed = next != 0;
+	if (next) {
+		avr_cycle_timer_register(avr, next - avr->cycle, usart_pc_dec_timer, u);
+	}
+}
+
 /* Move the buffer into the idle shifter: the start bit begins at WHEN. */
 static int usart_tx_load(usart_t *u, avr_cycle_count_t when)
 {
@@ -260,6 +421,18 @@ static int usart_tx_load(usart_t *u, avr_cycle_count_t when)
 	u->tx_buf_full = 0;
 	u->ucsra |= BIT(UCSRA_UDRE);
 	trace_event(u->trace, when, "uart tx %02X", u->tx_shift_byte);
+	/* As on the receive side: equal rates hand the PC the byte whole. */
+	if (u->pc_dec_armed) {
+		usart_pc_dec_kick(u);
+	}
+	u->tx_fast = usart_board_bit(u) == u->host_bit && !u->pc_dec.busy;
+	if (u->tx_fast) {
+		uart_dec_skip_to(&u->pc_dec, when + usart_byte_cycles(u));
+	}
+	uart_line_push(&u->tx_line, when, usart_board_bit(u), u->tx_shift_byte, u->tx_fast);
+	if (!u->tx_fast) {
+		usart_pc_dec_kick(u);
+	}
 	return 1;
 }
 
@@ -271,7 +444,7 @@ static avr_cycle_count_t usart_tx_timer(avr_t *avr, avr_cycle_count_t when,
 	(void)avr;
 	u->tx_shift_busy = 0;
 	u->activity++;
-	if (u->to_host) {
+	if (u->tx_fast && u->to_host) {
 		u->to_host(u->to_host_param, u->tx_shift_byte);
 	}
 	/* A byte already in the buffer goes out even if TXEN was cleared
@@ -303,10 +476,12 @@ static uint8_t usart_read_udr(avr_t *avr, avr_io_addr_t addr, void *param)
 	(void)addr;
 	if (u->rx_fifo_len) {
 		u->rx_last = u->rx_fifo[0].data;
+		u->fe_read += u->rx_fifo[0].fe;
 		u->rx_fifo[0] = u->rx_fifo[1];
 		u->rx_fifo_len--;
 		if (u->rx_shift_full) {
 			u->rx_fifo[u->rx_fifo_len].data = u->rx_shift_byte;
+			u->rx_fifo[u->rx_fifo_len].fe = u->rx_shift_fe;
 			u->rx_fifo[u->rx_fifo_len].dor = (uint8_t)u->rx_dor;
 			u->rx_fifo_len++;
 			u->rx_shift_full = 0;
@@ -366,6 +541,13 @@ static void usart_write_ucsrb(avr_t *avr, avr_io_addr_t addr, uint8_t v,
 	avr->data[addr] = v;
 	if ((old & BIT(UCSRB_RXEN)) && !(v & BIT(UCSRB_RXEN))) {
 		usart_rx_flush(u);
+	}
+	if (!(old & BIT(UCSRB_RXEN)) && (v & BIT(UCSRB_RXEN))) {
+		/* The receiver starts looking for a start bit from now on. */
+		u->rxen_since = avr->cycle;
+		uart_dec_skip_to(&u->rx_dec, avr->cycle);
+		trace_event(u->trace, avr->cycle, "line rxen %u%s", (unsigned)u->ubrr,
+			    (u->ucsra & BIT(UCSRA_U2X)) ? " u2x" : "");
 	}
 	if (v & BIT(UCSRB_TXEN)) {
 		usart_tx_kick(u);
@@ -476,6 +658,16 @@ static void usart_reset(avr_io_t *io)
 	u->rx_wire_busy = 0;
 	avr_cycle_timer_cancel(avr, usart_rx_timer, u);
 	u->rx_timer_armed = 0;
+	u->rx_dec_armed = 0;
+	u->pc_dec_armed = 0;
+	memset(&u->rx_dec, 0, sizeof(u->rx_dec));
+	memset(&u->pc_dec, 0, sizeof(u->pc_dec));
+	u->rx_dec.cursor = u->pc_dec.cursor = avr->cycle;
+	u->rxen_since = avr->cycle;
+	if (u->pin && u->pin_level == 0) {
+		u->pin_level = 1;	/* the frame being drawn is cut off */
+		u->pin(u->pin_param, 1);
+	}
 	u->tx_buf_full = 0;
 	u->tx_shift_busy = 0;
 	avr->data[r->ucsrb] = 0;
@@ -498,6 +690,9 @@ void usart_init(usart_t *u, avr_t *avr, const mcu_usart_regs_t *regs,
 	u->to_host = to_host;
 	u->to_host_param = param;
 	u->io.kind = "orfa-usart";
+	u->pin_level = 1;
+	u->host_baud = 115200;
+	u->host_bit = 64;
 	u->io.reset = usart_reset;
 
 	u->vect_rxc = (avr_int_vector_t) {
@@ -541,4 +736,26 @@ void usart_init(usart_t *u, avr_t *avr, const mcu_usart_regs_t *regs,
 
 	mcu_register_io_last(avr, &u->io);
 	usart_reset(&u->io);
+}
+
+void usart_set_host_baud(usart_t *u, uint32_t baud)
+{
+	uint32_t f = u->avr->frequency ? u->avr->frequency : 7372800u;
+
+	if (baud == 0 || baud == u->host_baud) {
+		return;
+	}
+	u->host_baud = baud;
+	u->host_bit = (f + baud / 2) / baud;
+	if (u->host_bit == 0) {
+		u->host_bit = 1;
+	}
+}
+
+void usart_set_pin(usart_t *u, usart_pin_t pin, void *param)
+{
+	u->pin = pin;
+	u->pin_param = param;
+	u->pin_level = 1;
+	pin(param, 1);
 }

@@ -27,6 +27,7 @@
 
 #include "mcu.h"
 #include "trace.h"
+#include "uart_line.h"
 
 /* Bytes from the host waiting for the wire; the pty is read only while
  * there is room, so a fast host is slowed by the kernel's pty buffer. */
@@ -36,6 +37,9 @@
 #define USART_INJECT_QUEUE 32768
 
 typedef void (*usart_to_host_t)(void *param, uint8_t byte);
+
+/* Drives the RXD pin: LEVEL 0 or 1. */
+typedef void (*usart_pin_t)(void *param, int level);
 
 /* One scheduled byte: its start bit begins at START, it takes CYCLES. */
 typedef struct usart_inject_t {
@@ -47,6 +51,7 @@ typedef struct usart_inject_t {
 typedef struct usart_rx_slot_t {
 	uint8_t data;
 	uint8_t dor;
+	uint8_t fe;
 } usart_rx_slot_t;
 
 typedef struct usart_t {
@@ -76,12 +81,36 @@ typedef struct usart_t {
 	avr_cycle_count_t rx_wire_end;	/* ... until the end of its stop bit */
 	uint8_t rx_wire_byte;
 	int rx_wire_valid;		/* the receiver was on at its start bit */
+	int rx_wire_fast;		/* rates agree: the byte arrives whole */
 	usart_rx_slot_t rx_fifo[2];
 	uint8_t rx_fifo_len;
 	int rx_shift_full;		/* complete frame waiting in the shifter */
 	uint8_t rx_shift_byte;
+	uint8_t rx_shift_fe;
 	int rx_dor;			/* a frame was lost: DOR for the shifter's frame */
 	uint8_t rx_last;
+	uint32_t fe_read;		/* frames with FE the firmware took from UDR */
+
+	/* The PC's side of the line: its rate (the pty's termios), the
+	 * waveform of both directions and the receivers at either end that
+	 * decode it when the two rates differ (uart_line.h). */
+	uint32_t host_baud;
+	uint32_t host_bit;		/* cycles per bit at host_baud */
+	uart_line_t rx_line;		/* PC -> board */
+	uart_dec_t rx_dec;		/* the board's receiver */
+	int rx_dec_armed;
+	avr_cycle_count_t rxen_since;	/* RXEN last turned on */
+	uart_line_t tx_line;		/* board -> PC */
+	uart_dec_t pc_dec;		/* the PC's receiver */
+	int pc_dec_armed;
+	int tx_fast;			/* the byte in the shifter reaches the PC whole */
+	usart_pin_t pin;		/* drives RXD with the PC's waveform */
+	void *pin_param;
+	int pin_level;
+	avr_cycle_count_t pin_start;	/* the frame being drawn on RXD */
+	uint32_t pin_bit;
+	uint8_t pin_byte;
+	int pin_k;
 
 	/* transmitter */
 	int tx_buf_full;
@@ -119,6 +148,16 @@ size_t usart_inject_pending(const usart_t *u);
  * 0 when START or N break those rules (nothing is scheduled then). */
 avr_cycle_count_t usart_inject(usart_t *u, avr_cycle_count_t start,
 			       const uint8_t *buf, size_t n);
+
+/* The PC's rate (baud), as its port's termios say; the line follows a
+ * change from the next bit the PC sends. 0 is ignored. */
+void usart_set_host_baud(usart_t *u, uint32_t baud);
+
+/* Draw the PC's waveform on RXD through PIN (idle high from now on). */
+void usart_set_pin(usart_t *u, usart_pin_t pin, void *param);
+
+/* The board's bit time from UBRR/U2X, in cycles. */
+uint32_t usart_board_bit(const usart_t *u);
 
 /* Cycles one frame takes with the current UBRR/U2X/UCSRC settings. */
 avr_cycle_count_t usart_byte_cycles(const usart_t *u);

@@ -584,6 +584,123 @@ def print_watchdog(boards, width):
     print("request the board heard (the gateway: its line's end; a slave: its address on")
     print("the bus) to the pin's last edge (a servo ends the 20 ms frame it is in).")
 
+# --- end of watchdog and failsafe -------------------------------------------
+
+
+# --- autobaud (issue 8) -------------------------------------------------------
+# Kept in one block, called once from main(), so it merges apart from the rest.
+
+def autobaud_elf(board):
+    """The BAUD=auto gateway of `board`, built into build/bench-auto/."""
+    out = "build/bench-auto/%s-gate" % board
+    subprocess.run(["make", "--no-print-directory", "-s", "BOARD=" + board, "MODE=gate",
+                    "BAUD=auto", "BUILD=" + out], cwd=ROOT, check=True)
+    return ROOT / out / "orfa.elf"
+
+
+def autobaud_detection(board, rate, elf):
+    """Cycles from the first falling edge of the preamble (eight 0x0D put
+    on the line with `rx` at cycle START, at `rate`) to the firmware's
+    receiver being on at the detected rate (RXEN set, the simulator's
+    `line rxen` moment), and whether that rate is `rate`. A fresh simulator:
+    the same cycles every run."""
+    from orfa.protocol import AUTOBAUD_PREAMBLE
+    with SimBoard(board, firmware=elf, trace=False, control=True) as sim, \
+            serial.Serial(sim.port, rate):
+        ctl = sim.control
+        ctl.wait(1000)                       # the simulator reads the port's rate
+        end = ctl.rx(START, AUTOBAUD_PREAMBLE)
+        line = ctl.line()
+        while not line["rxen"] and line.get("bit") and ctl.time() < end + F_CPU // 10:
+            ctl.wait(F_CPU // 1000)
+            line = ctl.line()
+        if not line["rxen"]:
+            return None, False
+        return line["since"] - START, line["board"] == F_CPU // rate
+
+
+def bench_autobaud(boards):
+    """Detection time per rate and board (docs/protocol.md, Autobaud)."""
+    from orfa.protocol import BAUD_RATES
+    elfs = {b: autobaud_elf(b) for b in boards}
+    res = {(b, r): autobaud_detection(b, r, elfs[b]) for b in boards for r in BAUD_RATES}
+    width = 38
+    print()
+    print("Autobaud (BAUD=auto): cycles from the preamble's first falling edge to the")
+    print("receiver on at the detected rate (80 bit times of preamble, the quiet of")
+    print("49152 cycles that ends it, the analysis)")
+    print()
+    print("%-*s" % (width, "rate") + "".join("%14s" % b for b in boards) + "%14s" % "preamble")
+    for r in BAUD_RATES:
+        cells = []
+        for b in boards:
+            cyc, right = res[(b, r)]
+            cells.append("%14s" % ("missed" if cyc is None else
+                                   ("%d" % cyc) + ("" if right else " WRONG")))
+        print("%-*s" % (width, "%d baud" % r) + "".join(cells) + "%14d" % (80 * F_CPU // r))
+    print("%-*s" % (width, "flash / static RAM (B)") + "".join(
+        "%14s" % ("%d/%d" % footprint_of(elfs[b])) for b in boards))
+    return all(c is not None and ok for c, ok in res.values())
+
+# --- end autobaud ----------------------------------------------------------------
+
+
+# --- Bus faults (issue 8): ERROR latency with a stuck or missing device ------
+#
+# The requests are scheduled with `rx` at fixed cycles; each fault is set
+# through the control socket half a gap before its request (a `wait` and the
+# `i2c` requests sent together act at the wait's cycle, give or take the
+# control socket's round trip, far less than half a gap), so the figures
+# repeat exactly.
+
+BUS_FAULTS = [
+    # (row, control requests that set the fault, request, its reply)
+    ("stuck SDA", ["i2c stuck 5"], "S A0 70 S A1 01 P\r", b"ERROR 06\r\n"),
+    ("held SCL", ["i2c stuck 0", "i2c hold-scl on"], "S A0 70 S A1 01 P\r",
+     b"ERROR 06\r\n"),
+    ("missing device", ["i2c hold-scl off"], "S 42 P\r", b"ERROR 06\r\n"),
+]
+#: Between two fault requests: far longer than an ERROR takes (10 ms).
+BUS_FAULT_GAP = 1 << 19
+
+
+def bench_bus_faults(board):
+    """{row: cycles from the request's last byte to its ERROR's first byte}."""
+    with SimBoard(board, eeproms=(0xA0,), control=True) as sim:
+        ctl = sim.control
+        sched = Schedule(ctl, START)
+        windows = [sched.send(req.encode(), gap=BUS_FAULT_GAP) for _, _, req, _ in BUS_FAULTS]
+        lines, at = [], ctl.time()
+        for (_, faults, _, _), (start, _) in zip(BUS_FAULTS, windows):
+            lines += ["wait %d" % (start - BUS_FAULT_GAP // 2 - at)] + faults
+            at = start - BUS_FAULT_GAP // 2
+        if int(lines[0].split()[1]) <= 0:
+            raise SystemExit("bench: the %s simulator passed the fault schedule" % board)
+        with serial.Serial(sim.port, 115200, timeout=30) as port:
+            ctl.requests(lines)        # returns when the last fault is set
+            replies = read_replies(port, len(BUS_FAULTS))
+        events = parse_trace(sim.trace_text())
+    rows = {}
+    for (name, _, _, want), window, reply in zip(BUS_FAULTS, windows, replies):
+        if reply != want:
+            raise SystemExit("bench: %s on %s answered %r" % (name, board, reply))
+        rows[name] = latency(events, window, reply)[0]
+    return rows
+
+
+def print_bus_faults(boards, width=38):
+    results = {b: bench_bus_faults(b) for b in boards}
+    print()
+    print("Bus faults: request end to ERROR (cycles, ms); target < 10 ms")
+    print()
+    for name, _, _, _ in BUS_FAULTS:
+        print("%-*s" % (width, "ERROR latency, %s" % name) + "".join(
+            "%14s" % ("%d %.2f" % (results[b][name], results[b][name] * 1e3 / F_CPU))
+            for b in boards) + "%10s" % "< 73728")
+    return all(results[b][n] < F_CPU // 100 for b in boards for n, _, _, _ in BUS_FAULTS)
+
+# --- end of bus faults ----------------------------------------------------------
+
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -702,6 +819,8 @@ def main():
     print("reply's first; wire time counts SCL periods (a byte and its ACK: 9). The write's")
     print("stretch is how long the slave held SCL before the read right after the write.")
     ok = ok and all(slaves[b]["pipeline"][0] == SLAVE_PIPELINE for b in args.boards)
+    ok = bench_autobaud(args.boards) and ok
+    ok = print_bus_faults(args.boards) and ok
     print_watchdog(args.boards, width)
     return 0 if ok else 1
 

@@ -63,7 +63,8 @@ def slave_spec(text: str):
 def cmd_sim(args) -> int:
     try:
         board = SimBoard(args.board, eeproms=args.eeprom, trace=False,
-                         firmware=args.firmware, slaves=args.slave).start()
+                         firmware=args.firmware, slaves=args.slave,
+                         control=args.autobaud).start()
     except (SimError, ValueError) as exc:
         print("orfa: %s" % exc, file=sys.stderr)
         return 2
@@ -72,7 +73,7 @@ def cmd_sim(args) -> int:
     try:
         print(board.port, flush=True)
         if args.terminal:
-            with Gateway(board.port) as gw:
+            with board.gateway(args.baud, autobaud=args.autobaud) as gw:
                 return terminal(gw, sys.stdin, sys.stdout)
         while board.running:
             time.sleep(0.2)
@@ -89,7 +90,8 @@ def _raise_interrupt():
 
 
 def cmd_request(args) -> int:
-    with Gateway(args.port, baudrate=args.baud, timeout=args.timeout) as gw:
+    with Gateway(args.port, baudrate=args.baud, timeout=args.timeout,
+                 autobaud=args.autobaud) as gw:
         for line in args.requests:
             try:
                 reply = gw.request(line)
@@ -116,11 +118,18 @@ def build_parser() -> argparse.ArgumentParser:
                      help="a slave board on the bus (repeatable); ELF defaults to"
                           " build/robot/<board>-<ADDR>/orfa.elf (make robot) if"
                           " built, else build/<board>-slave/orfa.elf")
+    sim.add_argument("--baud", type=int, default=p.DEFAULT_BAUD,
+                     help="the console's rate (default %(default)s)")
+    sim.add_argument("--autobaud", action="store_true",
+                     help="the console opens with the BAUD=auto preamble (eight CRs,"
+                          " 20 ms of simulated quiet)")
     sim.set_defaults(func=cmd_sim)
 
     req = sub.add_parser("request", help="send requests, print the replies")
     req.add_argument("--port", required=True, help="serial port or pyserial URL")
-    req.add_argument("--baud", type=int, default=115200)
+    req.add_argument("--baud", type=int, default=p.DEFAULT_BAUD)
+    req.add_argument("--autobaud", action="store_true",
+                     help="send the BAUD=auto preamble first (eight CRs, then 20 ms quiet)")
     req.add_argument("--timeout", type=float, default=2.0)
     req.add_argument("requests", nargs="+", metavar="REQUEST")
     req.set_defaults(func=cmd_request)

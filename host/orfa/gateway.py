@@ -7,7 +7,7 @@ pseudo-terminal path (the simulator's link) and a real port are the same.
 from __future__ import annotations
 
 import time
-from typing import Dict, FrozenSet, Iterable, List, Optional, Sequence
+from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Sequence
 
 import serial
 
@@ -16,14 +16,30 @@ from . import protocol as p
 
 
 class Gateway:
-    """An ORFA gateway on one serial port; a context manager."""
+    """An ORFA gateway on one serial port; a context manager.
 
-    def __init__(self, url: str, baudrate: int = 115200, timeout: float = 2.0,
-                 local_address: int = p.DEFAULT_LOCAL_ADDRESS):
+    autobaud=True sends the preamble of a BAUD=auto firmware (eight CRs, then
+    quiet) right after opening; see preamble().
+    """
+
+    def __init__(self, url: str, baudrate: int = p.DEFAULT_BAUD, timeout: float = 2.0,
+                 local_address: int = p.DEFAULT_LOCAL_ADDRESS, autobaud: bool = False,
+                 wait: Optional[Callable[[float], None]] = None):
         self.timeout = timeout
         self.local = local_address
         self.serial = serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
         self._sys_reg: Dict[int, int] = {}
+        if autobaud:
+            self.preamble(wait)
+
+    def preamble(self, wait: Optional[Callable[[float], None]] = None) -> None:
+        """Send the autobaud preamble at the port's rate, then stay quiet
+        until the firmware listens (SPEC section 2). `wait(seconds)` passes
+        that time: a simulator's simulated clock (SimBoard.wait_s); by
+        default time.sleep, for a real board. Empty lines to a firmware of
+        a fixed rate (no reply)."""
+        self.send(p.AUTOBAUD_PREAMBLE)
+        (wait or time.sleep)(p.autobaud_wait_s(self.serial.baudrate))
 
     # --- lifetime -----------------------------------------------------------
     def close(self) -> None:

@@ -29,6 +29,21 @@ F_CPU = 7372800
 #: The clock asked for at reset (100 kHz; the TWI makes 99.632 kHz).
 DEFAULT_CLOCK_KHZ = 0x64
 
+#: The serial line's rates (SPEC section 2); the Makefile's BAUD_RATES is
+#: the source (a host test keeps the two equal).
+BAUD_RATES = (2400, 4800, 9600, 14400, 19200, 28800, 38400, 57600, 76800, 115200)
+DEFAULT_BAUD = 115200
+#: With BAUD=auto the host opens the line with these eight CRs and then
+#: stays quiet for at least AUTOBAUD_QUIET_S before it talks.
+AUTOBAUD_PREAMBLE = b"\r" * 8
+AUTOBAUD_QUIET_S = 0.020
+
+
+def autobaud_wait_s(baudrate: int) -> float:
+    """Seconds from writing the preamble until the host may talk: its eight
+    frames on the wire (10 bits each) and the quiet after them."""
+    return len(AUTOBAUD_PREAMBLE) * 10.0 / baudrate + AUTOBAUD_QUIET_S
+
 
 class ErrorCode(enum.IntEnum):
     """The protocol's error codes (`ERROR <code>` replies)."""

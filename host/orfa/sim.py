@@ -6,6 +6,7 @@ simulator's stdout/stderr), so any number run in parallel.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import shutil
@@ -16,6 +17,8 @@ import time
 from pathlib import Path
 from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
+from .gateway import Gateway
+from .protocol import DEFAULT_BAUD, F_CPU
 from .simctl import SimControl
 
 #: The repository root (host/orfa/../..), so nothing needs installing.
@@ -260,6 +263,19 @@ class SimBoard:
         if self._control is None:
             self._control = SimControl(str(self.control_path))
         return self._control
+
+    def wait_s(self, seconds: float) -> int:
+        """Let `seconds` of simulated time pass (control socket); the cycle
+        reached."""
+        return self.control.wait(int(math.ceil(seconds * F_CPU)))
+
+    def gateway(self, baudrate: int = DEFAULT_BAUD, autobaud: bool = False,
+                **kw) -> Gateway:
+        """A Gateway on this board's port at `baudrate`; autobaud=True sends
+        the BAUD=auto preamble and waits its quiet in simulated time (needs
+        control=True)."""
+        return Gateway(self.port, baudrate=baudrate, autobaud=autobaud,
+                       wait=self.wait_s if autobaud else None, **kw)
 
     def speed(self) -> Optional[float]:
         """After stop(): world cycles per wall second while running free, in

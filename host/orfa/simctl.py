@@ -61,6 +61,26 @@ class SimControl:
             raise SimControlError(text)
         return text
 
+    def requests(self, lines: List[str]) -> List[str]:
+        """Send several requests at once and return their replies. The
+        simulator answers them in order, each as soon as the one before it
+        is answered: a `wait` followed by another request has that request
+        act at the wait's cycle."""
+        self.sock.sendall("".join(line + "\n" for line in lines).encode())
+        replies = []
+        for _ in lines:
+            while b"\n" not in self._buf:
+                chunk = self.sock.recv(65536)
+                if not chunk:
+                    raise SimControlError("orfa-sim closed the control socket")
+                self._buf += chunk
+            reply, self._buf = self._buf.split(b"\n", 1)
+            replies.append(reply.decode())
+        bad = [r for r in replies if r.startswith("ERR")]
+        if bad:
+            raise SimControlError(bad[0])
+        return replies
+
     # --- commands -------------------------------------------------------------
     def time(self) -> int:
         return int(self.request("time"))
@@ -186,6 +206,14 @@ class SimControl:
         power cycle: SRAM lost) or "brownout"; returns the cycle."""
         return int(self.request(self._board("reset %s" % cause)))
 
+    def line(self) -> Dict[str, int]:
+        """The gateway's serial line: `pc` the PC's rate (its port's termios),
+        `bit` its bit time and `board` the board's (UBRR/U2X), in cycles;
+        `ubrr`, `rxen`, `since` (the cycle RXEN last went on), `fe` (frames
+        with FE the firmware took from UDR)."""
+        words = self.request(self._board("line")).split()
+        return {k: int(v) for k, v in zip(words[::2], words[1::2])}
+
     def peek(self, addr: int, n: int = 1) -> bytes:
         """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
         return bytes.fromhex(self.request(self._board("peek %d %d" % (addr, n))))
@@ -196,6 +224,23 @@ class SimControl:
         starts the counts again (after reading them)."""
         w = self.request(self._board("isr clear" if clear else "isr")).split()
         return {"longest": int(w[2]), "count": int(w[4]), "total": int(w[6])}
+
+    def i2c_stuck(self, pulses: int) -> None:
+        """A device on the I2C bus holds SDA low until it has seen `pulses`
+        more SCL pulses (falling edges), as a slave does whose byte a master
+        abandoned; 0 lets SDA go."""
+        self.request("i2c stuck %d" % pulses)
+
+    def i2c_hold_scl(self, on: bool) -> None:
+        """A device on the I2C bus holds SCL low (on) or lets it go."""
+        self.request("i2c hold-scl %s" % ("on" if on else "off"))
+
+    def i2c(self) -> Dict[str, int]:
+        """The bus lines: {"sda", "scl" (levels), "stuck" (pulses the stuck
+        device still waits for), "hold_scl" (0/1)}."""
+        w = self.request("i2c").split()
+        return {"sda": int(w[1]), "scl": int(w[3]), "stuck": int(w[5]),
+                "hold_scl": int(w[7] == "on")}
 
     def srf08_range(self, addr: int, mm: int, mm2: Optional[int] = None) -> None:
         """What the SRF08 at 8-bit address `addr` sees at its next ping: a
@@ -227,6 +272,9 @@ class _SlaveView(SimControl):
 
     def request(self, line: str) -> str:
         return self._parent.request(line)
+
+    def requests(self, lines: List[str]) -> List[str]:
+        return self._parent.requests(lines)
 
     def close(self) -> None:
         pass

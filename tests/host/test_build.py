@@ -39,3 +39,31 @@ def test_unknown_mode_and_board(tmp_path):
     assert r.returncode != 0 and "MODE=master" in r.stderr
     r = make("BOARD=m64", tmp_path=tmp_path)
     assert r.returncode != 0 and "BOARD=m64" in r.stderr
+
+
+@pytest.mark.parametrize("baud", ["1200", "115201", "9600x", "AUTO", "", "230400"])
+def test_baud_that_is_not_a_line_rate_stops_the_build(baud, tmp_path):
+    r = make("BOARD=m32d", "MODE=gate", "BAUD=" + baud, tmp_path=tmp_path)
+    assert r.returncode != 0
+    assert "BAUD=%s is not a rate of the line" % baud in r.stderr, r.stderr
+    assert "avr-gcc" not in r.stdout
+
+
+@pytest.mark.parametrize("board", ["m32d", "m128s"])
+def test_auto_baud_links_the_autobaud_module_only(board, tmp_path):
+    r = make("BOARD=" + board, "MODE=gate", "BAUD=auto", tmp_path=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "firmware/autobaud.c" in r.stdout and "firmware/uart_rate.c" not in r.stdout
+    assert "-DORFA_BAUD_RATES" in r.stdout
+    r = make("BOARD=" + board, "MODE=gate", "BAUD=9600", tmp_path=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "firmware/uart_rate.c" in r.stdout and "firmware/autobaud.c" not in r.stdout
+    assert "-DORFA_BAUD=9600" in r.stdout
+
+
+def test_host_knows_the_rates_the_build_knows():
+    from orfa.protocol import BAUD_RATES, DEFAULT_BAUD
+    r = subprocess.run(["make", "--no-print-directory", "-s", "print-baud-rates"],
+                       cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert tuple(int(x) for x in r.stdout.split()) == BAUD_RATES
+    assert DEFAULT_BAUD in BAUD_RATES

@@ -8,6 +8,7 @@ sees another's state. Each simulator has its own temp dir and link path.
 
 import contextlib
 import re
+import subprocess
 import time
 from pathlib import Path
 
@@ -30,6 +31,34 @@ def require_builds(boards=BOARDS):
     if missing:
         pytest.fail("missing %s: %s" % (", ".join(map(str, missing)), BUILD_HINT),
                     pytrace=False)
+
+
+def build_gateway(board: str, baud) -> Path:
+    """A gateway firmware for `board` at `baud` (a rate, or "auto"), built
+    once per session into build/test-baud/<board>-<baud>/ (the default
+    builds stay as they are); its ELF."""
+    out = ROOT / "build" / "test-baud" / ("%s-%s" % (board, baud))
+    if out not in _BUILT:
+        r = subprocess.run(["make", "--no-print-directory", "-s", "BOARD=" + board, "MODE=gate",
+                            "BAUD=%s" % baud, "BUILD=%s" % out.relative_to(ROOT)],
+                           cwd=ROOT, capture_output=True, text=True, timeout=300)
+        if r.returncode != 0:
+            pytest.fail("building %s BAUD=%s failed:\n%s" % (board, baud, r.stderr), pytrace=False)
+        _BUILT.add(out)
+    return out / "orfa.elf"
+
+
+_BUILT = set()
+
+
+def line_after(sim: SimBoard, port, cycles: int) -> bytes:
+    """Everything the board sent to the PC by `cycles` simulated cycles from
+    now: the simulator hands its output to the pty before it answers a
+    `wait`, so simulated time decides; the short sleep is only the kernel's
+    pty hand-over (a work queue) to the reading side."""
+    sim.control.wait(cycles)
+    time.sleep(0.05)
+    return port.read(port.in_waiting)
 
 
 class Bench:
@@ -214,6 +243,7 @@ DRV_LAYOUT = {
         "servo_pins": ["A0", "A1", "A2", "A3", "A4", "A5", "A6", "A7",
                        "C7", "C6", "C5", "C4", "B3", "B2", "D5", "D4"],
         # pins of functions that GPIO never has (UART, TWI, SPI, motors)
+        "fixed_scl": "C0",
         "fixed_pins": {"D0": "UART", "D1": "UART", "C0": "TWI", "C1": "TWI",
                        "B4": "SPI", "B5": "SPI", "B6": "SPI", "B7": "SPI",
                        "D5": "MOTOR", "D4": "MOTOR", "B0": "MOTOR", "B1": "MOTOR"},
@@ -224,6 +254,7 @@ DRV_LAYOUT = {
         "servo_channels": 32, "adc_port": "F",
         "spi_pins": {"SS": "B0", "SCK": "B1", "MOSI": "B2", "MISO": "B3"},
         "servo_pins": ["servo%d" % n for n in range(32)],
+        "fixed_scl": "D0",
         "fixed_pins": {"D2": "UART", "D3": "UART", "D0": "TWI", "D1": "TWI",
                        "B0": "SPI", "B1": "SPI", "B2": "SPI", "B3": "SPI",
                        "E3": "SERVO", "E4": "SERVO", "E5": "SERVO", "B7": "SERVO",
@@ -329,6 +360,17 @@ class DrvBench(Bench):
     # --- the pins ---------------------------------------------------------------
     def pin(self, name: str):
         return self.ctl.pin(name)
+
+    def read_levels(self, port: str) -> int:
+        """What the board's GPIO value register reads for `port`: its pin
+        levels, except that a slave board reads its own SCL low, since it
+        holds SCL (clock stretching) while it answers the read. The TWI
+        pins show the bus's wired-AND lines (docs/simulator.md)."""
+        value = sum(self.pin("%s%d" % (port, l))[0] << l for l in range(8))
+        scl = self.lay["fixed_scl"]
+        if self.slave and scl[0] == port:
+            value &= ~(1 << int(scl[1]))
+        return value
 
     def drive(self, name: str, value) -> None:
         self.ctl.drive(name, value)

@@ -99,3 +99,15 @@ def test_sim_refuses_a_bad_slave():
     result = orfa("sim", "--slave", "m32d:0x21")
     assert result.returncode == 2
     assert "BOARD:ADDR" in result.stderr or "even" in result.stderr
+
+
+def test_terminal_with_autobaud_firmware():
+    """`orfa sim --autobaud --baud R` opens the console with the preamble
+    (its quiet in simulated time) on a BAUD=auto build."""
+    from conftest import build_gateway
+    require_builds(["m128s"])
+    elf = build_gateway("m128s", "auto")
+    result = orfa("sim", "--board", "m128s", "--firmware", str(elf), "--terminal",
+                  "--baud", "14400", "--autobaud", input="V\nS AA 00 00 S AB 01 P\n")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[1:] == ["V1.1", "SWAASR06P"]

@@ -16,7 +16,7 @@ def free_mask(drv, port):
 
 
 def levels(drv, port):
-    return sum(drv.pin("%s%d" % (port, l))[0] << l for l in range(8))
+    return drv.read_levels(port)
 
 
 def fixed_snapshot(drv):

@@ -384,8 +384,9 @@ def test_srf08_on_the_robot_bus(rb):
 #: A slave holds SCL while its main loop fetches a driver's read answer
 #: (i2c_slave/): about 400 cycles at most (make bench), bounded here with room.
 STRETCH_PER_BYTE_MAX = 1000
-#: The gateway waits at least 12 ms for a stretching slave (firmware/twi_master.c).
-GATEWAY_STRETCH_WAIT = 12 * F_CPU // 1000
+#: The gateway waits more than 32 clock ticks of 2048 cycles (8.9 ms) for a
+#: stretching slave (firmware/twi_master.c TWI_WAIT_TICKS), less than 10 ms.
+GATEWAY_STRETCH_WAIT = 32 * 2048
 
 
 @pytest.mark.parametrize("addr", [M128S, M32D])

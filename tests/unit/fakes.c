@@ -94,9 +94,10 @@ void twi_stop(void)
 	bus.device = -1;
 }
 
-void twi_clear_bus(void)
+bool twi_clear_bus(void)
 {
 	logf_("X ", 0);
+	return true;
 }
 
 uint16_t twi_set_khz(uint16_t khz)

@@ -351,46 +351,47 @@ static void test_sys(void)
 	expect("S AA 06 46 50 P\r", "SWAAAP\r\n", "");
 	expect("S AA 06 S AB 02 P\r", "SWASR4650P\r\n", "");
 
-	/* 100 ms = 360 ticks: trips at 360 quiet ticks, once */
+	/* 100 ms = 360 ticks, one more for the tick the request came in: trips
+	 * at 361 quiet ticks, once */
 	fake_clock = 65000;  /* across the clock's wrap */
 	fake_safe_calls = 0;
 	expect("S AA 06 00 64 P\r", "SWAAAP\r\n", "");
-	fake_clock = (uint16_t)(65000 + 359);
-	sys_poll();
-	check(fake_safe_calls == 0, "quiet for 359 ticks: not yet", NULL);
 	fake_clock = (uint16_t)(65000 + 360);
 	sys_poll();
-	check(fake_safe_calls == 1, "quiet for 360 ticks: tripped", NULL);
+	check(fake_safe_calls == 0, "quiet for 360 ticks: not yet", NULL);
+	fake_clock = (uint16_t)(65000 + 361);
+	sys_poll();
+	check(fake_safe_calls == 1, "quiet for 361 ticks: tripped", NULL);
 	fake_clock += 5000;
 	sys_poll();
 	check(fake_safe_calls == 1, "tripped once per quiet spell", NULL);
 	/* a request heard starts the time again */
 	SYS_HEARD();
 	sys_poll();
-	fake_clock += 359;
+	fake_clock += 360;
 	sys_poll();
-	check(fake_safe_calls == 1, "heard: 359 ticks are not enough", NULL);
+	check(fake_safe_calls == 1, "heard: 360 ticks are not enough", NULL);
 	SYS_HEARD();
 	sys_poll();
-	fake_clock += 359;
+	fake_clock += 360;
 	sys_poll();
 	check(fake_safe_calls == 1, "heard again", NULL);
 	fake_clock += 1;
 	sys_poll();
-	check(fake_safe_calls == 2, "then 360 quiet ticks trip it again", NULL);
+	check(fake_safe_calls == 2, "then 361 quiet ticks trip it again", NULL);
 	/* 0: off, never trips */
 	expect("S AA 06 00 00 P\r", "SWAAAP\r\n", "");
 	fake_clock += 30000;
 	sys_poll();
 	check(fake_safe_calls == 2, "FAILSAFE 0 never trips", NULL);
-	/* 1 ms = 4 ticks (3.6 rounded up) */
+	/* 1 ms = 4 ticks (3.6 rounded up), and one more */
 	expect("S AA 06 00 01 P\r", "SWAAAP\r\n", "");
-	fake_clock += 3;
+	fake_clock += 4;
 	sys_poll();
-	check(fake_safe_calls == 2, "1 ms: not after 3 ticks", NULL);
+	check(fake_safe_calls == 2, "1 ms: not after 4 ticks", NULL);
 	fake_clock += 1;
 	sys_poll();
-	check(fake_safe_calls == 3, "1 ms: after 4 ticks", NULL);
+	check(fake_safe_calls == 3, "1 ms: after 5 ticks", NULL);
 	/* reset: off again */
 	boot();
 	expect("S AA 06 S AB 02 P\r", "SWASR0000P\r\n", "");

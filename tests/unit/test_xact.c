@@ -124,6 +124,7 @@ static void run_twi(const frame_t *f, result_t *r)
 	memset(r, 0, sizeof *r);
 	if (f->read) {
 		int sent_ok = twi_event(TW_ST_SLA_ACK, &b) == SLAVE_SEND;
+		CHECK(slave_fsm_in_frame());
 		r->got[0] = b;
 		for (uint8_t k = 1; k < f->n; k++) {
 			sent_ok &= twi_event(TW_ST_DATA_ACK, &b) == SLAVE_SEND;
@@ -131,11 +132,13 @@ static void run_twi(const frame_t *f, result_t *r)
 		}
 		sent_ok &= twi_event(TW_ST_DATA_NACK, &b) == SLAVE_ACK;
 		CHECK(sent_ok);
+		CHECK(!slave_fsm_in_frame());  /* the master's NACK ends it */
 		r->status = status_now();
 		r->ok = 1;  /* the TWI cannot refuse: compared as FF bytes */
 		return;
 	}
 	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	CHECK(slave_fsm_in_frame());
 	int twea = 1, addressed = 1;
 	for (uint8_t k = 0; k <= f->n && addressed; k++) {
 		b = k ? f->data[k - 1] : f->reg;
@@ -150,8 +153,11 @@ static void run_twi(const frame_t *f, result_t *r)
 		r->acks = (uint8_t)(r->acks + twea);
 	}
 	if (addressed) {
+		CHECK(slave_fsm_in_frame());
 		CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
 	}
+	/* a STOP or a refused byte ends the frame (the slave's stall timer) */
+	CHECK(!slave_fsm_in_frame());
 	r->status = status_now();
 }
 

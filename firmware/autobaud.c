@@ -1,0 +1,362 @@
+/*
+ * BAUD=auto: the line's rate found from the PC's preamble of 0x0D
+ * characters (SPEC section 2; design in docs/protocol.md, "Autobaud").
+ *
+ * 0x0D in 8N1 is, in bit times: low 1 (start), high 1, low 1, high 2,
+ * low 4, then the stop bit. The RXD pin is timed by counting loop
+ * iterations of a known cycle count (no timer: the M32-D's three are the
+ * servos', the motors' and the time base's), with interrupts on, so the drivers are never
+ * disturbed; an interrupt can only shorten a measured run, and a frame
+ * that no longer fits the pattern is simply not taken.
+ *
+ *   DETECT  the pin's runs are recorded from a falling edge until the line
+ *           is quiet for AB_QUIET (6.7 ms; the host waits 20 ms after its
+ *           preamble); a record with two frames in a row that last nine
+ *           bits of the same of the ten rates, one of them 0x0D's shape,
+ *           gives the rate: UBRR is set and the receiver turned on while
+ *           the line is quiet, so it starts in step with the next start bit;
+ *   FRESH   no good request yet: the pin is still recorded whenever the main
+ *           loop is idle (received bytes wait in the ring), and a preamble
+ *           at another rate moves the rate (noise that looked like a
+ *           preamble locked a wrong one); one frame with FE sends it back
+ *           to DETECT;
+ *   TALK    a request parsed without error proves the rate: only AB_FE_RUN
+ *           frames with FE in a row (no good frame between) send it back
+ *           to DETECT.
+ * A new rate (uart_line_poll gives 1) makes the front end drop what the
+ * receiver took at the old one and the line the parser holds.
+ */
+#include "firmware/uart_line.h"
+
+#include <avr/io.h>
+#include <avr/wdt.h>
+#include <util/atomic.h>
+
+#include "board.h"
+#include "firmware/board_pins.h"
+#include "firmware/flash.h"
+#include "firmware/mcu.h"
+
+/* The preamble is over when RXD stays high this long (iterations of 6
+ * cycles: 6.7 ms, 16 bit times at 2400 baud; a host waits at least 20 ms),
+ * so the USART starts on an idle line, in step with the next start bit. */
+#define AB_QUIET 8192
+/* Runs kept of a record (up to five per character; stack bytes x2): the
+ * eight 0x0D of a preamble are 47. */
+#define AB_MAX_RUNS 64
+/* Framing errors in a row that end a proven rate. */
+#define AB_FE_RUN 3
+
+/* RXD from the board's pin map: its PINx must be in the I/O space the
+ * bit-test instructions reach (ports A-D on both MCUs). */
+#define AB_RXD_BIT(port, bit, fn, index) +((BF_##fn == BF_UART_RX) ? (bit) : 0)
+#define AB_RXD_PORT(port, bit, fn, index) +((BF_##fn == BF_UART_RX) ? (port) : 0)
+enum {
+	AB_RX_BIT = 0 BOARD_PINS(AB_RXD_BIT),
+	AB_RX_PORT = 0 BOARD_PINS(AB_RXD_PORT),
+	AB_PIN_IO = _SFR_IO_ADDR(PINA) - 3 * (AB_RX_PORT - 'A'),
+};
+_Static_assert(AB_RX_PORT >= 'A' && AB_RX_PORT <= 'D', "RXD on ports A-D");
+_Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart");
+
+/* Cycles of one counting iteration (sbic/sbis skipping 2, adiw 2, brne 2)
+ * and of the step from one run to the next in ab_record. */
+#define AB_LOOP_CYCLES 6
+#define AB_STEP_CYCLES 12
+
+/* The ten rates: bit time in cycles and UBRR, exact at 7.3728 MHz. */
+#define AB_RATE(r) { (uint16_t)(F_CPU / (r)), (uint8_t)(F_CPU / (16UL * (r)) - 1) },
+#define AB_EXACT(r) _Static_assert(F_CPU % (16UL * (r)) == 0 && F_CPU / (16UL * (r)) <= 256, \
+				   "UBRR exact and 8-bit for " #r);
+ORFA_BAUD_RATES(AB_EXACT)
+
+typedef struct {
+	uint16_t bit;
+	uint8_t ubrr;
+} ab_rate_t;
+
+static const ORFA_FLASH ab_rate_t ab_rates[] = { ORFA_BAUD_RATES(AB_RATE) };
+#define AB_NRATES (sizeof(ab_rates) / sizeof(ab_rates[0]))
+
+/* 0x0D from its start bit, runs in bit times; and the runs of two frames
+ * with the high run between them (stop bit and any gap). */
+static const ORFA_FLASH uint8_t ab_pattern[5] = { 1, 1, 1, 2, 4 };
+#define AB_PAIR 11
+
+/* Why a record ended. */
+enum { AB_END_QUIET = 1, AB_END_BREAK };
+
+enum { AB_DETECT, AB_FRESH, AB_TALK };
+
+static struct {
+	uint8_t state;
+	uint8_t rate;		/* index + 1 of the rate in use */
+	volatile uint8_t lost;	/* set by the receive interrupt */
+	uint8_t fe_run;
+} ab;
+
+/* Wait up to 65535 iterations (53 ms) for RXD to fall, then count the
+ * iterations of runs, low and high in turn, into the ring RUN of
+ * AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations (the line is
+ * quiet: that high run is not stored) or low for 65535 (a break). A high
+ * run's counter starts at -AB_QUIET so that its overflow is the quiet. The
+ * ring keeps the last AB_MAX_RUNS runs before the end, however long the
+ * line was busy. Returns *WHY the end; *LEFT the free slots before the
+ * next write position, *WRAPPED whether the ring went round. One block of
+ * assembly so that every step from one run to the next costs the same
+ * (AB_STEP_CYCLES). */
+static void __attribute__((noinline)) ab_record(uint16_t *run, uint8_t *why,
+						uint8_t *left_out, uint8_t *wrapped_out)
+{
+	uint16_t *p = run;
+	uint8_t left = AB_MAX_RUNS;
+	uint8_t wrapped = 0;
+	uint8_t end;
+	uint16_t n;
+
+	asm volatile("	clr %A[n]\n\t"
+		     "	clr %B[n]\n"
+		     "0:	sbis %[pin], %[bit]\n\t"
+		     "	rjmp 1f\n\t"
+		     "	adiw %[n], 1\n\t"
+		     "	brne 0b\n\t"
+		     "	rjmp 8f\n"
+		     "1:	clr %A[n]\n\t"
+		     "	clr %B[n]\n"
+		     "2:	sbic %[pin], %[bit]\n\t"
+		     "	rjmp 3f\n\t"
+		     "	adiw %[n], 1\n\t"
+		     "	brne 2b\n\t"
+		     "	rjmp 9f\n"
+		     "3:	st %a[p]+, %A[n]\n\t"
+		     "	st %a[p]+, %B[n]\n\t"
+		     "	dec %[left]\n\t"
+		     "	brne 4f\n\t"
+		     "	movw %[p], %[base]\n\t"
+		     "	ldi %[left], %[max]\n\t"
+		     "	ldi %[wr], 1\n"
+		     "4:	ldi %A[n], lo8(%[q])\n\t"
+		     "	ldi %B[n], hi8(%[q])\n"
+		     "5:	sbis %[pin], %[bit]\n\t"
+		     "	rjmp 6f\n\t"
+		     "	adiw %[n], 1\n\t"
+		     "	brne 5b\n\t"
+		     "	rjmp 8f\n"
+		     "6:	st %a[p]+, %A[n]\n\t"
+		     "	st %a[p]+, %B[n]\n\t"
+		     "	dec %[left]\n\t"
+		     "	brne 1b\n\t"
+		     "	movw %[p], %[base]\n\t"
+		     "	ldi %[left], %[max]\n\t"
+		     "	ldi %[wr], 1\n\t"
+		     "	rjmp 1b\n"
+		     "8:	ldi %[end], %[quiet]\n\t"
+		     "	rjmp 10f\n"
+		     "9:	ldi %[end], %[brk]\n"
+		     "10:\n"
+		     : [n] "=&w" (n), [p] "+e" (p), [left] "+d" (left), [wr] "+d" (wrapped),
+		       [end] "=&d" (end)
+		     : [base] "r" (run), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
+		       [q] "i" (0x10000L - AB_QUIET), [max] "M" (AB_MAX_RUNS),
+		       [quiet] "M" (AB_END_QUIET), [brk] "M" (AB_END_BREAK)
+		     : "memory");
+	*why = end;
+	*left_out = left;
+	*wrapped_out = wrapped;
+}
+
+static void ab_reverse(uint16_t *a, uint8_t n)
+{
+	for (uint8_t i = 0, j = (uint8_t)(n - 1); i < j; i++, j--) {
+		uint16_t t = a[i];
+
+		a[i] = a[j];
+		a[j] = t;
+	}
+}
+
+/* A run's length in cycles (the step to the next run included) from its
+ * iterations; 0xFFFF for one longer than any run of a 0x0D. */
+static uint16_t ab_cycles(uint16_t count)
+{
+	return count > 4000 ? 0xFFFF : (uint16_t)(count * AB_LOOP_CYCLES + AB_STEP_CYCLES);
+}
+
+/* The rate whose 0x0D the five runs from RUN (RUN[0] low) are: its
+ * index + 1, or 0. */
+static uint8_t ab_frame(const uint16_t *run)
+{
+	uint16_t total = 0;
+
+	for (uint8_t i = 0; i < 5; i++) {
+		uint16_t c = ab_cycles(run[i]);
+
+		if (c == 0xFFFF) {
+			return 0;
+		}
+		total += c;
+	}
+	for (uint8_t r = 0; r < AB_NRATES; r++) {
+		uint16_t nine = (uint16_t)(9 * ab_rates[r].bit);
+		uint16_t diff = total > nine ? total - nine : nine - total;
+
+		if (diff <= nine / 8) {
+			return (uint8_t)(r + 1);
+		}
+	}
+	return 0;
+}
+
+/* The five runs from RUN match 0x0D's 1 1 1 2 4 bit times at BIT. */
+static uint8_t ab_shape(const uint16_t *run, uint16_t bit)
+{
+	for (uint8_t i = 0; i < 5; i++) {
+		uint16_t want = (uint16_t)(ab_pattern[i] * bit);
+		uint16_t c = ab_cycles(run[i]);
+
+		if ((c > want ? c - want : want - c) > bit / 3) {
+			return 0;
+		}
+	}
+	return 1;
+}
+
+/*
+ * Two frames in a row last 9 bit times (start bit to stop bit) of the same
+ * rate, with at least half a bit between them, and one of them has 0x0D's
+ * shape: that rate's index + 1, or 0. One frame may be bent: an interrupt
+ * that runs while a run is timed shortens it (the drivers' interrupts stay
+ * on), which the 1/8 tolerance of a frame's length absorbs but a single
+ * run's may not.
+ */
+static uint8_t ab_check(const uint16_t *run)
+{
+	uint8_t r = ab_frame(run);
+
+	if (r == 0 || ab_frame(run + 6) != r) {
+		return 0;
+	}
+	uint16_t bit = ab_rates[r - 1].bit;
+
+	if (ab_cycles(run[5]) < bit / 2) {
+		return 0;
+	}
+	return (ab_shape(run, bit) || ab_shape(run + 6, bit)) ? r : 0;
+}
+
+static void ab_listen(uint8_t ubrr)
+{
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		MCU_UBRRH = 0;
+		MCU_UBRRL = ubrr;
+		/* |=: the transmitter's UDRIE may be set (a reply going out). */
+		MCU_UCSRB |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
+		/* Framing errors seen so far were at the old rate. */
+		ab.lost = 0;
+		ab.fe_run = 0;
+	}
+}
+
+static void ab_deaf(void)
+{
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		MCU_UCSRB &= (uint8_t)~(_BV(RXEN) | _BV(RXCIE));
+		ab.lost = 0;
+	}
+	ab.state = AB_DETECT;
+}
+
+/* Record the line once, until it is quiet (AB_QUIET), or 53 ms without an
+ * edge (*HEARD = 0). If the last AB_MAX_RUNS runs before the quiet hold two
+ * 0x0D in a row at one rate, that rate (index + 1); the last such pair wins
+ * (a fresh run at another rate replaces an earlier one). 0: no rate. */
+static uint8_t ab_scan(uint8_t *heard)
+{
+	uint16_t run[AB_MAX_RUNS];
+	uint8_t why, left, wrapped, n, first;
+	uint8_t found = 0;
+
+	wdt_reset();
+	ab_record(run, &why, &left, &wrapped);
+	n = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
+	*heard = n || wrapped;
+	if (why != AB_END_QUIET) {
+		return 0;
+	}
+	/* High runs (odd positions) counted from -AB_QUIET. */
+	for (uint8_t i = 1; i < (wrapped ? AB_MAX_RUNS : n); i += 2) {
+		run[i] = (uint16_t)(run[i] + AB_QUIET);
+	}
+	first = 0;
+	if (wrapped) {
+		/* oldest first: rotate the ring left by n */
+		ab_reverse(run, n);
+		ab_reverse(run + n, (uint8_t)(AB_MAX_RUNS - n));
+		ab_reverse(run, AB_MAX_RUNS);
+		first = n & 1;		/* a frame starts on a low run */
+		n = AB_MAX_RUNS;
+	}
+	for (uint8_t i = first; i + AB_PAIR <= n; i += 2) {
+		uint8_t r = ab_check(run + i);
+
+		if (r) {
+			found = r;
+		}
+	}
+	return found;
+}
+
+void uart_init(void)
+{
+	ab.state = AB_DETECT;
+}
+
+uint8_t uart_line_poll(void)
+{
+	uint8_t r;
+	uint8_t heard;
+
+	if (ab.lost) {
+		ab_deaf();
+	}
+	if (ab.state == AB_TALK) {
+		return 0;
+	}
+	if (ab.state == AB_FRESH) {
+		/* Until a request proves the rate, the pin is still watched
+		 * (the receiver runs on): a preamble at another rate after a
+		 * wrong lock (noise that looked like one) moves the rate. The
+		 * bytes the receiver takes meanwhile wait in the ring. */
+		r = ab_scan(&heard);
+		if (r == 0 || r == ab.rate) {
+			return 0;
+		}
+	} else {
+		do {
+			r = ab_scan(&heard);
+		} while (r == 0 && heard);
+	}
+	if (r == 0) {
+		return 1;	/* quiet for 53 ms: round the main loop */
+	}
+	ab.rate = r;
+	ab.state = AB_FRESH;
+	ab_listen(ab_rates[r - 1].ubrr);
+	return 1;
+}
+
+void uart_line_rx(void)
+{
+	if (!(MCU_UCSRA & _BV(FE))) {
+		ab.fe_run = 0;
+	} else if (ab.state != AB_TALK || ++ab.fe_run >= AB_FE_RUN) {
+		ab.lost = 1;
+	}
+}
+
+void uart_line_confirm(void)
+{
+	if (ab.state == AB_FRESH) {
+		ab.state = AB_TALK;
+	}
+}

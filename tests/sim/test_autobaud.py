@@ -1,0 +1,116 @@
+"""BAUD=auto firmware (docs/protocol.md, "Autobaud"): after reset it finds
+the PC's rate from the eight 0x0D of the preamble, at every one of the ten
+rates on both boards, also after noise, and then talks normally.
+
+The autobaud builds go to build/test-baud/<board>-auto/ (the default
+fixed-rate build stays); the simulator's serial line decodes at each end's
+own rate, so a wrong rate gets no reply (test_serial_line.py).
+"""
+
+import random
+
+import pytest
+
+from conftest import REPLY_TIMEOUT, build_gateway, line_after, require_builds
+from orfa.protocol import AUTOBAUD_PREAMBLE, BAUD_RATES, F_CPU
+from orfa.sim import BOARDS, SimBoard
+
+EEPROM = 0xA0
+COUNT = {"m32d": "SWAASR07P", "m128s": "SWAASR06P"}
+#: Driver 2, the GPIO: UID, version 1.1, its registers
+GPIO_INFO = {"m32d": "SWAASR002001010208P", "m128s": "SWAASR002101010204P"}
+
+
+def start(board):
+    require_builds([board])
+    return SimBoard(board, trace=True, control=True, eeproms=[EEPROM],
+                    firmware=build_gateway(board, "auto"))
+
+
+def talks(sim, gw, board, rate):
+    """The gateway answers local and bus requests at `rate`."""
+    assert gw.request("V") == "V1.1"
+    assert gw.request("S AA 00 00 S AB 01 P") == COUNT[board]
+    assert gw.request("S AA 00 02 S AB 06 P") == GPIO_INFO[board]
+    assert gw.request("S A0 10 48 69 P") == "SWAAAP"
+    assert gw.request("S A0 10 S A1 02 P") == "SWASR4869P"
+    line = sim.control.line()
+    assert line["board"] == line["bit"] == F_CPU // rate
+
+
+@pytest.mark.parametrize("rate", BAUD_RATES)
+@pytest.mark.parametrize("board", BOARDS)
+def test_every_rate_is_found(board, rate):
+    with start(board) as sim:
+        # a board that has not heard a preamble yet does not listen at all
+        assert sim.control.line()["rxen"] == 0
+        with sim.gateway(rate, autobaud=True, timeout=REPLY_TIMEOUT) as gw:
+            talks(sim, gw, board, rate)
+
+
+def noise(rng, n, avoid=b"\r"):
+    return bytes(b for b in (rng.randrange(256) for _ in range(4 * n)) if b not in avoid)[:n]
+
+
+@pytest.mark.parametrize("board,noise_rate,rate", [
+    ("m32d", 9600, 115200), ("m32d", 115200, 2400), ("m32d", 2400, 38400),
+    ("m128s", 57600, 14400), ("m128s", 4800, 76800), ("m128s", 115200, 9600),
+])
+def test_noise_first_then_the_preamble(board, noise_rate, rate):
+    """Random bytes at another rate, then bytes at the right rate that are
+    not 0x0D, then the preamble: the board ends talking at the right rate."""
+    rng = random.Random("%s %d %d" % (board, noise_rate, rate))
+    with start(board) as sim, sim.gateway(noise_rate, timeout=REPLY_TIMEOUT) as gw:
+        gw.send(noise(rng, 40))
+        sim.wait_s(45 * 10 / noise_rate)
+        gw.serial.baudrate = rate
+        gw.send(b"hello V S AA P \n" + noise(rng, 20))
+        sim.wait_s(40 * 10 / rate)
+        gw.preamble(sim.wait_s)
+        talks(sim, gw, board, rate)
+
+
+@pytest.mark.parametrize("board,wrong,rate", [
+    ("m32d", 9600, 115200), ("m128s", 115200, 9600), ("m32d", 2400, 57600),
+])
+def test_a_preamble_at_a_wrong_rate_first_is_not_kept(board, wrong, rate):
+    """0x0Ds at another rate, then quiet, look like a preamble and lock that
+    rate; the real preamble after them moves it (no request was accepted)."""
+    with start(board) as sim, sim.gateway(wrong, timeout=REPLY_TIMEOUT) as gw:
+        gw.preamble(sim.wait_s)
+        assert sim.control.line()["board"] == F_CPU // wrong
+        gw.serial.baudrate = rate
+        gw.preamble(sim.wait_s)
+        talks(sim, gw, board, rate)
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_a_slower_pc_later_brings_the_board_back_to_detection(board):
+    """After talking at 115200, a PC at 2400 sends framing errors (a run of
+    them ends a proven rate); its preamble is then found."""
+    with start(board) as sim, sim.gateway(115200, autobaud=True, timeout=REPLY_TIMEOUT) as gw:
+        assert gw.request("V") == "V1.1"
+        gw.serial.baudrate = 2400
+        gw.preamble(sim.wait_s)
+        gw.preamble(sim.wait_s)
+        talks(sim, gw, board, 2400)
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_the_preamble_gets_no_reply(board):
+    """The eight CRs are empty lines: nothing comes back, before or after
+    the rate is found."""
+    with start(board) as sim, sim.gateway(19200, autobaud=True, timeout=REPLY_TIMEOUT) as gw:
+        gw.send(AUTOBAUD_PREAMBLE)
+        assert line_after(sim, gw.serial, F_CPU // 10) == b""
+        assert gw.request("V") == "V1.1"
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_fixed_rate_build_does_not_answer_a_pc_at_9600(board):
+    """The default build is 115200: a PC at 9600 gets no valid reply."""
+    require_builds([board])
+    with SimBoard(board, trace=True, control=True) as sim, \
+            sim.gateway(9600, autobaud=True, timeout=REPLY_TIMEOUT) as gw:
+        gw.send(b"V\r")
+        assert b"V1.1" not in line_after(sim, gw.serial, F_CPU // 10)

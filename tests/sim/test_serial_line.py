@@ -1,0 +1,147 @@
+"""The simulator's serial line (docs/simulator.md, Serial line): the PC's
+rate comes from its port's termios, RXD shows the PC's bit waveform, and
+each end decodes the other's bits at its own rate, so a PC at the wrong rate
+gets garbage or nothing, as on a real line; equal rates behave as before.
+
+Fixed-rate firmware at other rates is built once into build/test-baud/.
+"""
+
+import pytest
+import serial
+
+from conftest import REPLY_TIMEOUT, build_gateway, line_after, require_builds
+from orfa.gateway import Gateway
+from orfa.protocol import F_CPU
+from orfa.sim import BOARDS, SimBoard
+
+RXD = {"m32d": "D0", "m128s": "D2"}
+#: A cycle a fresh simulator has not reached when the test asks.
+AT = 1 << 24
+#: Replies to V or a driver count take a few byte times at most.
+REPLY_CYCLES = 200 * F_CPU // 2400
+
+
+def sim_for(board, elf=None, **kw):
+    require_builds([board])
+    return SimBoard(board, trace=True, control=True, firmware=elf, **kw)
+
+
+def test_pc_rate_follows_the_termios_also_bother_rates():
+    """pyserial sets 14400, 28800 and 76800 through BOTHER (termios2): the
+    simulator reads them as numbers, and follows every change."""
+    with sim_for("m32d") as sim, serial.Serial(sim.port, 9600) as port:
+        ctl = sim.control
+        for rate in (9600, 14400, 28800, 76800, 115200, 2400, 57600):
+            port.baudrate = rate
+            ctl.wait(1000)
+            line = ctl.line()
+            assert (line["pc"], line["bit"]) == (rate, F_CPU // rate)
+        # the board's side: UBRR 3 at 115200, 64 cycles a bit
+        assert (line["ubrr"], line["board"], line["rxen"]) == (3, 64, 1)
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_rxd_pin_shows_the_pc_waveform(board):
+    """0x0D at 9600 from cycle AT: start 0, bits 1 0 1 1 0 0 0 0, stop 1,
+    768 cycles each, on the board's RXD pin (idle high, driven from outside).
+    A pin edge is stamped at the instruction boundary after it (< 5 cycles)."""
+    bit = F_CPU // 9600
+    with sim_for(board) as sim, serial.Serial(sim.port, 9600) as port:
+        ctl = sim.control
+        ctl.wait(1000)
+        assert ctl.pin(RXD[board]) == (1, "in ext")
+        assert ctl.rx(AT, b"\r") == AT + 10 * bit
+        ctl.wait(AT + 11 * bit - ctl.time())
+        edges = ctl.edges(RXD[board], AT)
+        want = [(AT, 0), (AT + bit, 1), (AT + 2 * bit, 0), (AT + 3 * bit, 1),
+                (AT + 5 * bit, 0), (AT + 9 * bit, 1)]
+        assert [lv for _, lv in edges] == [lv for _, lv in want]
+        assert all(0 <= c - w < 5 for (c, _), (w, _) in zip(edges, want)), edges
+        port.close()
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_pc_at_9600_gets_no_valid_reply_from_a_115200_build(board):
+    """The board's USART samples the PC's 9600 bits at 115200: framing
+    errors (the firmware reads them: FE in UCSRA) and garbage, never V1.1."""
+    with sim_for(board) as sim, serial.Serial(sim.port, 9600, timeout=0) as port:
+        got = b""
+        for _ in range(3):
+            port.write(b"V\r")
+            got += line_after(sim, port, REPLY_CYCLES)
+        assert b"V1.1" not in got
+        line = sim.control.line()
+        assert line["fe"] > 0                  # frames with FE taken from UDR
+        rx = sim.trace_events(kinds=["uart rx"])
+        assert any(e.fields[1:] == ("fe",) for e in rx)
+        assert not any(e.fields[0] == "56" for e in rx)     # never a 'V'
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_pc_at_115200_gets_no_valid_reply_from_a_9600_build(board):
+    elf = build_gateway(board, 9600)
+    with sim_for(board, elf) as sim, serial.Serial(sim.port, 115200, timeout=0) as port:
+        got = b""
+        for _ in range(3):
+            port.write(b"V\r")
+            got += line_after(sim, port, REPLY_CYCLES)
+        assert b"V1.1" not in got
+
+
+@pytest.mark.parametrize("rate", [2400, 9600, 57600])
+@pytest.mark.parametrize("board", BOARDS)
+def test_matched_rates_work(board, rate):
+    elf = build_gateway(board, rate)
+    with sim_for(board, elf, eeproms=[0xA0]) as sim, \
+            Gateway(sim.port, baudrate=rate, timeout=REPLY_TIMEOUT) as gw:
+        assert gw.request("V") == "V1.1"
+        assert gw.request("S AA 00 00 S AB 01 P") == \
+            {"m32d": "SWAASR07P", "m128s": "SWAASR06P"}[board]
+        assert gw.request("S A0 10 48 69 P") == "SWAAAP"
+        assert gw.request("S A0 10 S A1 02 P") == "SWASR4869P"
+        line = sim.control.line()
+        assert line["board"] == line["bit"] == F_CPU // rate
+        assert line["fe"] == 0
+
+
+def test_rx_requests_go_at_the_pc_rate():
+    """Scheduled bytes are the PC's: 10 bit times of its rate each."""
+    elf = build_gateway("m32d", 9600)
+    with sim_for("m32d", elf) as sim, serial.Serial(sim.port, 9600, timeout=REPLY_TIMEOUT) as port:
+        ctl = sim.control
+        ctl.wait(1000)
+        assert ctl.rx(AT, b"V\r") == AT + 2 * 10 * 768
+        assert port.readline() == b"V1.1\r\n"
+        rx = sim.trace_events(kinds=["uart rx"])
+        assert [(e.cycle, e.fields[0]) for e in rx] == [(AT + 7680, "56"), (AT + 15360, "0D")]
+
+
+def test_pc_changing_its_rate_mid_session_is_followed():
+    with sim_for("m32d") as sim, Gateway(sim.port, timeout=REPLY_TIMEOUT) as gw:
+        ctl = sim.control
+        port = gw.serial
+        assert gw.request("V") == "V1.1"
+        port.baudrate = 9600
+        port.write(b"V\r")
+        got = line_after(sim, port, REPLY_CYCLES)
+        assert b"V1.1" not in got
+        assert ctl.line()["pc"] == 9600
+        port.baudrate = 115200
+        # end the garbage line (whatever it answers), then talk again
+        port.write(b"\r")
+        line_after(sim, port, REPLY_CYCLES)
+        assert ctl.line()["pc"] == 115200
+        assert gw.request("V") == "V1.1"
+        assert gw.request("S AA 00 00 S AB 01 P") == "SWAASR07P"
+
+
+def test_a_pc_that_moves_to_the_board_rate_is_heard():
+    elf = build_gateway("m128s", 19200)
+    with sim_for("m128s", elf) as sim, Gateway(sim.port, timeout=REPLY_TIMEOUT) as gw:
+        port = gw.serial
+        port.write(b"V\r")
+        assert b"V1.1" not in line_after(sim, port, REPLY_CYCLES)
+        port.baudrate = 19200
+        port.write(b"\r")
+        line_after(sim, port, REPLY_CYCLES)
+        assert gw.request("V") == "V1.1"
