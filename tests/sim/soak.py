@@ -47,6 +47,7 @@ class Figures:
     bytes_received: int = 0
     sim_seconds: float = 0.0
     wall_seconds: float = 0.0
+    reset_checked: bool = False     # RESET registers read 00 at the end
 
     def report(self) -> str:
         errs = ", ".join("%s: %d" % (k, v) for k, v in sorted(self.errors.items())) or "none"
@@ -62,6 +63,8 @@ class Figures:
             "requests/s (wall)        %.1f" % rate,
             "requests/s (simulated)   %.1f" % (self.requests / self.sim_seconds
                                                if self.sim_seconds else 0.0),
+            "resets                   %s" % ("none (trace, and RESET 00 on both boards)"
+                                             if self.reset_checked else "not checked"),
         ])
 
 
@@ -92,6 +95,24 @@ def check_no_reset(sim: SimBoard, since: int) -> int:
             tail = data[cut:]
             pos += len(chunk)
     return pos - len(tail)
+
+
+SYS_UID = 0x0002                      # the sys driver: RESET at its start register
+
+
+def reset_register(records: List[Record]) -> int:
+    for rec in records:
+        if rec.uid == SYS_UID:
+            return rec.start
+    raise SoakFailure("no sys driver (UID 0002) in %r" % (records,))
+
+
+def read_reset_cause(ser: serial.Serial, addr: int, reg: int) -> int:
+    reply = _ask(ser, "S %02X %02X S %02X 01 P" % (addr, reg, addr | 1))
+    m = re.fullmatch(rb"SWASR([0-9A-F]{2})P", reply)
+    if not m:
+        raise SoakFailure("reset cause of %02X: %r" % (addr, reply))
+    return int(m.group(1), 16)
 
 
 def _ask(ser: serial.Serial, line: str, timeout: float = 10.0) -> bytes:
@@ -213,6 +234,15 @@ def _soak(sim, ser, fig, requests, seed, long_blank, log, check_every,
     slave_records = introspect(ser, slave_addr)
     check_facts(gateway, local_records)
     check_facts(slave, slave_records)
+    # the reset-cause registers: power-on only, then cleared; read again at the end
+    resets = {0xAA: reset_register(local_records), slave_addr: reset_register(slave_records)}
+    for addr, reg in resets.items():
+        cause = read_reset_cause(ser, addr, reg)
+        if cause != 0x01:
+            raise SoakFailure("board %02X reset cause %02X at the start, want 01 (power-on)"
+                              % (addr, cause))
+        if _ask(ser, "S %02X %02X FF P" % (addr, reg)) != b"SWAAP":
+            raise SoakFailure("could not clear the reset cause of %02X" % addr)
     # back to the state after reset: introspection cursor 0, status OK, register 0
     for addr in (0xAA, slave_addr):
         if _ask(ser, "S %02X 00 00 P" % addr) != b"SWAAP":
@@ -320,3 +350,9 @@ def _soak(sim, ser, fig, requests, seed, long_blank, log, check_every,
     fig.sim_seconds = (ctl.time() - t_sim0) / F_CPU
     fig.wall_seconds = time.monotonic() - t_wall0
     check_no_reset(sim, trace_pos)
+    # and the boards say so themselves: no reset of any cause since the start
+    for addr, reg in resets.items():
+        cause = read_reset_cause(ser, addr, reg)
+        if cause:
+            raise SoakFailure("board %02X reset during the soak: cause %02X" % (addr, cause))
+    fig.reset_checked = True

@@ -17,6 +17,7 @@ def test_soak_short():
     fig = run_soak(REQUESTS, SEED, log=lambda s: None, check_every=1000)
     print(fig.report())
     assert fig.requests == REQUESTS
+    assert fig.reset_checked              # both RESET registers read 00 at the end
     assert fig.replies + fig.no_reply == REQUESTS + fig.sync_requests
     # the mix reaches every error code the robot can give
     assert set(fig.errors) == {"ERROR %02X" % c for c in (2, 3, 4, 5, 6, 7)}, fig.errors
