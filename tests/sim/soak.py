@@ -111,7 +111,7 @@ def read_reset_cause(ser: serial.Serial, addr: int, reg: int) -> int:
     reply = _ask(ser, "S %02X %02X S %02X 01 P" % (addr, reg, addr | 1))
     m = re.fullmatch(rb"SWASR([0-9A-F]{2})P", reply)
     if not m:
-        raise SoakFailure("reset cause of %02X: %r" % (addr, reply))
+        raise SoakFailure("reset cause of %02X (register %02X): %r" % (addr, reg, reply))
     return int(m.group(1), 16)
 
 
@@ -351,6 +351,9 @@ def _soak(sim, ser, fig, requests, seed, long_blank, log, check_every,
     fig.wall_seconds = time.monotonic() - t_wall0
     check_no_reset(sim, trace_pos)
     # and the boards say so themselves: no reset of any cause since the start
+    # (the local address back at AA first: the requests may have moved it)
+    if _ask(ser, "LAA") != b"LAA":
+        raise SoakFailure("could not set the local address back to AA")
     for addr, reg in resets.items():
         cause = read_reset_cause(ser, addr, reg)
         if cause:
