@@ -229,7 +229,12 @@ sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 	if (p->state == ST_COMMENT || p->state == ST_ERROR) {
 		return SG_MORE;
 	}
-	if (++p->len > SG_LINE_MAX) {
+	/* Counted up to one past the limit (no wrap however many spaces);
+	 * spaces only are an empty line, whatever its length. */
+	if (p->len <= SG_LINE_MAX) {
+		p->len++;
+	}
+	if (p->len > SG_LINE_MAX && !(c == ' ' && (p->state == ST_BEGIN || p->state == ST_LEAD))) {
 		return fail(p, SG_ERR_DATA);
 	}
 	uint8_t d = hex_value(c);

@@ -293,6 +293,14 @@ static void test_limits(void)
 	memset(line, ' ', 127);
 	strcpy(line + 127, "V\r");
 	expect(line, "V1.1\r\n", "");
+	/* a line of nothing but spaces is empty, whatever its length (SPEC 2);
+	 * the spaces before a command count however many there are */
+	memset(line, ' ', 200);
+	strcpy(line + 200, "\rV\r");
+	expect(line, "V1.1\r\n", "");
+	memset(line, ' ', 290);
+	strcpy(line + 290, "V\r");
+	expect(line, "ERROR 04\r\n", "");
 }
 
 static void test_lost_characters(void)
