@@ -72,11 +72,11 @@ DRV_HW_motor := drivers/motor_hw.c
 DRV_HW_servo := $(foreach f,$(BOARD_SERVO_HW),drivers/$(f).c)
 
 FW_SRC := firmware/main.c firmware/regmap.c firmware/xact.c firmware/intro.c \
-	firmware/mcu.c firmware/pins.c firmware/board_pins.c firmware/port_io_avr.c \
+	firmware/mcu.c firmware/clock.c firmware/pins.c firmware/board_pins.c firmware/port_io_avr.c \
 	$(foreach d,$(DRIVERS),drivers/drv_$(d).c $(DRV_HW_$(d)))
 ifeq ($(MODE),gate)
 FW_SRC += firmware/uart.c firmware/twi_master.c firmware/twi_rate.c \
-	serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
+	serialgate/sg_rx.c serialgate/sg_parse.c serialgate/sg_exec.c serialgate/sg_gate.c
 else ifeq ($(MODE),slave)
 FW_SRC += i2c_slave/slave_fsm.c i2c_slave/i2c_slave.c
 else

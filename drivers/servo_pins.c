@@ -21,6 +21,7 @@
 #include "drivers/drv_servo.h"
 #include "drivers/servo_plan.h"
 #include "firmware/board_pins.h"
+#include "firmware/clock.h"
 #include "firmware/pins.h"
 #include "firmware/port_io.h"
 
@@ -36,7 +37,6 @@ static struct {
 	uint8_t next;                /* next edge of the active schedule */
 	uint32_t frame;              /* Timer0 cycle of the frame's start */
 	uint32_t target;             /* Timer0 cycle of the next edge */
-	volatile uint16_t wraps;     /* Timer2 overflows */
 	uint8_t t0_offset;           /* TCNT0 - 8 * TCNT2, measured at start */
 } sv;
 
@@ -60,10 +60,10 @@ static uint16_t servo_ticks(void)
 	uint8_t t = TCNT2;
 	if (TIFR & _BV(TOV2)) {
 		TIFR = _BV(TOV2);  /* a 1 clears that flag only */
-		sv.wraps++;
+		clock_wraps++;
 		t = TCNT2;         /* surely after the overflow */
 	}
-	return (uint16_t)(sv.wraps << 8 | t);
+	return (uint16_t)(clock_wraps << 8 | t);
 }
 
 /* Ticks from now until `cycle`. */
@@ -82,11 +82,6 @@ static bool servo_arm(void)
 	}
 	OCR2 = (uint8_t)((sv.target - SERVO_LEAD) >> 3);
 	return true;
-}
-
-ISR(TIMER2_OVF_vect)
-{
-	sv.wraps++;
 }
 
 ISR(TIMER2_COMP_vect)
@@ -153,10 +148,9 @@ void servo_hw_init(void)
 	sv.pending = 0;
 	sv.active = 0;
 	sv.sched[0].n = 0;
-	/* Timer0 counts every cycle, Timer2 every 8th; both run free. */
+	/* Timer0 counts every cycle; Timer2 counts every 8th, run free by
+	 * the time base (firmware/clock.c), which counts its overflows. */
 	TCCR0 = _BV(CS00);
-	TCCR2 = _BV(CS21);
-	TIMSK |= _BV(TOIE2);
 	/* Edge times are planned on Timer2 and met on Timer0: how far apart
 	 * the two count only shifts the last wait's window (by up to 7 cycles,
 	 * Timer2's tick), never an edge's place relative to the others. */

@@ -2,6 +2,7 @@
 #include <avr/interrupt.h>
 #include <avr/wdt.h>
 
+#include "firmware/clock.h"
 #include "firmware/front.h"
 #include "firmware/mcu.h"
 #include "firmware/pins.h"
@@ -11,6 +12,7 @@ int main(void)
 {
 	mcu_watchdog_start();
 	mcu_jtag_off();
+	clock_init();
 	pins_init();
 	regmap_init();
 	front_init();

@@ -8,6 +8,20 @@
 #include <avr/io.h>
 #include <stdint.h>
 
+#include "board.h"
+
+#define MCU_CAT3_(a, b, c) a##b##c
+#define MCU_CAT3(a, b, c)  MCU_CAT3_(a, b, c)
+
+/* The time base's 8-bit timer (the board file's BOARD_CLOCK_TIMER): the
+ * same register and bit names on both MCUs, clk/8 = CSn1 on both. */
+#define MCU_CLOCK_TCCR     MCU_CAT3(TCCR, BOARD_CLOCK_TIMER, )
+#define MCU_CLOCK_TCNT     MCU_CAT3(TCNT, BOARD_CLOCK_TIMER, )
+#define MCU_CLOCK_CLK8     _BV(MCU_CAT3(CS, BOARD_CLOCK_TIMER, 1))
+#define MCU_CLOCK_TOIE     _BV(MCU_CAT3(TOIE, BOARD_CLOCK_TIMER, ))
+#define MCU_CLOCK_TOV      _BV(MCU_CAT3(TOV, BOARD_CLOCK_TIMER, ))
+#define MCU_CLOCK_OVF_vect MCU_CAT3(TIMER, BOARD_CLOCK_TIMER, _OVF_vect)
+
 #if defined(__AVR_ATmega32__)
 #define MCU_UDR            UDR
 #define MCU_UCSRA          UCSRA
@@ -19,9 +33,6 @@
 #define MCU_RESET_FLAGS    MCUCSR
 #elif defined(__AVR_ATmega128__)
 /* Two USARTs: the board file's BOARD_UART picks the PC's. */
-#include "board.h"
-#define MCU_CAT3_(a, b, c) a##b##c
-#define MCU_CAT3(a, b, c)  MCU_CAT3_(a, b, c)
 #define MCU_UDR            MCU_CAT3(UDR, BOARD_UART, )
 #define MCU_UCSRA          MCU_CAT3(UCSR, BOARD_UART, A)
 #define MCU_UCSRB          MCU_CAT3(UCSR, BOARD_UART, B)

@@ -135,7 +135,7 @@ static void run_i2c(sg_parser_t *p)
 
 void sg_exec_lost(const sg_parser_t *p)
 {
-	for (uint8_t i = 0; i < p->lost; i++) {
+	for (uint16_t i = 0; i < p->lost; i++) {
 		out_error(SG_ERR_DATA);
 	}
 }

@@ -1,12 +1,16 @@
 /* The serial gateway front end: UART characters in, replies out. */
 #include "firmware/front.h"
 
+#include <util/atomic.h>
+
 #include "firmware/twi_master.h"
 #include "firmware/uart.h"
 #include "serialgate/sg_exec.h"
 #include "serialgate/sg_parse.h"
+#include "serialgate/sg_rx.h"
 
-_Static_assert(UART_RX_LOST == SG_CHAR_LOST, "UART and parser agree on the lost marker");
+_Static_assert(SG_RX_MARK_LOST == SG_CHAR_LOST && SG_RX_MARK_END_LOST == SG_CHAR_END_LOST &&
+	SG_RX_MARK_END_EMPTY == SG_CHAR_END_EMPTY, "receive ring and parser agree on the marks");
 
 static sg_parser_t parser;
 
@@ -15,8 +19,14 @@ void sg_out(uint8_t c)
 	uart_putc(c);
 }
 
+void uart_received(uint8_t c)
+{
+	sg_rx_put(c);
+}
+
 void front_init(void)
 {
+	sg_rx_init();
 	uart_init();
 	twi_init();
 	sg_parse_init(&parser);
@@ -25,9 +35,18 @@ void front_init(void)
 
 void front_poll(void)
 {
-	int16_t c = uart_getc();
+	int16_t c = sg_rx_get();
 	if (c < 0) {
-		return;
+		if (!sg_rx_losing()) {
+			return;
+		}
+		ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+			sg_rx_close();
+		}
+		c = sg_rx_get();
+		if (c < 0) {
+			return;
+		}
 	}
 	sg_event_t ev = sg_parse_char(&parser, (uint8_t)c);
 	if (ev == SG_REQUEST) {

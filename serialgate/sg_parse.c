@@ -175,27 +175,19 @@ static sg_event_t end_line(sg_parser_t *p)
 	return SG_REQUEST;
 }
 
-/* The record after a lost-run marker. Every line whose end was lost is
- * answered ERROR 04 now (the line in progress first, if it had something);
- * the line going on after the run is refused too if it lost its start. */
-static sg_event_t lost_run(sg_parser_t *p, uint8_t info)
+/* A byte of the record after SG_CHAR_LOST: the line in progress is gone
+ * (its end was lost, and with it its reply if it was a request, which the
+ * record counts); each lost request is answered ERROR 04. */
+static sg_event_t lost_run(sg_parser_t *p, uint8_t c)
 {
-	uint8_t lines = info & SG_LOST_LINES;
-	p->lost_info = 0;
-	if (lines == 0) {
-		/* The run lies inside the line in progress (the marker, as any
-		 * first character, already started a fresh line if need be). */
-		p->err = SG_ERR_DATA;
-		p->state = ST_ERROR;
+	if (p->lost_info == 2) {
+		p->lost = c;
+		p->lost_info = 1;
 		return SG_MORE;
 	}
-	p->lost = lines;
+	p->lost |= (uint16_t)c << 8;
 	sg_parse_init(p);
-	if (info & SG_LOST_TAIL) {
-		p->err = SG_ERR_DATA;
-		p->state = ST_ERROR;
-	}
-	return SG_LOST;
+	return p->lost ? SG_LOST : SG_IGNORED;
 }
 
 void sg_parse_init(sg_parser_t *p)
@@ -219,22 +211,33 @@ sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 	if (c == '\r' || c == '\n') {
 		return end_line(p);
 	}
+	if (c == SG_CHAR_LOST) {
+		p->lost_info = 2;
+		return SG_MORE;
+	}
+	if (c == SG_CHAR_END_LOST || c == SG_CHAR_END_EMPTY) {
+		/* the end of a line that lost characters: the receive ring knew
+		 * what the parser cannot (the lost part), so it decides */
+		p->state = ST_BEGIN;
+		if (c == SG_CHAR_END_EMPTY) {
+			return SG_IGNORED;
+		}
+		p->err = SG_ERR_DATA;
+		return SG_REQUEST;
+	}
 	if (p->state == ST_BEGIN) {
 		sg_parse_init(p);
-	}
-	if (c == SG_CHAR_LOST) {
-		p->lost_info = 1;
-		return SG_MORE;
 	}
 	if (p->state == ST_COMMENT || p->state == ST_ERROR) {
 		return SG_MORE;
 	}
-	/* Counted up to one past the limit (no wrap however many spaces);
-	 * spaces only are an empty line, whatever its length. */
 	if (p->len <= SG_LINE_MAX) {
-		p->len++;
+		p->len++;  /* stops at one over the limit */
 	}
-	if (p->len > SG_LINE_MAX && !(c == ' ' && (p->state == ST_BEGIN || p->state == ST_LEAD))) {
+	bool blank = c == ' ' && (p->state == ST_BEGIN || p->state == ST_LEAD);
+	if (p->len > SG_LINE_MAX && !blank) {
+		/* over the limit; a line of nothing but spaces is empty, however
+		 * long (no reply) */
 		return fail(p, SG_ERR_DATA);
 	}
 	uint8_t d = hex_value(c);

@@ -29,11 +29,14 @@ typedef enum {
  * and read bytes 2 reply characters each, so the limits bound this. */
 #define SG_BUF_SIZE   128
 
-/* Marker the UART puts where it lost characters, followed by one byte:
- * bits 0-6 the line ends lost, bit 7 the line going on lost characters. */
-#define SG_CHAR_LOST  0x80
-#define SG_LOST_LINES 0x7F
-#define SG_LOST_TAIL  0x80
+/* What the receive ring (serialgate/sg_rx.h) writes where it lost
+ * characters: SG_CHAR_LOST then two bytes (low, high) = the requests whose
+ * ends were lost, the line going on being gone; SG_CHAR_END_LOST in place of
+ * the end of a request that lost characters; SG_CHAR_END_EMPTY in place of
+ * the end of an empty or comment line that lost characters. */
+#define SG_CHAR_LOST      0x80
+#define SG_CHAR_END_LOST  0x81
+#define SG_CHAR_END_EMPTY 0x82
 
 typedef enum {
 	SG_CMD_NONE = 0,
@@ -62,8 +65,8 @@ typedef struct {
 	uint8_t nbytes;     /* bytes used in buf */
 	uint8_t frame;      /* index in buf of the current frame's [addr] */
 	uint8_t reply_len;  /* length of the reply this request will have */
-	uint8_t lost;       /* after SG_LOST: how many ERROR 04 to reply */
-	uint8_t lost_info;  /* the next character is the lost-run record */
+	uint16_t lost;      /* after SG_LOST: how many ERROR 04 to reply */
+	uint8_t lost_info;  /* bytes of a lost-run record still to come */
 	uint8_t buf[SG_BUF_SIZE];
 } sg_parser_t;
 

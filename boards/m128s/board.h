@@ -33,6 +33,10 @@
 #define BOARD_TWI_SCL   0
 #define BOARD_TWI_SDA   1
 
+/* The time base (firmware/clock.c): Timer0 at clk/8 (the servo counters
+ * run on Timer1 and Timer3). */
+#define BOARD_CLOCK_TIMER 0
+
 /* GPIO driver (UID 0x0021): its ports, in register order. */
 #define BOARD_GPIO_UID  0x0021
 #define BOARD_GPIO_PORTS(X) X('A') X('F')

@@ -32,6 +32,10 @@
 #define BOARD_TWI_SCL   0
 #define BOARD_TWI_SDA   1
 
+/* The time base (firmware/clock.c): Timer2 at clk/8, whose overflows the
+ * servo pulses (drivers/servo_pins.c) count on too. */
+#define BOARD_CLOCK_TIMER 2
+
 /* GPIO driver (UID 0x0020): its ports, in register order. */
 #define BOARD_GPIO_UID  0x0020
 #define BOARD_GPIO_PORTS(X) X('A') X('B') X('C') X('D')

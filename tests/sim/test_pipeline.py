@@ -81,3 +81,36 @@ def test_receive_overflow_is_error_04_never_garbage(board):
     assert b"ERROR 04" in lines                       # the buffer did overflow
     assert board.ask("V") == b"V1.1\r\n"
     assert board.ask(request[:-1].decode()) == want
+
+
+LONG = b"S AA 00 01 S AB 3C P\r"                      # 21 characters, 129 back
+
+
+def test_overflow_of_empty_lines_only_adds_no_reply(board):
+    """Issue 8: the overflow loses only line ends of empty lines: four long
+    requests, 330 empty lines and V are five requests, five replies (it had
+    been six: an ERROR 04 for the lost empty lines)."""
+    want = board.ask(LONG[:-1].decode())
+    board.gw.send(LONG * 4 + b"\n" * 330 + b"V\r")
+    lines = board.read_lines(5).split(b"\r\n")[:-1]
+    assert lines[:4] == [want[:-2]] * 4
+    assert lines[4] == b"V1.1"                        # V itself arrived whole
+    board.assert_silent()
+
+
+def test_idle_line_after_an_overflow_of_empty_lines(board):
+    """Issue 8: eleven long requests then 250 line ends: eleven replies, and
+    the next request on the quiet line is served (it had got ERROR 04)."""
+    want = board.ask(LONG[:-1].decode())
+    board.gw.send(LONG * 11 + b"\n" * 250)
+    lines = board.read_lines(11).split(b"\r\n")[:-1]
+    assert all(line in (want[:-2], b"ERROR 04") for line in lines), lines
+    board.assert_silent()                             # V now: V1.1, nothing before
+    assert board.ask("V") == b"V1.1\r\n"
+
+
+def test_long_lines_of_spaces_are_empty(board):
+    """SPEC 2: a line of nothing but spaces is empty, whatever its length."""
+    board.gw.send(b" " * 129 + b"\r" + b" " * 300 + b"\n" + b" " * 1000 + b"\r\n")
+    board.assert_silent()
+    assert board.ask(" " * 200 + "V") == b"ERROR 04\r\n"   # a request over 128

@@ -11,6 +11,7 @@
 #include "firmware/twi_rate.h"
 #include "serialgate/sg_exec.h"
 #include "serialgate/sg_parse.h"
+#include "serialgate/sg_rx.h"
 
 static int passed, failed;
 static sg_parser_t parser;
@@ -29,6 +30,7 @@ static void check(int ok, const char *what, const char *detail)
 static void boot(void)
 {
 	fakes_reset();
+	sg_rx_init();
 	regmap_init();
 	sg_parse_init(&parser);
 	sg_exec_init();
@@ -63,12 +65,12 @@ static void escape(char *dst, size_t cap, const char *s)
 
 /* Feeds `in` (on the state left by earlier calls) and compares the replies
  * and the bus traffic. bus == NULL: don't care. */
-static void expect(const char *in, const char *reply, const char *bus)
+static void expect_n(const char *in, size_t n, const char *reply, const char *bus)
 {
 	out_len = 0;
 	out_buf[0] = 0;
 	bus_log[0] = 0;
-	feed(in, strlen(in));
+	feed(in, n);
 	char a[600], b[600], c[900];
 	escape(a, sizeof a, in);
 	escape(b, sizeof b, out_buf);
@@ -82,6 +84,11 @@ static void expect(const char *in, const char *reply, const char *bus)
 		snprintf(detail, sizeof detail, "in=\"%s\" bus=\"%s\" want=\"%s\"", a, bus_log, bus);
 		check(strcmp(bus_log, bus) == 0, "bus", detail);
 	}
+}
+
+static void expect(const char *in, const char *reply, const char *bus)
+{
+	expect_n(in, strlen(in), reply, bus);
 }
 
 static void test_simple_commands(void)
@@ -248,7 +255,7 @@ static void test_limits(void)
 {
 	boot();
 	/* 128 characters: "S A0 00" + 40 data bytes " 00" = 7 + 120 = 127, + "P" */
-	char line[300];
+	char line[400];
 	strcpy(line, "S A0 00");
 	for (int i = 0; i < 40; i++) {
 		strcat(line, " 5A");
@@ -293,41 +300,244 @@ static void test_limits(void)
 	memset(line, ' ', 127);
 	strcpy(line + 127, "V\r");
 	expect(line, "V1.1\r\n", "");
-	/* a line of nothing but spaces is empty, whatever its length (SPEC 2);
-	 * the spaces before a command count however many there are */
-	memset(line, ' ', 200);
-	strcpy(line + 200, "\rV\r");
+	/* a line of nothing but spaces is empty however long: no reply */
+	memset(line, ' ', 129);
+	strcpy(line + 129, "\r");
+	expect(line, "", "");
+	memset(line, ' ', 300);
+	strcpy(line + 300, "\rV\r");
 	expect(line, "V1.1\r\n", "");
-	memset(line, ' ', 290);
-	strcpy(line + 290, "V\r");
+	memset(line, ' ', 300);
+	strcpy(line + 300, "V\r");
 	expect(line, "ERROR 04\r\n", "");
 }
 
 static void test_lost_characters(void)
 {
 	boot();
-	/* a run lost inside one line: that line is refused, the next is fine */
-	char in[] = "S A0 00 12 \x80\x80 P\rV\r";
-	expect(in, "ERROR 04\r\nV1.1\r\n", "");
-	/* the run ate the end of "S A0 00" and two whole lines, and the start of
-	 * the line after it: four ERROR 04, then the next line as usual */
-	char in2[] = "S A0 00\x80\x82 00 P\rV\r";
-	expect(in2, "ERROR 04\r\nERROR 04\r\nERROR 04\r\nV1.1\r\n", "");
+	/* characters lost inside one line: the ring ends it with 0x81, ERROR 04 */
+	char in[] = "S A0 00 12 P\x81V\r";
+	expect_n(in, sizeof in - 1, "ERROR 04\r\nV1.1\r\n", "");
+	/* ... or with 0x82 when the line held nothing (spaces, a comment) */
+	char in1[] = "   \x82#x\x82V\r";
+	expect_n(in1, sizeof in1 - 1, "V1.1\r\n", "");
+	/* a run ate the end of "S A0 00" and two whole requests, and the
+	 * start of the line after it: three ERROR 04 and one for that line */
+	char in2[] = "S A0 00\x80\x03\x00 00 P\x81V\r";
+	expect_n(in2, sizeof in2 - 1, "ERROR 04\r\nERROR 04\r\nERROR 04\r\nERROR 04\r\nV1.1\r\n", "");
 	/* the run ended at a line end: the line after it is whole */
-	char in3[] = "S A0 00\x80\x02V\rV\r";
-	expect(in3, "ERROR 04\r\nERROR 04\r\nV1.1\r\nV1.1\r\n", "");
-	/* the record byte can be any value, a line end's too */
-	char in4[] = "V\x80\x0D\rV\r";
-	expect(in4, NULL, NULL);
-	char want4[200] = "";
-	for (int i = 0; i < 13; i++) {
-		strcat(want4, "ERROR 04\r\n");
+	char in3[] = "S A0 00\x80\x02\x00V\rV\r";
+	expect_n(in3, sizeof in3 - 1, "ERROR 04\r\nERROR 04\r\nV1.1\r\nV1.1\r\n", "");
+	/* the count's bytes can be any value, a line end's too: 0x010D */
+	boot();
+	char in4[] = "V\x80\x0D\x01\rV\r";
+	out_len = 0;
+	feed(in4, sizeof in4 - 1);
+	check(out_len == 0x10D * 10 + 6 && strcmp(out_buf + 0x10D * 10, "V1.1\r\n") == 0,
+		"269 lost requests", NULL);
+	/* the issue-8 defect: a run that lost only line ends of empty lines
+	 * is no request (it had given an extra ERROR 04) */
+	boot();
+	char in5[] = "V\r\x80\x00\x00\rV\r";
+	expect_n(in5, sizeof in5 - 1, "V1.1\r\nV1.1\r\n", "");
+	/* and the line going on before the run is gone, not joined to the
+	 * next one: "#x" then a lost line end then "V" */
+	char in6[] = "#x\x80\x00\x00V\r";
+	expect_n(in6, sizeof in6 - 1, "V1.1\r\n", "");
+}
+
+/* --- the receive ring (sg_rx.c) in front of the parser --------------------
+ * A model of the firmware on a wire at full speed: one character arrives per
+ * character time; the main loop takes characters while it is not busy, and
+ * a reply keeps it busy for its length times `busy` character times (the
+ * transmit side), so replies longer than requests overflow the ring. */
+static void wire(const char *in, size_t n, unsigned busy_num, unsigned busy_den)
+{
+	unsigned busy = 0;  /* in 1/busy_den character times */
+	for (size_t i = 0;; i++) {
+		if (i < n) {
+			sg_rx_put((uint8_t)in[i]);
+		}
+		busy = busy > busy_den ? busy - busy_den : 0;
+		while (busy == 0) {
+			int16_t c = sg_rx_get();
+			if (c < 0) {
+				if (!sg_rx_losing()) {
+					break;
+				}
+				sg_rx_close();
+				continue;
+			}
+			unsigned before = out_len;
+			sg_event_t ev = sg_parse_char(&parser, (uint8_t)c);
+			if (ev == SG_REQUEST) {
+				sg_exec(&parser);
+			} else if (ev == SG_LOST) {
+				sg_exec_lost(&parser);
+			}
+			busy = (out_len - before) * busy_num;
+		}
+		if (i >= n && busy == 0) {
+			return;  /* everything taken, the line quiet */
+		}
 	}
-	strcat(want4, "V1.1\r\n");
-	check(strcmp(out_buf, want4) == 0, "13 lost lines", out_buf);
-	/* a comment can lose characters too: refused */
-	char in5[] = "#comment\x80\x80V\rV\r";
-	expect(in5, "ERROR 04\r\nV1.1\r\n", "");
+}
+
+static int count_lines(const char *s)
+{
+	int n = 0;
+	for (; *s; s++) {
+		n += *s == '\n';
+	}
+	return n;
+}
+
+static void test_receive_overflow(void)
+{
+	static char in[8192];
+	/* issue 8: four 127-character replies, then 330 line ends of empty
+	 * lines, then V: five requests, five replies */
+	boot();
+	in[0] = 0;
+	for (int i = 0; i < 4; i++) {
+		strcat(in, "S AA 00 01 S AB 3C P\r");
+	}
+	size_t k = strlen(in);
+	memset(in + k, '\n', 330);
+	strcpy(in + k + 330, "V\r");
+	out_len = 0;
+	out_buf[0] = 0;
+	wire(in, strlen(in), 1, 1);
+	check(count_lines(out_buf) == 5, "4 long replies, 330 empty lines, V: 5 replies", out_buf);
+	check(out_len >= 6 && strcmp(out_buf + out_len - 6, "V1.1\r\n") == 0, "V answered last", out_buf);
+	/* eleven long replies then 250 line ends, then later a V on an idle
+	 * line: twelve replies, the V's V1.1 */
+	boot();
+	in[0] = 0;
+	for (int i = 0; i < 11; i++) {
+		strcat(in, "S AA 00 01 S AB 3C P\r");
+	}
+	k = strlen(in);
+	memset(in + k, '\n', 250);
+	in[k + 250] = 0;
+	out_len = 0;
+	out_buf[0] = 0;
+	wire(in, strlen(in), 1, 1);
+	check(count_lines(out_buf) == 11, "11 long replies then 250 empty lines: 11 replies", out_buf);
+	wire("V\r", 2, 1, 1);
+	check(count_lines(out_buf) == 12 && strcmp(out_buf + out_len - 6, "V1.1\r\n") == 0,
+		"V on an idle line after the run", out_buf);
+	/* a line of spaces whose end is lost is no request either, and the
+	 * end of a space line that lost spaces gets no reply */
+	boot();
+	in[0] = 0;
+	for (int i = 0; i < 3; i++) {
+		strcat(in, "S AA 00 01 S AB 3C P\r");
+	}
+	k = strlen(in);
+	for (int i = 0; i < 60; i++) {
+		memcpy(in + k, "     \r\n", 7);
+		k += 7;
+	}
+	strcpy(in + k, "V\r");
+	out_len = 0;
+	out_buf[0] = 0;
+	wire(in, strlen(in), 1, 1);
+	check(count_lines(out_buf) == 4 && strcmp(out_buf + out_len - 6, "V1.1\r\n") == 0,
+		"lines of spaces lost: no replies", out_buf);
+}
+
+/* Random requests over a wire that overflows: every request gets exactly one
+ * reply, in order, either the one it gets without overflow or ERROR 04.
+ * Only requests whose replies do not depend on what ran before. */
+static void test_overflow_fuzz(void)
+{
+	static const char *const pool[] = {
+		"V", "X", "L", "C", "S AA 00 00 S AB 01 P", "S AA 00 01 S AB 3C P",
+		"S A0 10 S A1 04 P", "S A0 P", "S 42 P", "Q", "S AA", "V 1", "S A1 00 P",
+		"  V  ", "#a comment", "", "   ", "#", " #not a comment", "s aa 00 02 s ab 06 p",
+	};
+	static const char *const ends[] = { "\r", "\n", "\r\n" };
+	static char in[20000];
+	static char ref[200000];
+	uint32_t seed = 8;
+	int bad = 0, overflowed = 0, errors = 0;
+	for (int round = 0; round < 400 && bad < 3; round++) {
+		size_t n = 0;
+		int lines = 0, requests = 0;
+		const char *which[400];
+		int nreq = 0;
+		while (n < 4000 + (size_t)(round % 7) * 2000 && lines < 399) {
+			seed ^= seed << 13;
+			seed ^= seed >> 17;
+			seed ^= seed << 5;
+			const char *r = pool[seed % (sizeof pool / sizeof pool[0])];
+			const char *e = ends[(seed >> 8) % 3];
+			size_t rl = strlen(r), el = strlen(e);
+			memcpy(in + n, r, rl);
+			memcpy(in + n + rl, e, el);
+			n += rl + el;
+			lines++;
+			bool req = false;
+			for (const char *q = r; *q; q++) {
+				req |= *q != ' ';
+			}
+			if (req && r[0] != '#') {
+				which[nreq++] = r;
+				requests++;
+			}
+		}
+		/* the replies without overflow, one per request */
+		boot();
+		out_len = 0;
+		out_buf[0] = 0;
+		feed(in, n);
+		if (count_lines(out_buf) != requests) {
+			bad++;
+			printf("overflow fuzz %d: reference gives %d replies for %d requests\n", round,
+				count_lines(out_buf), requests);
+			continue;
+		}
+		memcpy(ref, out_buf, out_len + 1);
+		/* the same over a wire three times slower at replying than at
+		 * receiving (sometimes not slower: no overflow) */
+		boot();
+		out_len = 0;
+		out_buf[0] = 0;
+		unsigned num = 1 + (seed >> 3) % 4, den = 1 + (seed >> 5) % 2;
+		wire(in, n, num, den);
+		const char *g = out_buf, *w = ref;
+		int got = 0, lost_here = 0;
+		while (*g && *w) {
+			const char *ge = strchr(g, '\n'), *we = strchr(w, '\n');
+			if (!ge || !we) {
+				break;
+			}
+			size_t gl = (size_t)(ge - g + 1), wl = (size_t)(we - w + 1);
+			bool same = gl == wl && memcmp(g, w, gl) == 0;
+			bool refused = gl == 10 && memcmp(g, "ERROR 04\r\n", 10) == 0;
+			if (!same && !refused) {
+				bad++;
+				printf("overflow fuzz %d: reply %d of \"%s\" is \"%.*s\", want \"%.*s\" or ERROR 04\n",
+					round, got, which[got], (int)gl - 2, g, (int)wl - 2, w);
+				break;
+			}
+			lost_here += refused && !same;
+			got++;
+			g = ge + 1;
+			w = we + 1;
+		}
+		int replies = count_lines(out_buf);
+		if (replies != requests) {
+			bad++;
+			printf("overflow fuzz %d (busy %u/%u): %d replies for %d requests\n", round, num, den,
+				replies, requests);
+		}
+		overflowed += lost_here > 0;
+		errors += lost_here;
+	}
+	check(bad == 0, "overflow fuzz: one reply per request, each its own or ERROR 04", NULL);
+	check(overflowed > 100 && errors > 1000, "overflow fuzz overflowed", NULL);
 }
 
 static void test_registers(void)
@@ -404,32 +614,15 @@ static void test_fuzz(void)
 			in[n] = alphabet[seed % (sizeof alphabet - 1)];
 		}
 		/* expected replies: lines with a non-space character, not starting
-		 * with '#', or with lost characters */
-		int lines = 0, content = 0, comment = 0, first = 1, lost = 0;
+		 * with '#' (bytes >= 0x80 from the line are characters like any) */
+		int lines = 0, content = 0, comment = 0, first = 1;
 		for (size_t i = 0; i < n; i++) {
 			char c = in[i];
-			if ((unsigned char)c == 0x80) {
-				/* a lost-run record: the next byte says what was lost */
-				if (++i == n) {
-					break;
-				}
-				unsigned char info = (unsigned char)in[i];
-				if ((info & 0x7F) == 0) {
-					lost = 1;
-					first = 0;
-				} else {
-					lines += info & 0x7F;
-					content = comment = 0;
-					first = 1;
-					lost = (info & 0x80) != 0;
-				}
-				continue;
-			}
 			if (c == '\r' || c == '\n') {
-				if (lost || (content && !comment)) {
+				if (content && !comment) {
 					lines++;
 				}
-				content = comment = lost = 0;
+				content = comment = 0;
 				first = 1;
 				continue;
 			}
@@ -441,7 +634,7 @@ static void test_fuzz(void)
 			first = 0;
 		}
 		out_len = 0;
-		feed(in, n);
+		wire(in, n, 0, 1);  /* through the receive ring, never full */
 		int replies = 0;
 		for (unsigned i = 0; i + 1 < out_len + 1 && i < out_len; i++) {
 			if (out_buf[i] == '\n') {
@@ -481,6 +674,8 @@ int main(void)
 	test_i2c_parse_errors();
 	test_limits();
 	test_lost_characters();
+	test_receive_overflow();
+	test_overflow_fuzz();
 	test_registers();
 	test_fuzz();
 	printf("%d passed, %d failed\n", passed, failed);

@@ -1,0 +1,29 @@
+/*
+ * The board's time base: an 8-bit timer counting F_CPU/8 whose overflow
+ * interrupt counts wraps, so one tick is 2048 cycles (1/3600 s at
+ * 7.3728 MHz). The board file names the timer (BOARD_CLOCK_TIMER). Bus
+ * timeouts and the link-loss failsafe measure time with it; it runs in
+ * every build, whatever drivers are linked.
+ */
+#ifndef ORFA_CLOCK_H
+#define ORFA_CLOCK_H
+
+#include <stdint.h>
+
+#define CLOCK_TICK_CYCLES 2048UL
+#define CLOCK_HZ (F_CPU / CLOCK_TICK_CYCLES)
+/* Ticks in `ms` milliseconds, rounded up (a constant expression). */
+#define CLOCK_TICKS_MS(ms) ((uint16_t)(((ms) * CLOCK_HZ + 999UL) / 1000UL))
+
+/* Timer overflows so far; the timer's count is the low byte of a tick.
+ * Written by the overflow interrupt, and by code that runs with interrupts
+ * off and counts an overflow whose interrupt is pending (servo_pins.c). */
+extern volatile uint16_t clock_wraps;
+
+void clock_init(void);
+
+/* Ticks since clock_init, wrapping every 65536 (18.2 s): differences of
+ * two readings are exact up to that. */
+uint16_t clock_now(void);
+
+#endif
