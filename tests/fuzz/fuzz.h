@@ -28,9 +28,11 @@ int fuzz_gate_unchanged(void);      /* nothing changed since fuzz_gate_save */
 void fuzz_gate_after_line(void);    /* board invariants after each line */
 
 /* Feeds the input to the parser and executor, checking every reply. The
- * first byte chooses: bit 0 clear, the rest with bit 7 cleared (no UART
- * lost-run markers: the line/reply model holds exactly); set, the bytes as
- * they are (markers too: replies are checked for form only). */
+ * first byte % 3 chooses: 0, the rest with bit 7 cleared straight into the
+ * parser (no lost-run marks: the line/reply model holds line by line);
+ * 1, the bytes as they are (made-up marks too: replies are checked for form
+ * only); 2, the bytes through the receive ring (sg_rx.c), taken out at a
+ * rate the first byte's bits 2-7 set, so that it overflows. */
 void fuzz_gate_run(const uint8_t *data, size_t size);
 
 /* --- a board's real drivers over hw_fakes (fuzz_board.c) --------------- */
