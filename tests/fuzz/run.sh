@@ -3,7 +3,8 @@
 # kept corpus (corpus/<harness>/, the boards' builds sharing one), new inputs
 # going to a temporary copy, so the repository's corpus is never written.
 #   run.sh short SECONDS harness...   each harness SECONDS seconds
-#   run.sh long RUNS harness...       each harness RUNS executions
+#   run.sh long RUNS harness...       each harness RUNS executions (or at
+#                                     most MAX_TIME seconds, if set)
 # Prints one line per harness: executions, time, exec/s, coverage. A finding
 # stops the run: the input is in build/fuzz/artifacts/, the log printed.
 set -eu
@@ -26,7 +27,7 @@ for h in "$@"; do
 	if [ "$mode" = short ]; then
 		limit="-max_total_time=$amount"
 	else
-		limit="-runs=$amount"
+		limit="-runs=$amount${MAX_TIME:+ -max_total_time=$MAX_TIME}"
 	fi
 	tmp=$(mktemp -d)
 	mkdir -p "$tmp/corpus"
