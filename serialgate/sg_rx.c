@@ -26,8 +26,10 @@ void sg_rx_init(void)
 	rx.line = 0;
 }
 
-/* The run of lost characters is over: its record, if a line ended in it. */
-static uint8_t end_run(uint8_t head)
+/* The run of lost characters is over: its record, if a line ended in it.
+ * Inlined: a call from the receive interrupt would make it save every
+ * call-clobbered register, on every character. */
+static inline __attribute__((always_inline)) uint8_t end_run(uint8_t head)
 {
 	if (rx.ends_lost) {
 		rx.buf[head] = SG_RX_MARK_LOST;
@@ -40,9 +42,9 @@ static uint8_t end_run(uint8_t head)
 	return head;
 }
 
-void sg_rx_put(uint8_t c)
+/* A line end, or any character while the ring is full or nearly. */
+static inline __attribute__((always_inline)) void put_slow(uint8_t c, uint8_t head)
 {
-	uint8_t head = rx.head;
 	uint8_t room = (uint8_t)(rx.tail - head - 1);
 
 	if (rx.losing) {
@@ -80,18 +82,37 @@ void sg_rx_put(uint8_t c)
 			line |= LINE_CONTENT;
 		}
 		if (rx.losing) {
-			line |= LINE_LOST;
-		}
-		rx.line = line;
-		if (rx.losing) {
+			rx.line = line | LINE_LOST;
 			return;
 		}
+		rx.line = line;
 		if (c >= SG_RX_MARK_LOST) {
 			c = 0x7F;
 		}
 	}
 	rx.buf[head] = c;
 	rx.head = (uint8_t)(head + 1);
+}
+
+void sg_rx_put(uint8_t c)
+{
+	uint8_t head = rx.head;
+	uint8_t line = rx.line;
+
+	/* The common case first: a character inside a line, room to spare. */
+	if (c != '\r' && c != '\n' && !rx.losing &&
+		(uint8_t)(rx.tail - head - 1) > SG_RX_RECORD && (line & LINE_STARTED)) {
+		if (c != ' ') {
+			rx.line = line | LINE_CONTENT;
+		}
+		if (c >= SG_RX_MARK_LOST) {
+			c = 0x7F;
+		}
+		rx.buf[head] = c;
+		rx.head = (uint8_t)(head + 1);
+		return;
+	}
+	put_slow(c, head);
 }
 
 int16_t sg_rx_get(void)
