@@ -6,6 +6,8 @@
 #   make size           flash and static RAM of every build in build/
 #   make sim            build/sim/orfa-sim
 #   make unit           host-compiled unit tests of the parser and register logic
+#   make fuzz-short     each libFuzzer harness a few seconds (about a minute in all)
+#   make fuzz           the long run: 10^7 executions per harness (docs/fuzzing.md)
 #   make test           install what is missing, build everything, run all tests
 #   make bench          cycle-exact benchmark table
 #   make soak           the long differential soak (SOAK_REQUESTS, SOAK_SEED)
@@ -95,7 +97,7 @@ $(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 
-.PHONY: print-baud-rates firmware all-boards robot size sim unit test bench soak demo demo-robot clean setup
+.PHONY: print-baud-rates firmware all-boards robot size sim unit fuzz fuzz-short test bench soak demo demo-robot clean setup
 .DEFAULT_GOAL := firmware
 
 firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
@@ -161,12 +163,23 @@ build/sim/orfa-sim: $(SIM_SRC) $(SIM_HDR)
 unit:
 	@$(MAKE) --no-print-directory -C tests/unit
 
+# libFuzzer harnesses (clang; tests/fuzz, docs/fuzzing.md): from the corpus
+# kept in tests/fuzz/corpus/, new inputs to a temporary copy.
+FUZZ_SHORT_TIME ?= 8
+FUZZ_RUNS ?= 10000000
+fuzz-short:
+	@$(MAKE) --no-print-directory -C tests/fuzz short SHORT_TIME=$(FUZZ_SHORT_TIME)
+
+fuzz:
+	@$(MAKE) --no-print-directory -C tests/fuzz long RUNS=$(FUZZ_RUNS)
+
 setup:
 	@tools/setup.sh
 
 test: setup
 	@$(MAKE) --no-print-directory all-boards robot sim
 	@$(MAKE) --no-print-directory unit
+	@$(MAKE) --no-print-directory fuzz-short
 	python3 -m pytest -q tests
 
 bench: setup

@@ -3,7 +3,9 @@
 # Idempotent and quiet when everything is there already.
 set -eu
 
-APT_PACKAGES="gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev"
+# clang and its runtime (-fsanitize=fuzzer) for tests/fuzz: Debian's clang
+# is 14 on bookworm, whose libFuzzer comes in libclang-rt-14-dev.
+APT_PACKAGES="gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-14-dev"
 # python module:pip package
 PY_PACKAGES="serial:pyserial pytest:pytest"
 

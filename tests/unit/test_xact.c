@@ -15,31 +15,7 @@
 #include "drv_test.h"
 #include "firmware/xact.h"
 #include "i2c_slave/slave_fsm.h"
-
-#define SLAVE_BUF 64
-
-typedef struct {
-	uint8_t reg;
-	uint8_t read;        /* read frame of n bytes, else write frame */
-	uint8_t n;           /* read count, or data bytes after the register */
-	uint8_t data[SLAVE_BUF];
-} frame_t;
-
-/* What a frame gave: acknowledges, bytes read, the result at its end. */
-typedef struct {
-	uint8_t acks;        /* bytes acknowledged, register byte included */
-	uint8_t got[SLAVE_BUF];
-	uint8_t ok;          /* read: register could be read */
-	uint8_t end;         /* xact_frame_end() */
-	uint8_t status;      /* the status register afterwards */
-} result_t;
-
-/* The status register's value, without selecting register 01 (so a read
- * frame of the fuzz reads the register its own select named). */
-static uint8_t status_now(void)
-{
-	return (uint8_t)regmap_status();
-}
+#include "xact_model.h"
 
 static uint8_t status_read(void)
 {
@@ -51,114 +27,6 @@ static uint8_t status_read(void)
 	xact_read_processed(&st);
 	xact_frame_end();
 	return st;
-}
-
-/* The gateway's way (serialgate/sg_exec.c run_local): the frame's bytes are
- * the buffer, the read length is known, a read's bytes are taken at once
- * (xact_read_take: n byte events in one call). A write frame is [reg][data], so its
- * select is part of it; a read frame reads the selected register. */
-static void run_gateway(const frame_t *f, result_t *r)
-{
-	uint8_t bytes[1 + SLAVE_BUF];
-	memset(r, 0, sizeof *r);
-	if (f->read) {
-		/* all n byte events at once, as the gateway takes them */
-		r->ok = xact_read_requested(r->got, f->n) && xact_read_take(f->n);
-		if (!r->ok) {
-			memset(r->got, 0, sizeof r->got);
-		}
-	} else {
-		bytes[0] = f->reg;
-		memcpy(bytes + 1, f->data, f->n);
-		xact_write_requested(bytes + 1, f->n);
-		for (uint8_t k = 0; k <= f->n && xact_write_received(bytes[k]); k++) {
-			r->acks++;
-		}
-	}
-	r->end = xact_frame_end();
-	r->status = status_now();
-}
-
-/* The slave's way (i2c_slave/): its own 64-byte buffer, bytes one at a time
- * with no length known; the master stops after n. */
-static void run_slave(const frame_t *f, result_t *r)
-{
-	static uint8_t buf[SLAVE_BUF];
-	memset(r, 0, sizeof *r);
-	if (f->read) {
-		r->ok = xact_read_requested(buf, sizeof buf);
-		for (uint8_t k = 0; k < f->n && r->ok; k++) {
-			r->ok = xact_read_processed(&r->got[k]);
-		}
-		if (!r->ok) {
-			memset(r->got, 0, sizeof r->got);
-		}
-	} else {
-		xact_write_requested(buf, sizeof buf);
-		if (xact_write_received(f->reg)) {
-			r->acks++;
-			for (uint8_t k = 0; k < f->n && xact_write_received(f->data[k]); k++) {
-				r->acks++;
-			}
-		}
-	}
-	r->end = xact_frame_end();
-	r->status = status_now();
-}
-
-/* The whole slave (i2c_slave/slave_fsm.c) under a model of the AVR TWI: the
- * status codes the hardware gives for a master's frame, TWEA deciding the
- * next byte's acknowledge, deferred work done as the main loop would. */
-static slave_action_t twi_event(uint8_t status, uint8_t *byte)
-{
-	slave_action_t act = slave_fsm_event(status, byte);
-	if (act == SLAVE_DEFER) {
-		act = slave_fsm_work(byte);
-	}
-	return act;
-}
-
-static void run_twi(const frame_t *f, result_t *r)
-{
-	uint8_t b = 0;
-	memset(r, 0, sizeof *r);
-	if (f->read) {
-		int sent_ok = twi_event(TW_ST_SLA_ACK, &b) == SLAVE_SEND;
-		CHECK(slave_fsm_in_frame());
-		r->got[0] = b;
-		for (uint8_t k = 1; k < f->n; k++) {
-			sent_ok &= twi_event(TW_ST_DATA_ACK, &b) == SLAVE_SEND;
-			r->got[k] = b;
-		}
-		sent_ok &= twi_event(TW_ST_DATA_NACK, &b) == SLAVE_ACK;
-		CHECK(sent_ok);
-		CHECK(!slave_fsm_in_frame());  /* the master's NACK ends it */
-		r->status = status_now();
-		r->ok = 1;  /* the TWI cannot refuse: compared as FF bytes */
-		return;
-	}
-	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
-	CHECK(slave_fsm_in_frame());
-	int twea = 1, addressed = 1;
-	for (uint8_t k = 0; k <= f->n && addressed; k++) {
-		b = k ? f->data[k - 1] : f->reg;
-		if (!twea) {
-			/* the byte after a refusal is not acknowledged, and the
-			 * TWI leaves the frame */
-			CHECK_EQ(twi_event(TW_SR_DATA_NACK, &b), SLAVE_ACK);
-			addressed = 0;
-			break;
-		}
-		twea = twi_event(TW_SR_DATA_ACK, &b) == SLAVE_ACK;
-		r->acks = (uint8_t)(r->acks + twea);
-	}
-	if (addressed) {
-		CHECK(slave_fsm_in_frame());
-		CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
-	}
-	/* a STOP or a refused byte ends the frame (the slave's stall timer) */
-	CHECK(!slave_fsm_in_frame());
-	r->status = status_now();
 }
 
 static uint32_t rng_state;
@@ -226,9 +94,9 @@ static void test_equal_to_frames(void)
 		for (unsigned i = 0; i < FRAMES; i++) {
 			random_frame(&seq[i]);
 		}
-		run_seq(seq, FRAMES, a, sa, run_gateway);
-		run_seq(seq, FRAMES, b, sb, run_slave);
-		run_seq(seq, FRAMES, c, sc, run_twi);
+		run_seq(seq, FRAMES, a, sa, xact_model_gateway);
+		run_seq(seq, FRAMES, b, sb, xact_model_slave);
+		run_seq(seq, FRAMES, c, sc, xact_model_twi);
 		for (unsigned i = 0; i < FRAMES; i++) {
 			sa[i].end = sb[i].end = sc[i].end = 0;  /* in the status too */
 			reads += seq[i].read && a[i].ok && seq[i].reg > REGMAP_STATUS_REG;
@@ -437,62 +305,62 @@ static void test_aborted_frames(void)
 	boot();
 	slave_fsm_init();
 	uint8_t sp = B.servo_sp;
-	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
 	b = sp;
-	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
 	b = 0x00;
-	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
 	b = 0x05;
-	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
 	b = 0xDC;
-	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
-	CHECK_EQ(twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
+	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
 	READ(sp, 2, "00 00");                    /* nothing applied */
 	/* the next frame is served: the same write, ended properly */
-	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
 	const uint8_t w[4] = { sp, 0x00, 0x05, 0xDC };
 	for (int i = 0; i < 4; i++) {
 		b = w[i];
-		CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+		CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
 	}
-	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
 	READ(sp, 2, "05 DC");
 	/* a read the master ends with a STOP after an ACK: no event comes
 	 * (the TWI leaves the frame by itself); the next write is served.
 	 * (READ above left the status register selected: select SP.) */
-	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
 	b = sp;
-	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
-	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
-	CHECK_EQ(twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
 	CHECK_EQ(b, 0x05);
-	CHECK_EQ(twi_event(TW_ST_DATA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(xact_model_twi_event(TW_ST_DATA_ACK, &b), SLAVE_SEND);
 	CHECK_EQ(b, 0xDC);
-	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
 	const uint8_t off[4] = { sp, 0x00, 0x00, 0x00 };
 	for (int i = 0; i < 4; i++) {
 		b = off[i];
-		CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+		CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
 	}
-	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
 	READ(sp, 2, "00 00");
 	/* No register selected after an unmapped one, also across a bus
 	 * error: a read gives FF, the status keeps 08. */
-	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
 	b = 0x00;
-	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
-	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
-	CHECK_EQ(twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
 	b = 0xFE;
-	CHECK_EQ(twi_event(TW_SR_DATA_ACK, &b), SLAVE_NACK);
-	CHECK_EQ(twi_event(TW_SR_STOP, &b), SLAVE_ACK);
-	CHECK_EQ(twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_NACK);
+	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
 	CHECK_EQ(b, 0xFF);
-	CHECK_EQ(twi_event(TW_ST_DATA_NACK, &b), SLAVE_ACK);
-	CHECK_EQ(twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
-	CHECK_EQ(twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(xact_model_twi_event(TW_ST_DATA_NACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
+	CHECK_EQ(xact_model_twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
 	CHECK_EQ(b, 0xFF);
-	CHECK_EQ(twi_event(TW_ST_DATA_NACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_ST_DATA_NACK, &b), SLAVE_ACK);
 	CHECK_EQ(regmap_status(), REG_NO_REGISTER);
 }
 
