@@ -462,20 +462,7 @@ def wd_stream(ctl, start, line, until):
     """`line` again and again on the serial line from `start` (or a little
     after now, should the simulation have passed it while we asked) to
     `until`; returns (the first line's start, the last one's end)."""
-    per = RX_MAX // len(line) if until else 1
-    while True:
-        try:
-            end = ctl.rx(start, line * per)
-            break
-        except SimControlError as e:
-            if "is past" not in str(e):
-                raise
-            start = ctl.time() + 20 * WD_MS
-    first, at = start, end
-    while at < until:
-        end = ctl.rx(at, line * per)
-        at = end
-    return first, end
+    return ctl.rx_stream(start, line, until, 20 * WD_MS)
 
 
 def wd_replies(events, since):

@@ -196,6 +196,27 @@ class SimControl:
             raise ValueError("rx takes 1..%d bytes, not %d" % (RX_MAX, len(data)))
         return int(self.request("rx %d %s" % (cycle, bytes(data).hex().upper())))
 
+    def rx_stream(self, cycle: int, line: bytes, until: int, slip: int) -> Tuple[int, int]:
+        """`line` (a request and its terminator) again and again on the serial
+        line, back to back, from `cycle` (or `slip` cycles after now, should
+        the simulation have passed it while it was asked: a loaded machine)
+        until `until` (0: once); returns (the first start bit's cycle, the
+        last stop bit's end)."""
+        per = RX_MAX // len(line) if until else 1
+        while True:
+            try:
+                end = self.rx(cycle, line * per)
+                break
+            except SimControlError as e:
+                if "is past" not in str(e):
+                    raise
+                cycle = self.time() + slip
+        first, at = cycle, end
+        while at < until:
+            end = self.rx(at, line * per)
+            at = end
+        return first, end
+
     def fault_hang(self) -> int:
         """The board stops running its program (interrupts off, the PC on an
         endless loop) until its watchdog resets it; returns the cycle."""

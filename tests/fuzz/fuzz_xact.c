@@ -49,22 +49,6 @@ static uint8_t next(void)
 static frame_t seq[FRAMES_MAX];
 static result_t res[3][FRAMES_MAX], sel[3][FRAMES_MAX];
 
-static void run_seq(unsigned n, result_t *out, result_t *sel_out,
-		    void (*run)(const frame_t *, result_t *))
-{
-	boot();
-	xact_init();
-	slave_fsm_init();
-	for (unsigned i = 0; i < n; i++) {
-		memset(&sel_out[i], 0, sizeof sel_out[i]);
-		if (seq[i].read) {
-			frame_t s = { .reg = seq[i].reg, .read = 0, .n = 0 };
-			run(&s, &sel_out[i]);
-		}
-		run(&seq[i], &out[i]);
-	}
-}
-
 static void frames(uint8_t nregs)
 {
 	unsigned n = 0;
@@ -80,9 +64,9 @@ static void frames(uint8_t nregs)
 			f->data[k] = next();
 		}
 	}
-	run_seq(n, res[0], sel[0], xact_model_gateway);
-	run_seq(n, res[1], sel[1], xact_model_slave);
-	run_seq(n, res[2], sel[2], xact_model_twi);
+	xact_model_run(seq, n, res[0], sel[0], xact_model_gateway);
+	xact_model_run(seq, n, res[1], sel[1], xact_model_slave);
+	xact_model_run(seq, n, res[2], sel[2], xact_model_twi);
 	for (unsigned i = 0; i < n; i++) {
 		const frame_t *f = &seq[i];
 		sel[0][i].end = sel[1][i].end = sel[2][i].end = 0;  /* in the status too */

@@ -15,7 +15,6 @@ from conftest import (DRV_TARGETS, F_CPU, GATEWAY_OF_SLAVES, SERVO_FRAME, DrvBen
                       require_builds, require_slave, running, target)
 from orfa import boards
 from orfa.sim import SimBoard
-from orfa.simctl import RX_MAX, SimControlError
 
 MS = F_CPU // 1000                  # cycles per millisecond
 BYTE = 640                          # cycles per byte at 115200 baud
@@ -83,21 +82,7 @@ def stream(b, start, line, until):
     gateway's serial line from cycle `start` (or a little after now, should
     the simulation have passed it while we asked) until `until`; returns
     the cycle the last one's terminator arrives."""
-    ctl = b.sim.control
-    per = RX_MAX // len(line) if until else 1
-    while True:
-        try:
-            end = ctl.rx(start, line * per)
-            break
-        except SimControlError as e:
-            if "is past" not in str(e):
-                raise
-            start = ctl.time() + 20 * MS
-    at = end
-    while at < until:
-        end = ctl.rx(at, line * per)
-        at = end
-    return end
+    return b.sim.control.rx_stream(start, line, until, 20 * MS)[1]
 
 
 def reply_lines(b, since_cycle):

@@ -63,24 +63,6 @@ static void random_frame(frame_t *f)
 	}
 }
 
-/* A read frame reads its register: the select runs first as a write frame
- * of its own (its result is compared too), as a host would send it. */
-static void run_seq(const frame_t *seq, unsigned n, result_t *out, result_t *sel_out,
-		    void (*run)(const frame_t *, result_t *))
-{
-	boot();
-	xact_init();
-	slave_fsm_init();
-	for (unsigned i = 0; i < n; i++) {
-		memset(&sel_out[i], 0, sizeof sel_out[i]);
-		if (seq[i].read) {
-			frame_t sel = { .reg = seq[i].reg, .read = 0, .n = 0 };
-			run(&sel, &sel_out[i]);
-		}
-		run(&seq[i], &out[i]);
-	}
-}
-
 static void test_equal_to_frames(void)
 {
 	enum { ROUNDS = 300, FRAMES = 40 };
@@ -94,9 +76,9 @@ static void test_equal_to_frames(void)
 		for (unsigned i = 0; i < FRAMES; i++) {
 			random_frame(&seq[i]);
 		}
-		run_seq(seq, FRAMES, a, sa, xact_model_gateway);
-		run_seq(seq, FRAMES, b, sb, xact_model_slave);
-		run_seq(seq, FRAMES, c, sc, xact_model_twi);
+		xact_model_run(seq, FRAMES, a, sa, xact_model_gateway);
+		xact_model_run(seq, FRAMES, b, sb, xact_model_slave);
+		xact_model_run(seq, FRAMES, c, sc, xact_model_twi);
 		for (unsigned i = 0; i < FRAMES; i++) {
 			sa[i].end = sb[i].end = sc[i].end = 0;  /* in the status too */
 			reads += seq[i].read && a[i].ok && seq[i].reg > REGMAP_STATUS_REG;

@@ -122,3 +122,19 @@ void xact_model_twi(const frame_t *f, result_t *r)
 	CHECK(!slave_fsm_in_frame());
 	r->status = xact_model_status();
 }
+
+void xact_model_run(const frame_t *seq, unsigned n, result_t *out, result_t *sel_out,
+		    void (*run)(const frame_t *, result_t *))
+{
+	boot();
+	xact_init();
+	slave_fsm_init();
+	for (unsigned i = 0; i < n; i++) {
+		memset(&sel_out[i], 0, sizeof sel_out[i]);
+		if (seq[i].read) {
+			frame_t sel = { .reg = seq[i].reg, .read = 0, .n = 0 };
+			run(&sel, &sel_out[i]);
+		}
+		run(&seq[i], &out[i]);
+	}
+}

@@ -49,4 +49,11 @@ slave_action_t xact_model_twi_event(uint8_t status, uint8_t *byte);
 /* The whole slave: the TWI status codes a master's frame makes. */
 void xact_model_twi(const frame_t *f, result_t *r);
 
+/* One of the ways above over n frames from power-on (boot(), which each
+ * program provides, then the transaction module and the slave state
+ * machine afresh). A read frame reads its register: the select runs first
+ * as a write frame of its own, its result in sel_out, as a host sends it. */
+void xact_model_run(const frame_t *seq, unsigned n, result_t *out, result_t *sel_out,
+		    void (*run)(const frame_t *, result_t *));
+
 #endif
