@@ -1,0 +1,103 @@
+"""The `orfa` command: `orfa [--port URL | --sim BOARD] COMMAND ...`.
+
+One module per group of commands: bus (version, scan, read, write, transfer,
+request), devices (drivers and the driver clients), console, simulate (sim);
+`flash` comes from orfa.flash when it is there. Exit status: 0 ok, 1 an
+ERROR reply or a device, bus or serial failure, 2 a usage error (bad
+arguments, a port that cannot be opened), 130 Ctrl-C.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import importlib.util
+import sys
+from typing import List, Optional
+
+import serial
+
+from .. import __version__
+from .. import protocol as p
+from ..sim import BOARDS
+from . import bus, console, devices, simulate
+from .common import ADDRESS_RULE, PORT_ENV, UsageError, add_sim_devices, env_port, explain, number
+from .console import expects_reply, terminal  # noqa: F401  (kept for scripts)
+from .simulate import slave_spec  # noqa: F401
+
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+
+def _connection_options(parser, suppress: bool) -> None:
+    """--port/--sim and friends: before the command (with defaults) and
+    after it (suppressed defaults, so they do not undo the ones before)."""
+    def default(value):
+        return argparse.SUPPRESS if suppress else value
+    group = parser.add_argument_group("the board")
+    where = group.add_mutually_exclusive_group()
+    where.add_argument("--port", "-p", metavar="URL", default=default(env_port()),
+                       help="serial port or pyserial URL (/dev/ttyUSB0, socket://host:port);"
+                            " default $%s" % PORT_ENV)
+    where.add_argument("--sim", choices=BOARDS, metavar="BOARD", default=default(None),
+                       help="start a simulated board (%s) for this one command; --eeprom,"
+                            " --slave, --adc, --spi (before the command) add devices"
+                            % "|".join(BOARDS))
+    group.add_argument("--baud", type=int, default=default(p.DEFAULT_BAUD),
+                       help="serial rate (default %d)" % p.DEFAULT_BAUD)
+    group.add_argument("--timeout", type=float, default=default(2.0), metavar="S",
+                       help="seconds to wait for a reply (default 2)")
+    group.add_argument("--addr", type=number,
+                       default=default(None), metavar="A",
+                       help="the board the driver commands talk to: a slave's bus"
+                            " address (default: the gateway itself)")
+    group.add_argument("-7", "--7bit", dest="seven_bit", action="store_true",
+                       default=default(False),
+                       help="addresses are 7-bit (i2c-tools' form), not the protocol's 8-bit")
+    group.add_argument("--autobaud", action="store_true", default=default(False),
+                       help="open the line with the BAUD=auto preamble (eight CRs, 20 ms quiet)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="orfa", description="ORFA host tools: talk to an ORFA gateway and the boards"
+                                 " on its I2C bus, or simulate them. " + ADDRESS_RULE,
+        epilog="examples: orfa --sim m32d scan; orfa --port /dev/ttyUSB0 servo 3 1500;"
+               " orfa COMMAND --help. Exit status: 0 ok, 1 an ERROR reply or a device"
+               " or bus failure, 2 a usage error or a port that cannot be opened.")
+    parser.add_argument("--version", action="version", version="orfa %s" % __version__)
+    _connection_options(parser, suppress=False)
+    sim_devices = parser.add_argument_group("devices of the --sim board")
+    add_sim_devices(sim_devices, suppress=True)
+    common = argparse.ArgumentParser(add_help=False)
+    _connection_options(common, suppress=True)
+
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    bus.add_parsers(sub, common)
+    devices.add_parsers(sub, common)
+    console.add_parsers(sub, common)
+    simulate.add_parsers(sub, common)
+    if importlib.util.find_spec("orfa.flash") is not None:
+        importlib.import_module("orfa.flash").add_parser(sub)
+    return parser
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except UsageError as exc:
+        print("orfa: %s" % exc, file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        return EXIT_INTERRUPTED
+    except p.OrfaError as exc:
+        print("orfa: %s" % explain(exc), file=sys.stderr)
+        return EXIT_FAILED
+    except (serial.SerialException, OSError) as exc:
+        print("orfa: serial line: %s" % exc, file=sys.stderr)
+        return EXIT_FAILED
+    except ValueError as exc:
+        print("orfa: %s" % exc, file=sys.stderr)
+        return EXIT_USAGE

@@ -1,0 +1,173 @@
+"""What every `orfa` command shares: numbers and addresses from the command
+line, the board connection (a port or a simulated board), error messages."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+from typing import Iterator, List, Optional
+
+import serial
+
+from .. import protocol as p
+from ..gateway import Gateway
+from ..sim import BOARDS, SimBoard, SimError
+
+#: The environment variable that gives --port its default.
+PORT_ENV = "ORFA_PORT"
+
+#: What the help of every command says about addresses.
+ADDRESS_RULE = ("Addresses are the protocol's 8-bit form (0xA0, 0x10, the gateway's"
+                " own 0xAA: even, bit 0 is the R/W bit), as in requests and everywhere"
+                " else in ORFA; with -7 they are i2c-tools' 7-bit form (0x50, 0x08,"
+                " 0x55), 8-bit = 7-bit << 1.")
+
+
+class UsageError(Exception):
+    """A mistake on the command line found after parsing: exit status 2."""
+
+
+def number(text: str) -> int:
+    """An integer as C writes it: 16, 0x10, 0o20, 0b10000."""
+    try:
+        return int(text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r is not a number (16, 0x10)" % text) from None
+
+
+def byte(text: str) -> int:
+    value = number(text)
+    if not 0 <= value <= 0xFF:
+        raise argparse.ArgumentTypeError("%s is not a byte (0..0xFF)" % text)
+    return value
+
+
+def address(args, value: int, what: str = "address") -> int:
+    """A command-line address as the protocol's 8-bit form (see ADDRESS_RULE)."""
+    if getattr(args, "seven_bit", False):
+        if not 0 <= value <= 0x7F:
+            raise UsageError("%s 0x%02X: a 7-bit address is 0x00..0x7F" % (what, value))
+        return value << 1
+    if not 0 <= value <= 0xFF or value & 1:
+        hint = " (the 7-bit 0x%02X is 0x%02X, or give -7)" % (value, value << 1) \
+            if 0 <= value <= 0x7F else ""
+        raise UsageError("%s 0x%02X: an 8-bit address is even, 0x00..0xFE%s"
+                         % (what, value, hint))
+    return value
+
+
+def show_address(args, addr8: int) -> str:
+    """An 8-bit address in the form the command line uses."""
+    if getattr(args, "seven_bit", False):
+        return "0x%02X" % (addr8 >> 1)
+    return "0x%02X" % addr8
+
+
+def explain(exc: BaseException) -> str:
+    """One line for an error: a protocol code gets its meaning."""
+    text = str(exc) or type(exc).__name__
+    code = getattr(exc, "code", None)
+    if code is not None and text == "ERROR %02X" % code:
+        doc = (type(exc).__doc__ or "").strip().splitlines()
+        meaning = doc[0].split(": ", 1)[-1].rstrip(".") if doc else ""
+        if meaning:
+            text += ": %s" % meaning
+    return text
+
+
+def _os_reason(exc: BaseException) -> str:
+    """The innermost OS reason of an exception chain ("No such file or directory")."""
+    seen = exc
+    while seen is not None:
+        if isinstance(seen, OSError) and seen.strerror and not isinstance(
+                seen, serial.SerialException):
+            return seen.strerror
+        seen = seen.__cause__ or seen.__context__
+    text = str(exc)
+    return text.split(": ", 1)[-1] if text.startswith("[Errno") else text
+
+
+def open_gateway(url: str, args) -> Gateway:
+    """A Gateway on url; a port that cannot be opened is a UsageError."""
+    try:
+        return Gateway(url, baudrate=args.baud, timeout=args.timeout,
+                       autobaud=args.autobaud)
+    except (serial.SerialException, OSError, ValueError, p.OrfaError) as exc:
+        raise UsageError("cannot open %s: %s" % (url, _os_reason(exc))) from None
+
+
+def add_sim_devices(parser, suppress: bool = False) -> None:
+    """The simulated board's devices: for `sim`, and for --sim."""
+    from .simulate import adc_spec, slave_spec
+    default = argparse.SUPPRESS if suppress else None
+    parser.add_argument("--eeprom", type=number, action="append", default=default or [],
+                        metavar="ADDR",
+                        help="a 24C02-like EEPROM at the 8-bit bus address ADDR (0xA0),"
+                             " repeatable")
+    parser.add_argument("--slave", type=slave_spec, action="append", default=default or [],
+                        metavar="BOARD:ADDR[:ELF]",
+                        help="a slave board on the bus at the 8-bit ADDR (repeatable); ELF"
+                             " defaults to build/robot/<board>-<ADDR>/orfa.elf (make robot)"
+                             " if built, else build/<board>-slave/orfa.elf")
+    parser.add_argument("--adc", type=adc_spec, action="append", default=default or [],
+                        metavar="CH=MV", help="analog input CH (0-7) at MV millivolts,"
+                                              " repeatable")
+    parser.add_argument("--spi", action="append", default=default or [],
+                        metavar="[SLAVE/]KIND@PIN[:mode=N][:lsb]",
+                        help="an SPI device: eeprom25 or mcp3008 selected by PIN"
+                             " (eeprom25@B4), repeatable")
+
+
+def sim_board(board: str, args, **kw) -> SimBoard:
+    """A SimBoard with the devices of args (not started)."""
+    return SimBoard(board, eeproms=getattr(args, "eeprom", None) or (),
+                    slaves=getattr(args, "slave", None) or (),
+                    adc=dict(getattr(args, "adc", None) or ()),
+                    spi=getattr(args, "spi", None) or (), **kw)
+
+
+@contextlib.contextmanager
+def connect(args) -> Iterator[Gateway]:
+    """The Gateway of --port URL (or $ORFA_PORT), or of a board --sim starts
+    for this one command (stopped when the command ends)."""
+    sim = None
+    devices = [opt for opt in ("eeprom", "slave", "adc", "spi") if getattr(args, opt, None)]
+    if args.sim is None and devices:
+        raise UsageError("--%s describes a simulated board: give --sim BOARD too" % devices[0])
+    if args.sim is not None:
+        if args.port:
+            raise UsageError("give --port or --sim, not both")
+        try:
+            sim = sim_board(args.sim, args, trace=False).start()
+        except (SimError, ValueError) as exc:
+            raise UsageError(str(exc)) from None
+        url = sim.port
+    elif args.port:
+        url = args.port
+    else:
+        raise UsageError("no board: give --port URL (or set %s) or --sim BOARD (%s)"
+                         % (PORT_ENV, "|".join(BOARDS)))
+    try:
+        with open_gateway(url, args) as gw:
+            yield gw
+    finally:
+        if sim is not None:
+            sim.stop()
+
+
+def hex_bytes(data: bytes) -> str:
+    """Bytes as i2cget prints them: 0x41 0x42."""
+    return " ".join("0x%02x" % b for b in data)
+
+
+def table(rows: List[List[str]], header: Optional[List[str]] = None) -> str:
+    """Left-aligned columns, two spaces apart."""
+    rows = ([header] if header else []) + rows
+    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
+    return "\n".join("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip()
+                     for row in rows)
+
+
+def env_port() -> Optional[str]:
+    return os.environ.get(PORT_ENV) or None

@@ -1,0 +1,119 @@
+"""`orfa sim`: run a simulated board or robot until interrupted (or for a
+console on it), printing its serial port's path."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+import time
+
+from .. import protocol as p
+from ..sim import BOARDS, SimError
+from .common import UsageError, add_sim_devices, sim_board
+from .console import run_console
+
+
+def slave_spec(text: str):
+    """`BOARD:ADDR[:ELF]` -> (board, addr, elf or None: the board's slave build)."""
+    parts = text.split(":", 2)
+    if len(parts) < 2 or parts[0] not in BOARDS:
+        raise argparse.ArgumentTypeError(
+            "%r: BOARD:ADDR[:ELF] with BOARD one of %s" % (text, ", ".join(BOARDS)))
+    try:
+        addr = int(parts[1], 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0x10" % text) from None
+    if addr & 1 or not 0x10 <= addr <= 0xEE:
+        raise argparse.ArgumentTypeError("%r: ADDR must be even, 0x10..0xEE" % text)
+    return (parts[0], addr, parts[2] if len(parts) == 3 and parts[2] else None)
+
+
+def adc_spec(text: str):
+    """`CH=MV` -> (channel, millivolts)."""
+    ch, sep, mv = text.partition("=")
+    try:
+        pair = (int(ch, 0), int(mv, 0))
+    except ValueError:
+        pair = None
+    if not sep or pair is None or not 0 <= pair[0] <= 7 or pair[1] < 0:
+        raise argparse.ArgumentTypeError("%r: CH=MV with CH 0-7 (3=1200)" % text)
+    return pair
+
+
+def _raise_interrupt(*_):
+    raise KeyboardInterrupt
+
+
+def _link(target, path: str) -> None:
+    """A symlink at path to target (the simulator's control socket)."""
+    try:
+        os.symlink(str(target), path)
+    except OSError as exc:
+        raise UsageError("cannot make %s: %s" % (path, exc.strerror)) from None
+
+
+def cmd_sim(args) -> int:
+    control = args.control is not None or args.autobaud
+    extra = []
+    if args.trace:
+        extra += ["--trace", args.trace]
+    if args.vcd:
+        extra += ["--vcd", args.vcd]
+    try:
+        board = sim_board(args.board, args, trace=False, firmware=args.firmware,
+                          control=control, extra_args=extra).start()
+    except (SimError, ValueError) as exc:
+        raise UsageError(str(exc)) from None
+    link = None
+    signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        print(board.port, flush=True)
+        if args.control is not None:
+            link = args.control or None
+            if link:
+                _link(board.control_path, link)
+            print(link or board.control_path, flush=True)
+        if args.terminal:
+            with board.gateway(args.baud, autobaud=args.autobaud) as gw:
+                return run_console(gw)
+        while board.running:
+            time.sleep(0.2)
+        print("orfa: the simulator stopped: %s" % board.stderr.strip(), file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        board.stop()
+        if link and os.path.islink(link):
+            os.unlink(link)
+
+
+def add_parsers(sub, common) -> None:
+    cmd = sub.add_parser(
+        "sim", help="run a simulated board or robot, print its port",
+        description="Run build/sim/orfa-sim on a board's gateway firmware (with --slave:"
+                    " a robot, the slave boards on its I2C bus) and print the path of"
+                    " its serial port on the first line (with --control, the control"
+                    " socket's on the second). Runs until Ctrl-C or SIGTERM (exit 0),"
+                    " or with --terminal for a console on the board until the end of"
+                    " its input. Bus addresses are the protocol's 8-bit form."
+                    " docs/simulator.md describes the devices and the control socket.",
+        epilog="example: orfa sim --board m32d --eeprom 0xA0 --slave m128s:0x10 --terminal")
+    cmd.add_argument("--board", choices=BOARDS, default="m32d",
+                     help="the gateway's board (default %(default)s)")
+    add_sim_devices(cmd)
+    cmd.add_argument("--firmware", help="ELF to run (default: build/<board>-gate/orfa.elf)")
+    cmd.add_argument("--control", nargs="?", const="", metavar="PATH",
+                     help="open the control socket (at PATH if given) and print its path")
+    cmd.add_argument("--trace", metavar="FILE", help="write the bus and serial trace to FILE")
+    cmd.add_argument("--vcd", metavar="FILE", help="write every pin's waveform to FILE (VCD)")
+    cmd.add_argument("--terminal", action="store_true",
+                     help="also open a line console on the board (as orfa console)")
+    cmd.add_argument("--baud", type=int, default=p.DEFAULT_BAUD,
+                     help="the console's rate (default %(default)s)")
+    cmd.add_argument("--autobaud", action="store_true",
+                     help="the console opens with the BAUD=auto preamble (eight CRs,"
+                          " 20 ms of simulated quiet)")
+    cmd.set_defaults(func=cmd_sim)
