@@ -32,8 +32,10 @@ def test_request_command(board_name):
     require_builds([board_name])
     with SimBoard(board_name, eeproms=(0xA0,), trace=False) as sim:
         result = orfa("request", "--port", sim.port, "V", "S A0 P", "S A2 P")
-        assert result.returncode == 0, result.stderr
+        assert result.returncode == 1, result.stderr
         assert result.stdout == "V1.1\nSWP\nERROR 06\n"
+        assert result.stderr == ("orfa: S A2 P: ERROR 06: no ACK for an address"
+                                 " (no device, bus stuck, unreadable register)\n")
 
 
 def test_request_refused_on_the_host():

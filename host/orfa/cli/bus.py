@@ -109,6 +109,7 @@ def cmd_read(args) -> int:
         raise UsageError("COUNT is 1..%d (a reply holds %d characters)"
                          % (MAX_READ, p.MAX_REPLY_CHARS))
     frames = p.register_read_frames(addr, args.reg, args.count)
+    _check_fits(frames)
     with connect(args) as gw:
         data = _transact(gw, frames, "%s register 0x%02X" % (show_address(args, addr), args.reg))
     print(hex_bytes(data[-1].data))
@@ -184,6 +185,7 @@ def parse_messages(args, words: Sequence[str]) -> List[p.Frame]:
 
 def cmd_transfer(args) -> int:
     frames = parse_messages(args, args.messages)
+    _check_fits(frames)
     with connect(args) as gw:
         results = _transact(gw, frames, "transfer")
     for result in results:

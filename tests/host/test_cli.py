@@ -1,0 +1,153 @@
+"""The `orfa` command without a board: arguments, addresses, messages, the
+scan grid, and the one-line errors for a missing or bad port."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from orfa import cli
+from orfa.cli import bus
+from orfa.cli.common import UsageError, address
+
+HOST = str(Path(__file__).resolve().parents[2] / "host")
+
+
+class Args:
+    def __init__(self, seven_bit=False):
+        self.seven_bit = seven_bit
+
+
+def run(argv, capsys, env=None):
+    """main(argv) in-process: (exit status, stdout, stderr)."""
+    try:
+        status = cli.main(argv)
+    except SystemExit as exc:                  # argparse
+        status = exc.code
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def orfa(*args, env=None):
+    env = dict(os.environ if env is None else env, PYTHONPATH=HOST)
+    return subprocess.run([sys.executable, "-m", "orfa"] + list(args), env=env,
+                          capture_output=True, text=True, timeout=30)
+
+
+def test_addresses_are_8_bit_unless_7_bit_is_asked():
+    assert address(Args(), 0xA0) == 0xA0
+    assert address(Args(seven_bit=True), 0x50) == 0xA0
+    assert address(Args(seven_bit=True), 0x55) == 0xAA
+    with pytest.raises(UsageError, match=r"0x21: an 8-bit address is even.*7-bit 0x21 is 0x42"):
+        address(Args(), 0x21)
+    with pytest.raises(UsageError, match="0x80: a 7-bit address is 0x00..0x7F"):
+        address(Args(seven_bit=True), 0x80)
+    with pytest.raises(UsageError, match="0x100"):
+        address(Args(), 0x100)
+
+
+def test_transfer_messages_as_i2ctransfer_takes_them():
+    frames = bus.parse_messages(Args(), ["w3@0xA0", "0x10", "0x41", "66", "r2", "w0@0x10"])
+    assert [(type(f).__name__, f.addr, getattr(f, "data", getattr(f, "count", None)))
+            for f in frames] == [("Write", 0xA0, b"\x10\x41\x42"), ("Read", 0xA0, 2),
+                                 ("Write", 0x10, b"")]
+    (frame,) = bus.parse_messages(Args(seven_bit=True), ["r1@0x50"])
+    assert frame.addr == 0xA0
+
+
+@pytest.mark.parametrize("words, message", [
+    (["r2"], "the first message needs @ADDR"),
+    (["w2@0xA0", "0x10"], "2 data bytes must follow"),
+    (["w2@0xA0", "0x10", "r1"], "2 data bytes must follow"),
+    (["w1@0xA0", "0x100"], "data bytes are 0..0xFF"),
+    (["r0@0xA0"], "a read reads 1 byte or more"),
+    (["x1@0xA0"], "a message is {r|w}LENGTH"),
+    (["w1@0xA1", "0"], "an 8-bit address is even"),
+    (["w1@zz", "0"], "ADDR like 0xA0"),
+])
+def test_bad_transfer_messages(words, message):
+    with pytest.raises(UsageError) as exc:
+        bus.parse_messages(Args(), words)
+    assert message in str(exc.value)
+
+
+def test_scan_grid_is_i2cdetects():
+    assert bus.scan_grid([0x08, 0x55, 0x77], 0x08, 0x77) == "\n".join([
+        "     0  1  2  3  4  5  6  7  8  9  a  b  c  d  e  f",
+        "00:                         08 -- -- -- -- -- -- --",
+        "10: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "20: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "30: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "40: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "50: -- -- -- -- -- 55 -- -- -- -- -- -- -- -- -- --",
+        "60: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "70: -- -- -- -- -- -- -- 77",
+    ])
+    assert bus.scan_grid([0x00], 0, 0x7F).splitlines()[1].startswith("00: 00 -- --")
+
+
+def test_no_board_is_a_usage_error(capsys, monkeypatch):
+    monkeypatch.delenv("ORFA_PORT", raising=False)
+    assert run(["version"], capsys) == (
+        2, "", "orfa: no board: give --port URL (or set ORFA_PORT) or --sim BOARD"
+               " (m32d|m128s)\n")
+
+
+def test_port_and_sim_exclude_each_other(capsys):
+    status, out, err = run(["--port", "loop://", "--sim", "m32d", "version"], capsys)
+    assert status == 2 and "not allowed with argument" in err
+
+
+def test_sim_devices_need_sim(capsys):
+    assert run(["--port", "loop://", "--eeprom", "0xA0", "scan"], capsys) == (
+        2, "", "orfa: --eeprom describes a simulated board: give --sim BOARD too\n")
+
+
+def test_a_bad_port_is_one_line_and_exit_2():
+    result = orfa("--port", "/dev/ttyUSB9", "version")
+    assert (result.returncode, result.stdout, result.stderr) == (
+        2, "", "orfa: cannot open /dev/ttyUSB9: No such file or directory\n")
+
+
+def test_the_port_comes_from_the_environment():
+    result = orfa("scan", env=dict(os.environ, ORFA_PORT="/dev/ttyUSB9"))
+    assert (result.returncode, result.stderr) == (
+        2, "orfa: cannot open /dev/ttyUSB9: No such file or directory\n")
+
+
+def test_a_bad_url_is_one_line():
+    result = orfa("--port", "foo://x", "version")
+    assert (result.returncode, result.stderr) == (
+        2, "orfa: cannot open foo://x: invalid URL, protocol 'foo' not known\n")
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--port", "loop://", "read", "0xA1", "0"], "address 0xA1: an 8-bit address is even"),
+    (["--port", "loop://", "read", "0xA0", "0", "61"], "COUNT is 1..60"),
+    (["--port", "loop://", "read", "0xA0", "0", "0"], "COUNT is 1..60"),
+    (["--port", "loop://", "write", "0xA0", "0"] + ["1"] * 62,
+     "request of 130 characters, the limit is 128"),
+    (["--port", "loop://", "transfer", "r63@0xA0"], "reply of 129 characters, the limit is 127"),
+])
+def test_bad_arguments_refused_before_sending(argv, message, capsys):
+    status, out, err = run(argv, capsys)
+    assert status == 2 and out == "" and message in err and err.count("\n") == 1
+
+
+def test_a_request_over_the_limit_is_refused_on_the_host(capsys):
+    status, out, err = run(["request", "--port", "loop://", "V" * 129], capsys)
+    assert (status, out) == (1, "")
+    assert err == "orfa: request of 129 characters, the limit is 128\n"
+
+
+def test_every_command_has_help_with_an_example(capsys):
+    parser = cli.build_parser()
+    commands = parser._subparsers._group_actions[0].choices
+    assert {"version", "scan", "read", "write", "transfer", "request", "drivers",
+            "console", "sim"} <= set(commands)
+    for name, sub in commands.items():
+        assert "example" in (sub.epilog or ""), name
+        status, out, err = run([name, "--help"], capsys)
+        assert status == 0 and out.startswith("usage: orfa " + name), name

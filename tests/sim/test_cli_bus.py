@@ -1,0 +1,142 @@
+"""`orfa` version, drivers, scan, read, write, transfer, request and console
+against one simulated robot (M32-D gateway, EEPROM 0xA0, an M128-S slave at
+0x10 and an M32-D slave at 0x12), run in-process through main(argv)."""
+
+import pytest
+
+from conftest import require_builds
+from orfa import cli
+from orfa.sim import SimRobot
+
+EEPROM = 0xA0
+
+
+@pytest.fixture(scope="module")
+def robot():
+    require_builds()
+    with SimRobot("m32d", eeproms=(EEPROM,), trace=False,
+                  slaves=[("m128s", 0x10, None), ("m32d", 0x12, None)]) as sim:
+        yield sim
+
+
+@pytest.fixture
+def orfa(robot, capsys):
+    """orfa(*argv) on the robot's port: (exit status, stdout, stderr)."""
+    def run(*argv):
+        try:
+            status = cli.main(["--port", robot.port, "--timeout", "5"] + list(argv))
+        except SystemExit as exc:
+            status = exc.code
+        out, err = capsys.readouterr()
+        return status, out, err
+    return run
+
+
+def test_version(orfa):
+    assert orfa("version") == (0, "protocol 1.1\nboard    m32d\n", "")
+
+
+def test_drivers_of_the_gateway(orfa):
+    status, out, err = orfa("drivers")
+    assert (status, err) == (0, "")
+    assert out.splitlines() == [
+        "0xAA: m32d, 7 drivers",
+        "UID   driver                          version  registers",
+        "0000  introspection                   1.0      0x00-0x01",
+        "0020  GPIO (4 ports)                  1.1      0x02-0x09",
+        "0001  SPI                             1.1      0x0A-0x0B",
+        "0040  ADC                             1.1      0x0C-0x0D",
+        "0060  motors                          1.1      0x0E-0x11",
+        "0031  servos (16)                     2.0      0x12-0x13",
+        "0002  system (reset cause, failsafe)  1.0      0x14-0x15",
+    ]
+
+
+def test_drivers_of_a_slave(orfa):
+    status, out, err = orfa("drivers", "--addr", "0x10")
+    assert (status, err) == (0, "")
+    assert out.splitlines()[0] == "0x10: unknown (UIDs 0000 0021 0001 0040 0030 0002), 6 drivers" \
+        or out.splitlines()[0] == "0x10: m128s, 6 drivers"
+    assert [line.split()[0] for line in out.splitlines()[2:]] == [
+        "0000", "0021", "0001", "0040", "0030", "0002"]
+    assert orfa("-7", "drivers", "--addr", "0x08")[1] == out.replace("0x10:", "0x08:", 1)
+
+
+def test_scan_shows_every_device_in_the_grid(orfa):
+    status, out, err = orfa("scan")
+    assert (status, err) == (0, "")
+    assert out == "\n".join([
+        "     0  1  2  3  4  5  6  7  8  9  a  b  c  d  e  f",
+        "00:                         08 09 -- -- -- -- -- --",
+        "10: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "20: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "30: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "40: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "50: 50 -- -- -- -- 55 -- -- -- -- -- -- -- -- -- --",
+        "60: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --",
+        "70: -- -- -- -- -- -- -- --",
+        "8-bit: 0x10 0x12 0xA0 0xAA (0xAA: the gateway itself)",
+        ""])
+    assert orfa("-7", "scan")[1].splitlines()[-1] == \
+        "7-bit: 0x08 0x09 0x50 0x55 (0x55: the gateway itself)"
+
+
+def test_scan_all_addresses(orfa):
+    status, out, err = orfa("scan", "--all")
+    lines = out.splitlines()
+    assert lines[1] == "00: -- -- -- -- -- -- -- -- 08 09 -- -- -- -- -- --"
+    assert lines[8] == "70: -- -- -- -- -- -- -- -- -- -- -- -- -- -- -- --"
+
+
+def test_write_then_read_the_eeprom(orfa):
+    assert orfa("write", "0xA0", "0x20", "0x41", "0x42", "0x43") == (0, "", "")
+    assert orfa("read", "0xA0", "0x20", "3") == (0, "0x41 0x42 0x43\n", "")
+    assert orfa("read", "0xA0", "0x21") == (0, "0x42\n", "")
+    assert orfa("-7", "read", "0x50", "0x22") == (0, "0x43\n", "")
+
+
+def test_read_a_register_of_a_slave(orfa):
+    # introspection's count: the M128-S slave at 0x10 has 6 drivers
+    assert orfa("write", "0x10", "0x00", "0x00") == (0, "", "")
+    assert orfa("read", "0x10", "0x00", "2") == (0, "0x06 0x06\n", "")
+
+
+def test_transfer(orfa):
+    assert orfa("transfer", "w3@0xA0", "0x30", "0x11", "0x22", "w1", "0x30", "r2",
+                "w2@0x10", "0", "0", "r1") == (0, "0x11 0x22\n0x06\n", "")
+    assert orfa("-7", "transfer", "w1@0x50", "0x31", "r1") == (0, "0x22\n", "")
+
+
+def test_nothing_at_the_address_is_exit_1(orfa):
+    assert orfa("read", "0xA2", "0x00") == (
+        1, "", "orfa: 0xA2 register 0x00: ERROR 06: no ACK for an address"
+               " (no device, bus stuck, unreadable register)\n")
+    assert orfa("transfer", "w1@0xA0", "0", "r1@0xB0")[::2] == (
+        1, "orfa: transfer: ERROR 06: no ACK for an address"
+           " (no device, bus stuck, unreadable register)\n")
+
+
+def test_a_write_the_gateway_refuses_is_exit_1(orfa):
+    # the status register (0x01) cannot be written: ERROR 07 on the gateway itself
+    assert orfa("write", "0xAA", "0x01", "0x00") == (
+        1, "", "orfa: 0xAA register 0x01: ERROR 07: no ACK for a data byte"
+               " (or a local write a driver rejects)\n")
+
+
+def test_request_prints_every_reply_and_exits_1_on_an_error(orfa):
+    assert orfa("request", "V", "S A2 P", "S A0 P") == (
+        1, "V1.1\nERROR 06\nSWP\n",
+        "orfa: S A2 P: ERROR 06: no ACK for an address (no device, bus stuck,"
+        " unreadable register)\n")
+    assert orfa("request", "V", "S A0 P") == (0, "V1.1\nSWP\n", "")
+
+
+def test_console_from_a_pipe(orfa, monkeypatch):
+    import io
+    comment = "#" + "c" * 199
+    lines = ["V", comment, "S A0 40 41 P", "#" + "d" * 999, "S A0 40 S A1 01 P",
+             "V" * 129, "", "   ", "l", "Q", "caf\u00e9"]
+    monkeypatch.setattr("sys.stdin", io.StringIO("\n".join(lines) + "\n"))
+    assert orfa("console") == (0, "\n".join([
+        "V1.1", "SWAAP", "SWASR41P", "ERROR 04", "LAA", "ERROR 02",
+        "host: a request is ASCII text", ""]), "")
