@@ -113,3 +113,43 @@ def test_terminal_with_autobaud_firmware():
                   "--baud", "14400", "--autobaud", input="V\nS AA 00 00 S AB 01 P\n")
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines()[1:] == ["V1.1", "SWAASR06P"]
+
+
+def test_sim_with_control_socket_and_trace(tmp_path):
+    """`sim --control PATH` prints the socket's path on the second line and
+    it reaches the board's control interface; --trace FILE keeps the trace;
+    --adc sets an analog input; the link to the socket goes at exit."""
+    from orfa.simctl import SimControl
+    require_builds(["m32d"])
+    control, trace = tmp_path / "ctl", tmp_path / "trace.log"
+    proc = subprocess.Popen([sys.executable, "-m", "orfa", "sim", "--board", "m32d",
+                             "--adc", "3=1200", "--control", str(control), "--trace", str(trace)],
+                            env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        port = proc.stdout.readline().strip()
+        assert proc.stdout.readline().strip() == str(control)
+        result = orfa("request", "--port", port, "V")
+        assert result.stdout == "V1.1\n"
+        with SimControl(str(control)) as ctl:
+            assert ctl.pin("A3")[0] in (0, 1)
+            assert ctl.request("adc 3") == "1200"
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=10) == 0
+        assert not os.path.lexists(control)
+        assert " uart rx 56" in trace.read_text()          # the V
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def test_sim_board_for_one_command():
+    """What a new user types first: `orfa --sim m32d scan` shows the gateway
+    itself (0x55 in the 7-bit grid); devices come with the sim options."""
+    require_builds(["m32d"])
+    result = orfa("--sim", "m32d", "--eeprom", "0xA0", "scan")
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[6] == "50: 50 -- -- -- -- 55 -- -- -- -- -- -- -- -- -- --"
+    assert lines[-1] == "8-bit: 0xA0 0xAA (0xAA: the gateway itself)"
+    assert sum(line.count("--") for line in lines) == 0x70 - 2
