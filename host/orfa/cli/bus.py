@@ -9,6 +9,7 @@ import sys
 from typing import List, Sequence
 
 from .. import protocol as p
+from ..board import Board
 from .common import (ADDRESS_RULE, UsageError, address, byte, connect, explain,
                      hex_bytes, number, show_address)
 from .names import board_of
@@ -47,7 +48,7 @@ def pipelined(gw, lines: Sequence[str]) -> List[str]:
 def cmd_version(args) -> int:
     with connect(args) as gw:
         version = gw.version()
-        board = board_of(gw.drivers())
+        board = board_of(Board(gw))
     print("protocol %s" % version)
     print("board    %s" % board)
     return 0

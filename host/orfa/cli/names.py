@@ -1,20 +1,16 @@
-"""Names for what introspection reports: the board, each driver."""
+"""Names for what introspection reports: the board, each driver (from the
+generated board maps, through orfa.Board)."""
 
 from __future__ import annotations
 
-from typing import Sequence
 
-from .. import boards
-
-
-def board_of(records: Sequence) -> str:
-    """The board whose drivers these are: "m32d" or "unknown (UIDs ...)"."""
-    uids = tuple(r.uid for r in records)
-    for name, known in boards.BOARD_UIDS.items():
-        if uids == known:
-            return name
-    return "unknown (UIDs %s)" % " ".join("%04X" % u for u in uids)
+def board_of(board) -> str:
+    """"m32d (OR-AVR-M32-D)", or "unknown (UIDs ...)" when no map matches."""
+    m = board.map
+    if m is not None:
+        return "%s (%s)" % (m.board, m.name)
+    return "unknown (UIDs %s)" % " ".join("%04X" % r.uid for r in board.drivers)
 
 
-def driver_name(uid: int) -> str:
-    return boards.DRIVER_NAMES.get(uid, "?")
+def driver_name(board, uid: int) -> str:
+    return board.driver_name(uid) or "?"
