@@ -34,8 +34,8 @@ def test_request_command(board_name):
         result = orfa("request", "--port", sim.port, "V", "S A0 P", "S A2 P")
         assert result.returncode == 1, result.stderr
         assert result.stdout == "V1.1\nSWP\nERROR 06\n"
-        assert result.stderr == ("orfa: S A2 P: ERROR 06: no ACK for an address"
-                                 " (no device, bus stuck, unreadable register)\n")
+        assert result.stderr == ("orfa: S A2 P: ERROR 06: no ACK for an address byte"
+                                 " (no device, bus not to be had, register not readable)\n")
 
 
 def test_request_refused_on_the_host():

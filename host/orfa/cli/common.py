@@ -10,6 +10,7 @@ from typing import Iterator, List, Optional
 
 import serial
 
+from .. import boardmap
 from .. import protocol as p
 from ..gateway import Gateway
 from ..sim import BOARDS, SimBoard, SimError
@@ -65,27 +66,27 @@ def show_address(args, addr8: int) -> str:
 
 
 def explain(exc: BaseException) -> str:
-    """One line for an error: a protocol code gets its meaning."""
+    """One line for an error: a bare `ERROR xx` gets the code's meaning
+    (from the board map, as the firmware's error enum gives it)."""
     text = str(exc) or type(exc).__name__
     code = getattr(exc, "code", None)
-    if code is not None and text == "ERROR %02X" % code:
-        doc = (type(exc).__doc__ or "").strip().splitlines()
-        meaning = doc[0].split(": ", 1)[-1].rstrip(".") if doc else ""
-        if meaning:
-            text += ": %s" % meaning
+    if code is not None and text == "ERROR %02X" % code and code in boardmap.ERRORS:
+        text += ": %s" % boardmap.ERRORS[code].text
     return text
 
 
 def _os_reason(exc: BaseException) -> str:
-    """The innermost OS reason of an exception chain ("No such file or directory")."""
+    """Why a port did not open, from the innermost error of the chain: the
+    OS's reason ("No such file or directory") or pyserial's ("invalid URL")."""
     seen = exc
-    while seen is not None:
+    while True:
         if isinstance(seen, OSError) and seen.strerror and not isinstance(
                 seen, serial.SerialException):
             return seen.strerror
-        seen = seen.__cause__ or seen.__context__
-    text = str(exc)
-    return text.split(": ", 1)[-1] if text.startswith("[Errno") else text
+        inner = seen.__cause__ or seen.__context__
+        if inner is None:
+            return str(seen)
+        seen = inner
 
 
 def open_gateway(url: str, args) -> Gateway:
