@@ -66,7 +66,7 @@ def test_drivers_of_a_slave(orfa):
         "0002  sys     1.0      0x0C-0x0D",
         ""])
     assert orfa("drivers", "--addr", "0x10") == (0, out, "")
-    assert orfa("-7", "drivers", "--addr", "0x08") == (0, out.replace("0x10:", "0x08:"), "")
+    assert orfa("--7bit", "drivers", "--addr", "0x08") == (0, out.replace("0x10:", "0x08:"), "")
     assert orfa("--addr", "0x12", "drivers")[1].splitlines()[0] == \
         "0x12: m32d (OR-AVR-M32-D), 7 drivers"
     assert orfa("drivers", "--addr", "0x14") == (
@@ -89,7 +89,7 @@ def test_scan_shows_every_device_in_the_grid(orfa):
         "70: -- -- -- -- -- -- -- --",
         "8-bit: 0x10 0x12 0xA0 0xAA (0xAA: the gateway itself)",
         ""])
-    assert orfa("-7", "scan")[1].splitlines()[-1] == \
+    assert orfa("--7bit", "scan")[1].splitlines()[-1] == \
         "7-bit: 0x08 0x09 0x50 0x55 (0x55: the gateway itself)"
 
 
@@ -104,7 +104,7 @@ def test_write_then_read_the_eeprom(orfa):
     assert orfa("write", "0xA0", "0x20", "0x41", "0x42", "0x43") == (0, "", "")
     assert orfa("read", "0xA0", "0x20", "3") == (0, "0x41 0x42 0x43\n", "")
     assert orfa("read", "0xA0", "0x21") == (0, "0x42\n", "")
-    assert orfa("-7", "read", "0x50", "0x22") == (0, "0x43\n", "")
+    assert orfa("--7bit", "read", "0x50", "0x22") == (0, "0x43\n", "")
 
 
 def test_read_a_register_of_a_slave(orfa):
@@ -116,7 +116,7 @@ def test_read_a_register_of_a_slave(orfa):
 def test_transfer(orfa):
     assert orfa("transfer", "w3@0xA0", "0x30", "0x11", "0x22", "w1", "0x30", "r2",
                 "w2@0x10", "0", "0", "r1") == (0, "0x11 0x22\n0x06\n", "")
-    assert orfa("-7", "transfer", "w1@0x50", "0x31", "r1") == (0, "0x22\n", "")
+    assert orfa("--7bit", "transfer", "w1@0x50", "0x31", "r1") == (0, "0x22\n", "")
 
 
 def test_nothing_at_the_address_is_exit_1(orfa):

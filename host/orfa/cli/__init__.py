@@ -50,7 +50,7 @@ def _connection_options(parser, suppress: bool) -> None:
                        default=default(None), metavar="A",
                        help="the board the driver commands talk to: a slave's bus"
                             " address (default: the gateway itself)")
-    group.add_argument("-7", "--7bit", dest="seven_bit", action="store_true",
+    group.add_argument("--7bit", dest="seven_bit", action="store_true",
                        default=default(False),
                        help="addresses are 7-bit (i2c-tools' form), not the protocol's 8-bit")
     group.add_argument("--autobaud", action="store_true", default=default(False),

@@ -228,7 +228,7 @@ def add_parsers(sub, common) -> None:
                     " and print i2cdetect's grid: the 7-bit address where a device"
                     " answered, -- where none did. The line under it lists the same"
                     " devices in the form the other commands take (8-bit, or 7-bit"
-                    " with -7); 8-bit = 7-bit << 1, so the gateway's own 0xAA is"
+                    " with --7bit); 8-bit = 7-bit << 1, so the gateway's own 0xAA is"
                     " 0x55 in the grid.",
         epilog="example: orfa --sim m32d --eeprom 0xA0 scan")
     cmd.add_argument("-a", "--all", action="store_true",

@@ -21,7 +21,7 @@ PORT_ENV = "ORFA_PORT"
 #: What the help of every command says about addresses.
 ADDRESS_RULE = ("Addresses are the protocol's 8-bit form (0xA0, 0x10, the gateway's"
                 " own 0xAA: even, bit 0 is the R/W bit), as in requests and everywhere"
-                " else in ORFA; with -7 they are i2c-tools' 7-bit form (0x50, 0x08,"
+                " else in ORFA; with --7bit they are i2c-tools' 7-bit form (0x50, 0x08,"
                 " 0x55), 8-bit = 7-bit << 1.")
 
 
@@ -51,7 +51,7 @@ def address(args, value: int, what: str = "address") -> int:
             raise UsageError("%s 0x%02X: a 7-bit address is 0x00..0x7F" % (what, value))
         return value << 1
     if not 0 <= value <= 0xFF or value & 1:
-        hint = " (the 7-bit 0x%02X is 0x%02X, or give -7)" % (value, value << 1) \
+        hint = " (the 7-bit 0x%02X is 0x%02X, or give --7bit)" % (value, value << 1) \
             if 0 <= value <= 0x7F else ""
         raise UsageError("%s 0x%02X: an 8-bit address is even, 0x00..0xFE%s"
                          % (what, value, hint))

@@ -240,9 +240,8 @@ def cmd_adc(args) -> int:
     with open_board(args) as board:
         adc = board.adc
         if args.channels is not None or args.ref is not None or args.bits is not None:
-            reference, bits, channels = adc.config()
-            adc.configure(channels=channels if args.channels is None else args.channels,
-                          reference=args.ref or reference, bits=args.bits or bits)
+            adc.configure(channels=range(8) if args.channels is None else args.channels,
+                          reference=args.ref or "avcc", bits=args.bits or 10)
             _settle(board, args)
         reference, bits, channels = adc.config()
         vref = args.vref if args.vref is not None else VREF.get(reference)
@@ -281,10 +280,10 @@ def _port(board: Board, text: str) -> str:
 def cmd_gpio(args) -> int:
     with open_board(args) as board:
         gpio = board.gpio
-        if args.port is None:
+        if args.gpio_port is None:
             ports = gpio.ports
         else:
-            ports = _port(board, args.port)
+            ports = _port(board, args.gpio_port)
             if args.output is not None:
                 gpio.set_modes(ports, 0xFF, args.output)
             if args.input is not None:
@@ -306,7 +305,7 @@ def cmd_spi(args) -> int:
     with open_board(args) as board:
         spi = board.spi
         if args.spi_command == "bind":
-            spi.bind(args.channel, _port(board, args.port), args.line)
+            spi.bind(args.channel, _port(board, args.gpio_port), args.line)
         elif args.spi_command == "config":
             if args.div is None and args.mode is None and args.lsb is None:
                 cfg = spi.config()
@@ -387,15 +386,18 @@ def add_parsers(sub, common) -> None:
     cmd = sub.add_parser(
         "adc", parents=[common], help="analog inputs: a table, or a live one",
         description="Print the ADC's channels: raw value and volts (from the"
-                    " reference: AVCC 5 V, internal 2.56 V; AREF needs --vref). The"
-                    " options change the configuration first (kept by the board)."
+                    " reference: AVCC 5 V, internal 2.56 V; AREF needs --vref)."
+                    " --channels, --ref or --bits configure the ADC first (the board"
+                    " keeps it): the channels given (default all), the reference"
+                    " (default avcc), the resolution (default 10)."
                     " --watch redraws the table every SECONDS (in place on a terminal)"
                     " until Ctrl-C (exit 0) or --count tables.",
         epilog="example: orfa adc --channels 0-3 --ref avcc --watch 0.2")
     cmd.add_argument("--channels", type=channel_list, metavar="LIST",
-                     help="turn on these channels, the others off (0-3,6; all; none)")
-    cmd.add_argument("--ref", choices=("avcc", "aref", "internal"), help="the reference")
-    cmd.add_argument("--bits", type=int, choices=(8, 10), help="the resolution")
+                     help="turn on these channels, the others off (0-3,6; all; none; default all)")
+    cmd.add_argument("--ref", choices=("avcc", "aref", "internal"),
+                     help="the reference (default avcc)")
+    cmd.add_argument("--bits", type=int, choices=(8, 10), help="the resolution (default 10)")
     cmd.add_argument("--vref", type=float, metavar="V",
                      help="the reference's volts (for aref; default 5.0 avcc, 2.56 internal)")
     cmd.add_argument("--watch", nargs="?", type=float, const=0.5, metavar="SECONDS",
@@ -410,8 +412,8 @@ def add_parsers(sub, common) -> None:
                     " MASK (default all): an output's level, an input's pull-up;"
                     " --output/--input MASK make those lines outputs or inputs first."
                     " Lines another function holds are left as they are.",
-        epilog="example: orfa gpio B --output 0x0F 0x05")
-    cmd.add_argument("port", nargs="?", metavar="PORT", help="a port letter (A)")
+        epilog="example: orfa gpio B 0x05 --output 0x0F")
+    cmd.add_argument("gpio_port", nargs="?", metavar="PORT", help="a port letter (A)")
     cmd.add_argument("value", nargs="?", type=byte, metavar="VALUE")
     cmd.add_argument("mask", nargs="?", type=byte, metavar="MASK")
     cmd.add_argument("--output", type=byte, metavar="MASK", help="make these lines outputs")
@@ -430,7 +432,7 @@ def add_parsers(sub, common) -> None:
     bind = spi.add_parser("bind", parents=[common], help="a chip select line for a channel",
                           epilog="example: orfa spi bind 0 B 4")
     bind.add_argument("channel", type=number, metavar="CH")
-    bind.add_argument("port", metavar="PORT")
+    bind.add_argument("gpio_port", metavar="PORT")
     bind.add_argument("line", type=number, metavar="LINE")
     conf = spi.add_parser("config", parents=[common], help="bus settings",
                           epilog="example: orfa spi config --div 6 --mode 3")
