@@ -18,30 +18,6 @@ from .names import board_of
 #: are reserved by the I2C specification).
 SCAN_FIRST, SCAN_LAST = 0x08, 0x77
 
-#: Characters of requests the host keeps unanswered: SPEC's flow rule allows
-#: fewer than 256.
-FLOW_WINDOW = 250
-
-
-def pipelined(gw, lines: Sequence[str]) -> List[str]:
-    """The reply of each line, requests sent in batches that keep within the
-    flow rule (the gateway's run() when it has one)."""
-    run = getattr(gw, "run", None)
-    if run is not None:
-        return run(list(lines))
-    replies: List[str] = []
-    batch: List[str] = []
-    size = 0
-    for line in list(lines) + [None]:
-        if line is None or size + len(line) + 1 > FLOW_WINDOW:
-            if batch:
-                replies += gw.pipeline(batch)
-            batch, size = [], 0
-        if line is not None:
-            batch.append(line)
-            size += len(line) + 1
-    return replies
-
 
 # --- version ------------------------------------------------------------------
 
@@ -74,7 +50,7 @@ def scan_grid(found: Sequence[int], first: int, last: int) -> str:
 def scan(gw, first: int = SCAN_FIRST, last: int = SCAN_LAST) -> List[int]:
     """The 7-bit addresses first..last that acknowledge a probe (`S<addr> P`)."""
     addrs = list(range(first, last + 1))
-    replies = pipelined(gw, ["S%02XP" % (a << 1) for a in addrs])
+    replies = gw.run(["S%02XP" % (a << 1) for a in addrs])     # pipelined
     found = []
     for a, reply in zip(addrs, replies):
         if reply == "SWP":
