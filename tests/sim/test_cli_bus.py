@@ -70,8 +70,7 @@ def test_drivers_of_a_slave(orfa):
     assert orfa("--addr", "0x12", "drivers")[1].splitlines()[0] == \
         "0x12: m32d (OR-AVR-M32-D), 7 drivers"
     assert orfa("drivers", "--addr", "0x14") == (
-        1, "", "orfa: ERROR 06: no ACK for an address byte (no device, bus not to be had,"
-               " register not readable)\n")
+        1, "", "orfa: 0x14: " + NACK + "\n")
 
 
 def test_scan_shows_every_device_in_the_grid(orfa):

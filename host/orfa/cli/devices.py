@@ -11,7 +11,8 @@ from typing import Iterator, List, Optional
 
 from .. import protocol as p
 from ..board import Board
-from .common import UsageError, address, byte, connect, hex_bytes, number, show_address, table
+from .common import (UsageError, address, byte, connect, explain, hex_bytes, number,
+                     show_address, table)
 from .names import board_of, driver_name
 
 
@@ -20,7 +21,15 @@ def open_board(args) -> Iterator[Board]:
     """The Board of --addr (None: the gateway itself) on the command's connection."""
     addr = None if args.addr is None else address(args, args.addr, "--addr")
     with connect(args) as gw:
-        yield Board(gw, addr)
+        board = Board(gw, addr)
+        try:
+            yield board
+        except p.OrfaError as exc:
+            if exc.code is None or str(exc) != "ERROR %02X" % exc.code:
+                raise
+            # a bare ERROR reply: say whom it came from
+            raise p.OrfaError("%s: %s" % (_where(args, board), explain(exc)),
+                              code=exc.code) from None
 
 
 def _where(args, board: Board) -> str:
