@@ -145,9 +145,27 @@ def test_a_request_over_the_limit_is_refused_on_the_host(capsys):
 def test_every_command_has_help_with_an_example(capsys):
     parser = cli.build_parser()
     commands = parser._subparsers._group_actions[0].choices
-    assert {"version", "scan", "read", "write", "transfer", "request", "drivers",
-            "console", "sim"} <= set(commands)
-    for name, sub in commands.items():
+    ours = {"version", "scan", "read", "write", "transfer", "request", "drivers", "servo",
+            "motor", "adc", "gpio", "spi", "status", "console", "sim"}
+    assert ours <= set(commands)
+    for name in sorted(ours):
+        sub = commands[name]
         assert "example" in (sub.epilog or ""), name
         status, out, err = run([name, "--help"], capsys)
         assert status == 0 and out.startswith("usage: orfa " + name), name
+
+
+def test_flash_plugs_in_when_orfa_flash_is_there(monkeypatch, capsys):
+    """orfa.flash (another module) registers `flash` with add_parser(subparsers)."""
+    import importlib.machinery
+    import types
+    flash = types.ModuleType("orfa.flash")
+    flash.__spec__ = importlib.machinery.ModuleSpec("orfa.flash", None)
+
+    def add_parser(sub):
+        cmd = sub.add_parser("flash", help="program a board", epilog="example: orfa flash")
+        cmd.set_defaults(func=lambda args: print("flashing") or 0)
+        return cmd
+    flash.add_parser = add_parser
+    monkeypatch.setitem(sys.modules, "orfa.flash", flash)
+    assert run(["flash"], capsys) == (0, "flashing\n", "")

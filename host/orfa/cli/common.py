@@ -117,7 +117,7 @@ def add_sim_devices(parser, suppress: bool = False) -> None:
     parser.add_argument("--spi", action="append", default=default or [],
                         metavar="[SLAVE/]KIND@PIN[:mode=N][:lsb]",
                         help="an SPI device: eeprom25 or mcp3008 selected by PIN"
-                             " (eeprom25@B4), repeatable")
+                             " (eeprom25@C2), repeatable")
 
 
 def sim_board(board: str, args, **kw) -> SimBoard:
