@@ -29,7 +29,7 @@ def open_port(url: str, baudrate: int, timeout: float) -> serial.SerialBase:
 def _os_reason(e: BaseException) -> str:
     """The OS's reason behind a pyserial error: "[Errno 2] No such file or
     directory" rather than pyserial's message that repeats the path."""
-    for err in (e, e.__context__, e.__cause__):
+    for err in (e.__cause__, e.__context__, e):
         if isinstance(err, OSError) and err.errno is not None and err.strerror:
             return "[Errno %d] %s" % (err.errno, err.strerror)
     return str(e)
@@ -240,6 +240,13 @@ class Gateway:
                 continue
             # noise: stop sending, mark, and sort out the lines up to the marker
             self.resyncs += 1
+            if unsure_from is not None:
+                # the noise may be the reply an extra ERROR line displaced
+                for j in range(unsure_from, i):
+                    out[j] = p.ProtocolError(
+                        "replies out of step from %r on (an extra line on the serial "
+                        "line); its result is unknown" % lines[j])
+                unsure_from = None
             self.send(p.encode_request(flow.MARKER))
             self._settle(list(pending), patterns, out, lines)
             pending.clear()
