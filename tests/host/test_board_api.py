@@ -82,7 +82,6 @@ M32D_SERVO = [
     (lambda b: b.servo.set_angle(4, -45), "SAA130404B0P", "SWAAAAP", None),
     (lambda b: b.servo.angle(4), "SAA1304SAB02P", "SWAASR04B0P", -45.0),
     (lambda b: b.servo.pulsing(), "SAA12SAB02P", "SWASR4008P", {3, 14}),
-    (lambda b: b.motor.set(2, -64), "SAA0F40SAA1101P", "SWAASWAAP", None),
     (lambda b: b.motor.set_all(128, -96), "SAA0E80600001P", "SWAAAAAP", None),
     (lambda b: b.motor.get(2), "SAA0ESAB04P", "SWASR80600001P", -96),
     (lambda b: b.motor.stop(), "SAA0E0000P", "SWAAAP", None),
@@ -107,6 +106,13 @@ def test_call_sends(fake, call, request_, reply, result):
     b, line = make_board(fake, "m32d", table={request_: reply})
     assert call(b) == result
     assert line.written == [request_]
+
+
+def test_motor_set_is_one_write_of_all_registers(fake):
+    b, line = make_board(fake, "m32d", table={"SAA0ESAB04P": "SWASR80000000P",
+                                              "SAA0E80400001P": "SWAAAAAP"})
+    b.motor.set(2, -64)
+    assert line.written == ["SAA0ESAB04P", "SAA0E80400001P"]
 
 
 def test_slave_write_reads_status_in_the_same_request(fake):
@@ -160,17 +166,17 @@ def test_servo_widths_batched_and_pipelined(fake):
 # --- refusals -------------------------------------------------------------------------
 
 def test_local_refusal_reads_the_status(fake):
-    b, line = make_board(fake, "m32d", table={"SAA0E40SAA1000P": "ERROR 07",
+    b, line = make_board(fake, "m32d", table={"SAA0E40000000P": "ERROR 07",
                                               "SAA01SAB01P": "SWASR03P"})
     with pytest.raises(PinBusyError) as e:
-        b.motor.set(1, 64)
+        b.motor.set_all(64, 0)
     assert str(e.value) == ("0xAA motor PWM1: write refused: PIN_BUSY "
                             "(a pin the operation needs belongs to another function)")
     assert e.value.status is Status.PIN_BUSY and e.value.addr == 0xAA
     assert e.value.register == "motor PWM1" and e.value.code == 0x07
     assert isinstance(e.value.__cause__, DataNackError)
     # after the ERROR line the V marker checks the line is in step
-    assert line.written == ["SAA0E40SAA1000P", "V", "SAA01SAB01P"]
+    assert line.written == ["SAA0E40000000P", "V", "SAA01SAB01P"]
 
 
 def test_slave_refusal_found_at_frame_end(fake):
@@ -292,8 +298,10 @@ def test_garbled_reply_is_lost_not_misplaced(fake):
     line.garble[10] = b"SR0G0P\r\n"
     with pytest.raises(ProtocolError, match="lost to noise"):
         gw.run(lines)
-    results = gw.transactions([[p_read(1)], [p_read(2)]])
-    assert [r[0].data for r in results] == [b"\x01", b"\x02\x02"]
+    line.garble = {line._answered + 10: b"SR0G0P\r\n"}     # the 11th of the next 30
+    results = gw.transactions([[p_read(1 + i % 40)] for i in range(30)])
+    assert [i for i, r in enumerate(results) if isinstance(r, ProtocolError)] == [10]
+    assert [r[0].data for r in results[11:]] == [bytes([1 + i]) * (1 + i) for i in range(11, 30)]
 
 
 def p_read(n):
