@@ -10,12 +10,8 @@ from __future__ import annotations
 import enum
 from typing import Dict, Optional, Type
 
+from . import boardmap as _map
 from .protocol import OrfaError
-
-try:
-    from . import boardmap as _map
-except ImportError:                       # until main's generated map is merged
-    from . import _mapstub as _map
 
 
 class _StatusBase(enum.IntEnum):
