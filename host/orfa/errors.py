@@ -15,6 +15,15 @@ from .protocol import OrfaError
 
 
 class _StatusBase(enum.IntEnum):
+    def __str__(self) -> str:
+        return self.name
+
+    def __format__(self, spec: str) -> str:
+        """The name ("{:>10}"), or the number with a numeric type ("{:02X}")."""
+        if spec and spec[-1] in "bcdoxXneEfFgG%":
+            return format(int(self), spec)
+        return format(self.name, spec)
+
     @property
     def text(self) -> str:
         """What the code means, as the board map explains it."""

@@ -375,3 +375,14 @@ def test_noise_in_a_pipelined_run(sims, noise):
     else:
         assert min(errors) >= 60 - 1
     assert gw.run(lines) == want
+
+
+def test_docs_example_prints_what_the_docs_show(capsys):
+    """docs/python.md's example session, run: it prints what the page says."""
+    import re
+    from pathlib import Path
+    text = (Path(__file__).resolve().parents[2] / "docs" / "python.md").read_text()
+    code, shown = re.search(r"```python\n(.*?)```\n\nprints\n\n```\n(.*?)```", text, re.S).groups()
+    require_builds(["m32d"])
+    exec(compile(code, "docs/python.md", "exec"), {})
+    assert capsys.readouterr().out == shown

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Dict, List, Mapping, Optional, Set
+from typing import List, Mapping, Optional, Set
 
 from ..protocol import OrfaError
 
