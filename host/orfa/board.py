@@ -14,18 +14,15 @@ and reads raise the RegisterError of the status register's reason
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import lru_cache
 from typing import Dict, FrozenSet, Iterable, List, Optional, Sequence, Tuple
 
+from . import boardmap
 from . import boards
 from . import protocol as p
 from .errors import NoDriverError, Status, register_error
 from .gateway import Gateway
-
-try:
-    from . import boardmap
-except ImportError:                       # until main's generated map is merged
-    from . import _mapstub as boardmap
 
 
 @dataclass(frozen=True)
@@ -44,9 +41,13 @@ class Op:
         return "write" if self.kind == "w" else "read"
 
 
-def _uid_index() -> Dict[int, Tuple[object, object]]:
-    """Every driver UID of every board map: (BoardMap, DriverMap)."""
-    index: Dict[int, Tuple[object, object]] = {}
+@lru_cache(maxsize=None)
+def _uid_index() -> Dict[int, Tuple[boardmap.BoardMap, boardmap.DriverMap]]:
+    """Every driver UID of every board map: (BoardMap, DriverMap). A UID
+    names one driver on every board that has it (GPIO of 4 ports is 0x0020,
+    of 2 ports 0x0021), so a driver's facts follow from its UID even on a
+    build that left drivers out."""
+    index: Dict[int, Tuple[boardmap.BoardMap, boardmap.DriverMap]] = {}
     for name in boardmap.BOARDS:
         m = boardmap.load(name)
         for d in m.drivers:
@@ -144,12 +145,7 @@ class Board:
         """Register `reg` of driver `name`: introspection's start plus the
         register's place in the map ("servo", "SP" -> 0x13 on an M32-D)."""
         rec, _, dmap = self._record(name)
-        try:
-            offset = dmap.registers.index(reg)
-        except ValueError:
-            raise KeyError("driver %s has no register %r (%s)"
-                           % (name, reg, ", ".join(dmap.registers))) from None
-        return rec.start + offset
+        return rec.start + dmap.offset(reg)
 
     def board_map(self, name: str):
         """The BoardMap the driver `name` of this board comes from (its

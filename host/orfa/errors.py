@@ -10,15 +10,20 @@ from __future__ import annotations
 import enum
 from typing import Dict, Optional, Type
 
+from . import boardmap as _map
 from .protocol import OrfaError
-
-try:
-    from . import boardmap as _map
-except ImportError:                       # until main's generated map is merged
-    from . import _mapstub as _map
 
 
 class _StatusBase(enum.IntEnum):
+    def __str__(self) -> str:
+        return self.name
+
+    def __format__(self, spec: str) -> str:
+        """The name ("{:>10}"), or the number with a numeric type ("{:02X}")."""
+        if spec and spec[-1] in "bcdoxXneEfFgG%":
+            return format(int(self), spec)
+        return format(self.name, spec)
+
     @property
     def text(self) -> str:
         """What the code means, as the board map explains it."""

@@ -29,7 +29,7 @@ def open_port(url: str, baudrate: int, timeout: float) -> serial.SerialBase:
 def _os_reason(e: BaseException) -> str:
     """The OS's reason behind a pyserial error: "[Errno 2] No such file or
     directory" rather than pyserial's message that repeats the path."""
-    for err in (e, e.__context__, e.__cause__):
+    for err in (e.__cause__, e.__context__, e):
         if isinstance(err, OSError) and err.errno is not None and err.strerror:
             return "[Errno %d] %s" % (err.errno, err.strerror)
     return str(e)
@@ -56,7 +56,7 @@ class Gateway:
         #: set when the line may hold replies nobody waits for (a timeout,
         #: noise): the next run resynchronises first
         self._dirty = False
-        #: noise and out-of-step events seen (for tests and diagnostics)
+        #: times the line was brought back in step (noise, stale lines, timeouts)
         self.resyncs = 0
         if autobaud:
             self.preamble(wait)
@@ -172,6 +172,7 @@ class Gateway:
     def resync(self) -> int:
         """Bring the line in step: send the `V` marker and drop every line
         up to its `V1.1`. Returns the number of lines dropped."""
+        self.resyncs += 1
         self.send(p.encode_request(flow.MARKER))
         dropped = 0
         while self._read_line() != flow.MARKER_REPLY:
@@ -240,6 +241,13 @@ class Gateway:
                 continue
             # noise: stop sending, mark, and sort out the lines up to the marker
             self.resyncs += 1
+            if unsure_from is not None:
+                # the noise may be the reply an extra ERROR line displaced
+                for j in range(unsure_from, i):
+                    out[j] = p.ProtocolError(
+                        "replies out of step from %r on (an extra line on the serial "
+                        "line); its result is unknown" % lines[j])
+                unsure_from = None
             self.send(p.encode_request(flow.MARKER))
             self._settle(list(pending), patterns, out, lines)
             pending.clear()
@@ -274,11 +282,16 @@ class Gateway:
                     break
             seen.append(text)
         candidates = [t for t in seen if any(flow.plausible(patterns[i], t) for i in waiting)]
-        if len(candidates) == len(waiting) and all(
-                flow.plausible(patterns[i], t) for i, t in zip(waiting, candidates)):
-            for i, t in zip(waiting, candidates):
-                out[i] = t
-            return
+        # the line that was noise came in the first waiting request's place:
+        # an extra line (all replies follow) or its reply garbled (one fewer)
+        for lost in (0, 1):
+            rest = waiting[lost:]
+            if len(candidates) == len(rest) and all(
+                    flow.plausible(patterns[i], t) for i, t in zip(rest, candidates)):
+                for i, t in zip(rest, candidates):
+                    out[i] = t
+                waiting = waiting[:lost]
+                break
         for i in waiting:
             out[i] = p.ProtocolError("the reply to %r was lost to noise on the serial line"
                                      % lines[i])

@@ -24,13 +24,14 @@ class Motor:
         return duty
 
     def set(self, n: int, duty: int) -> None:
-        """Motor n (1 or 2) at duty -255..255: |duty| to PWMn, then the sign
-        to DIRn (1 backward), two frames of one request: a refused PWM
-        (pin busy) leaves the direction alone."""
+        """Motor n (1 or 2) at duty -255..255 (sign: direction, 1 backward on
+        DIRn). The registers are read, then written back whole from PWM1
+        with motor n changed: one write, all of it or none (a refused PWM,
+        pin busy, leaves the direction too), the motors in the same period."""
         n, duty = self._n(n), self._duty(duty)
-        b = self.board
-        b.execute([[b.op_write("motor", "PWM%d" % n, [abs(duty)]),
-                    b.op_write("motor", "DIR%d" % n, [1 if duty < 0 else 0])]])
+        duties = self.duties()
+        duties[n - 1] = duty
+        self.set_all(*duties)
 
     def set_all(self, *duties: int) -> None:
         """Every motor at once, one write from PWM1 (`80 60 00 01`): both

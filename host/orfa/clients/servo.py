@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Dict, List, Mapping, Optional, Set
+from typing import List, Mapping, Optional, Set
 
 from ..protocol import OrfaError
 
-#: SP takes at most this many [channel][hi][lo] triples per write.
-MAX_TRIPLES = 16
 #: Widths read back per request: 28 channels keep a slave's reply (with its
 #: status read) within 127 characters.
 READ_CHANNELS = 28
@@ -45,8 +43,11 @@ class ServoRange:
 class Servo:
     def __init__(self, board):
         self.board = board
+        m = board.board_map("servo")
         #: channels of the board's servo driver: 16 on an M32-D, 32 on an M128-S
-        self.channels: int = board.board_map("servo").servo_channels
+        self.channels: int = m.servo_channels
+        #: SP takes at most this many [channel][hi][lo] triples per write
+        self.max_triples: int = m.limits["servo_triples"]
 
     def _ch(self, ch: int) -> int:
         if not isinstance(ch, int) or isinstance(ch, bool) or not 0 <= ch < self.channels:
@@ -88,8 +89,9 @@ class Servo:
         if not triples:
             return
         b = self.board
-        b.execute([[b.op_write("servo", "SP", b"".join(triples[i:i + MAX_TRIPLES]))]
-                   for i in range(0, len(triples), MAX_TRIPLES)])
+        n = self.max_triples
+        b.execute([[b.op_write("servo", "SP", b"".join(triples[i:i + n]))]
+                   for i in range(0, len(triples), n)])
 
     def off(self, ch: Optional[int] = None) -> None:
         """Stop pulsing channel ch, or every channel."""

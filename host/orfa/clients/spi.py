@@ -6,15 +6,18 @@ from typing import Dict
 
 from ..protocol import LimitError
 
-CHANNELS = 4
 #: CONFIG's first byte that sets the bus instead of a channel
 BUS = 0xFF
-MAX_TRANSFER = 64
 
 
 class Spi:
     def __init__(self, board):
         self.board = board
+        limits = board.board_map("spi").limits
+        #: chip-select channels, and the most bytes of one exchange (the
+        #: driver's; a request through the gateway holds fewer, see transfer)
+        self.channels: int = limits["spi_channels"]
+        self.max_bytes: int = limits["spi_bytes"]
 
     def _ports(self) -> str:
         return self.board.board_map("gpio").gpio_ports
@@ -22,8 +25,8 @@ class Spi:
     def bind(self, channel: int, port: str, line: int) -> None:
         """Line `line` of GPIO port `port` ("B") as channel's chip select."""
         ports = self._ports()
-        if not isinstance(channel, int) or not 0 <= channel < CHANNELS:
-            raise ValueError("SPI channel %r: channels are 0..%d" % (channel, CHANNELS - 1))
+        if not isinstance(channel, int) or not 0 <= channel < self.channels:
+            raise ValueError("SPI channel %r: channels are 0..%d" % (channel, self.channels - 1))
         if not isinstance(port, str) or len(port) != 1 or port.upper() not in ports:
             raise ValueError("no GPIO port %r on this board (ports %s)" % (port, ", ".join(ports)))
         if not isinstance(line, int) or not 0 <= line <= 7:
@@ -41,10 +44,10 @@ class Spi:
 
     def config(self) -> Dict[str, object]:
         """{"clock_div", "mode", "lsb_first", "channels": {ch: (port, line) or None}}."""
-        data = self.board.read("spi", "CONFIG", 1 + 2 * CHANNELS)
+        data = self.board.read("spi", "CONFIG", 1 + 2 * self.channels)
         ports = self._ports()
         chans = {}
-        for ch in range(CHANNELS):
+        for ch in range(self.channels):
             port, line = data[1 + 2 * ch], data[2 + 2 * ch]
             chans[ch] = None if port == 0xFF else (ports[port], line)
         s = data[0]
@@ -57,10 +60,10 @@ class Spi:
         characters of a request hold 60 bytes to the gateway itself, 55
         to a slave (with its status read)."""
         data = bytes(data)
-        if not isinstance(channel, int) or not 0 <= channel < CHANNELS:
-            raise ValueError("SPI channel %r: channels are 0..%d" % (channel, CHANNELS - 1))
-        if not 1 <= len(data) <= MAX_TRANSFER:
-            raise ValueError("an SPI transfer has 1..%d bytes, not %d" % (MAX_TRANSFER, len(data)))
+        if not isinstance(channel, int) or not 0 <= channel < self.channels:
+            raise ValueError("SPI channel %r: channels are 0..%d" % (channel, self.channels - 1))
+        if not 1 <= len(data) <= self.max_bytes:
+            raise ValueError("an SPI transfer has 1..%d bytes, not %d" % (self.max_bytes, len(data)))
         b = self.board
         write = [b.op_write("spi", "DATA", bytes([channel]) + data)]
         read = [b.op_read("spi", "DATA", len(data))]
