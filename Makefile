@@ -149,12 +149,18 @@ AVRDUDE_FLAGS ?=
 AVRDUDE_CMD = $(AVRDUDE) -c $(PROGRAMMER) -p $(BOARD_AVRDUDE_PART) \
 	$(if $(strip $(PORT)),-P $(strip $(PORT))) $(AVRDUDE_FLAGS)
 
+AVRDUDE_CHECK = command -v $(firstword $(AVRDUDE)) >/dev/null || { echo \
+	"make: $(firstword $(AVRDUDE)) not found: install avrdude (tools/setup.sh) or give AVRDUDE=/path/to/avrdude" >&2; \
+	exit 127; }
+
 # Built first with the same BAUD, ADDR, DRIVERS and BUILD as `make firmware`.
 flash: $(BUILD)/orfa.hex
+	@$(AVRDUDE_CHECK)
 	$(strip $(AVRDUDE_CMD) -U flash:w:$<:i)
 
 # name:0xVV in board.mk -> -U name:w:0xVV:m, in board.mk's order.
 fuses:
+	@$(AVRDUDE_CHECK)
 	$(strip $(AVRDUDE_CMD) $(foreach f,$(BOARD_FUSES),-U $(subst :,:w:,$(f)):m))
 
 # --- simulator (host C, Debian's libsimavr) --------------------------------
