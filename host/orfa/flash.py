@@ -12,18 +12,17 @@ output passed through.
 from __future__ import annotations
 
 import os
-import re
 import shlex
 import shutil
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
-from typing import Dict, List, NamedTuple, Optional, Sequence
+from typing import List, Optional, Sequence
 
-from . import ihex
+from . import boardmap, ihex
 from .protocol import OrfaError
-from .sim import BOARDS, REPO_ROOT, firmware_path
+from .sim import REPO_ROOT, firmware_path
 
 PROGRAMMER = "usbasp"
 MODES = ("gate", "slave")
@@ -37,31 +36,12 @@ class FlashError(OrfaError):
     """Flashing cannot start: no avrdude, no firmware, an unreadable file."""
 
 
-class BoardFacts(NamedTuple):
-    part: str                 # avrdude's -p name
-    fuses: Dict[str, int]     # name -> value, in the order they are written
-
-
-def board_facts(board: str) -> BoardFacts:
-    """The board's avrdude part and fuses, read from boards/<board>/board.mk
-    (BOARD_AVRDUDE_PART, BOARD_FUSES), where `make flash`/`make fuses` read
-    them too."""
-    if board not in BOARDS:
-        raise FlashError("no such board %r: one of %s" % (board, ", ".join(BOARDS)))
-    path = REPO_ROOT / "boards" / board / "board.mk"
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise FlashError("cannot read %s: %s" % (path, exc.strerror)) from None
-    values = dict(re.findall(r"^(BOARD_\w+)\s*:?=\s*(.*?)\s*$", text, re.M))
-    try:
-        part = values["BOARD_AVRDUDE_PART"]
-        fuses = {name: int(value, 16) for name, value in
-                 (item.split(":") for item in values["BOARD_FUSES"].split())}
-    except (KeyError, ValueError) as exc:
-        raise FlashError("%s: no usable BOARD_AVRDUDE_PART/BOARD_FUSES (%s)"
-                         % (path, exc)) from None
-    return BoardFacts(part, fuses)
+def board_map(board: str) -> boardmap.BoardMap:
+    """The board's map, whose avrdude part and fuses come from its board.mk
+    (BOARD_AVRDUDE_PART, BOARD_FUSES), as `make flash`/`make fuses` read them."""
+    if board not in boardmap.BOARDS:
+        raise FlashError("no such board %r: one of %s" % (board, ", ".join(boardmap.BOARDS)))
+    return boardmap.load(board)
 
 
 def avrdude_argv(part: str, programmer: str = PROGRAMMER, port: Optional[str] = None,
@@ -75,14 +55,14 @@ def avrdude_argv(part: str, programmer: str = PROGRAMMER, port: Optional[str] = 
 
 def flash_argv(board: str, hex_path: str, **kw) -> List[str]:
     """Write `hex_path` (Intel HEX) to the board's flash."""
-    return avrdude_argv(board_facts(board).part, **kw) + ["-U", "flash:w:%s:i" % hex_path]
+    return avrdude_argv(board_map(board).avrdude_part, **kw) + ["-U", "flash:w:%s:i" % hex_path]
 
 
 def fuses_argv(board: str, **kw) -> List[str]:
     """Write the board's fuses, in board.mk's order."""
-    facts = board_facts(board)
-    argv = avrdude_argv(facts.part, **kw)
-    for name, value in facts.fuses.items():
+    bmap = board_map(board)
+    argv = avrdude_argv(bmap.avrdude_part, **kw)
+    for name, value in bmap.fuses.items():
         argv += ["-U", "%s:w:0x%02x:m" % (name, value)]
     return argv
 
@@ -189,7 +169,7 @@ def add_parser(subparsers) -> None:
         description="Write the firmware's Intel HEX to a board through an ISP"
                     " programmer with avrdude, as `make flash` does; --fuses"
                     " writes the board's fuses instead, as `make fuses`.")
-    p.add_argument("--board", choices=BOARDS, default="m32d")
+    p.add_argument("--board", choices=boardmap.BOARDS, default="m32d")
     p.add_argument("--mode", choices=MODES, default="gate",
                    help="which build (default %(default)s); a slave's bus address"
                         " is the one it was built with")
