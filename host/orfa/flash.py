@@ -22,7 +22,7 @@ from typing import List, Optional, Sequence
 
 from . import boardmap, ihex
 from .protocol import OrfaError
-from .sim import REPO_ROOT, firmware_path
+from .sim import firmware_path
 
 PROGRAMMER = "usbasp"
 MODES = ("gate", "slave")
@@ -68,8 +68,8 @@ def fuses_argv(board: str, **kw) -> List[str]:
 
 
 def build_hex(board: str, mode: str) -> Path:
-    """The `make` build's .hex of a board and mode (build/<board>-<mode>/orfa.hex)."""
-    return firmware_path(board, mode).with_name("orfa.hex")
+    """The .hex next to the board's ELF (`make`'s build/<board>-<mode>/orfa.hex)."""
+    return firmware_path(board, mode).with_suffix(".hex")
 
 
 def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str) -> Path:
@@ -96,8 +96,8 @@ def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str) -> Pa
     if elf.is_file():
         return _converted(elf, tmpdir)
     addr = " ADDR=0x10" if mode == "slave" else ""
-    raise FlashError("no firmware for %s %s: build it with `make BOARD=%s MODE=%s%s`"
-                     " in %s, or give --hex FILE" % (board, mode, board, mode, addr, REPO_ROOT))
+    raise FlashError("no firmware for %s %s: build it with `make BOARD=%s MODE=%s%s`,"
+                     " or give --hex FILE" % (board, mode, board, mode, addr))
 
 
 def _near(path: Path) -> Path:
