@@ -9,8 +9,11 @@ import sys
 import time
 from typing import Iterator, List, Optional
 
+from .. import boardmap
 from .. import protocol as p
 from ..board import Board
+from ..clients.adc import CHANNELS as ADC_CHANNELS, VREF
+from ..clients.servo import ServoRange
 from .common import (UsageError, address, byte, connect, explain, hex_bytes, number,
                      show_address, table)
 from .names import board_of, driver_name
@@ -58,12 +61,13 @@ def cmd_drivers(args) -> int:
 
 # --- servo ----------------------------------------------------------------------
 
-SERVO_MIN_US, SERVO_MAX_US = 500, 2500
+#: The widths the servo driver makes (others it clamps to these).
+SERVO_MIN_US = boardmap.load(boardmap.BOARDS[0]).limits["servo_min_us"]
+SERVO_MAX_US = boardmap.load(boardmap.BOARDS[0]).limits["servo_max_us"]
 
 
 def servo_range(text: str):
     """`MIN_US:MAX_US:MIN_DEG:MAX_DEG` -> ServoRange."""
-    from ..clients.servo import ServoRange
     parts = text.split(":")
     try:
         if len(parts) != 4:
@@ -90,10 +94,9 @@ def _show_width(us: int) -> str:
 
 
 def cmd_servo(args) -> int:
-    rng = args.range if args.range is not None else None
+    kw = {} if args.range is None else {"range": args.range}
     with open_board(args) as board:
         servo = board.servo
-        kw = {} if rng is None else {"range": rng}
         if args.channel == "off":
             if args.us is not None or args.angle is not None:
                 raise UsageError("servo off takes no width or angle")
@@ -207,7 +210,7 @@ ADC_SETTLE_S = 0.010
 def channel_list(text: str) -> List[int]:
     """`0-3,6` -> [0, 1, 2, 3, 6]; `all` -> 0..7; `none` -> []."""
     if text == "all":
-        return list(range(8))
+        return list(range(ADC_CHANNELS))
     if text == "none":
         return []
     out: List[int] = []
@@ -217,7 +220,7 @@ def channel_list(text: str) -> List[int]:
             out += range(int(first, 0), int(last or first, 0) + 1)
     except ValueError:
         out = [-1]
-    if not out or any(not 0 <= ch <= 7 for ch in out):
+    if not out or any(not 0 <= ch < ADC_CHANNELS for ch in out):
         raise argparse.ArgumentTypeError("%r: channels 0-7 like 0-3,6 (or all, none)" % text)
     return sorted(set(out))
 
@@ -245,11 +248,11 @@ def _settle(board: Board, args) -> None:
 
 
 def cmd_adc(args) -> int:
-    from ..clients.adc import VREF
     with open_board(args) as board:
         adc = board.adc
         if args.channels is not None or args.ref is not None or args.bits is not None:
-            adc.configure(channels=range(8) if args.channels is None else args.channels,
+            adc.configure(channels=range(ADC_CHANNELS) if args.channels is None
+                          else args.channels,
                           reference=args.ref or "avcc", bits=args.bits or 10)
             _settle(board, args)
         reference, bits, channels = adc.config()
