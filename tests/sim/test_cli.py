@@ -46,8 +46,10 @@ def test_request_refused_on_the_host():
 
 def test_terminal_through_a_pipe():
     require_builds(["m32d"])
+    # make demo's console: a comment over 128 characters is what the board
+    # ignores, not a traceback
     result = orfa("sim", "--board", "m32d", "--eeprom", "0xA0", "--terminal",
-                  input="V\nl\n# comment\n\nS A0 P\nS A2 P\nQ\n")
+                  input="V\nl\n# comment\n\n#%s\nS A0 P\nS A2 P\nQ\n" % ("c" * 199))
     assert result.returncode == 0, result.stderr
     lines = result.stdout.splitlines()
     assert lines[1:] == ["V1.1", "LAA", "SWP", "ERROR 06", "ERROR 02"]
