@@ -36,6 +36,8 @@ def orfa(robot, capsys):
 
 def test_version(orfa):
     assert orfa("version") == (0, "protocol 1.1\nboard    m32d (OR-AVR-M32-D)\n", "")
+    assert orfa("version", "--addr", "0x10") == (
+        0, "protocol 1.1\nboard    m128s (OR-AVR-M128-S) at 0x10\n", "")
 
 
 def test_drivers_of_the_gateway(orfa):

@@ -22,11 +22,14 @@ SCAN_FIRST, SCAN_LAST = 0x08, 0x77
 # --- version ------------------------------------------------------------------
 
 def cmd_version(args) -> int:
+    addr = None if args.addr is None else address(args, args.addr, "--addr")
     with connect(args) as gw:
         version = gw.version()
-        board = board_of(Board(gw))
+        board = Board(gw, addr)
+        model = board_of(board)
+        where = show_address(args, board.addr)
     print("protocol %s" % version)
-    print("board    %s" % board)
+    print("board    %s at %s" % (model, where) if addr is not None else "board    %s" % model)
     return 0
 
 
@@ -193,8 +196,8 @@ def cmd_request(args) -> int:
 def add_parsers(sub, common) -> None:
     cmd = sub.add_parser(
         "version", parents=[common], help="the gateway's protocol version and board",
-        description="Print the protocol version the gateway speaks (V) and its board,"
-                    " known from its drivers.",
+        description="Print the protocol version the gateway speaks (V) and its board"
+                    " (with --addr: the slave's), known from its drivers.",
         epilog="example: orfa --sim m32d version")
     cmd.set_defaults(func=cmd_version)
 
