@@ -1,0 +1,63 @@
+"""A robot builder's own tests, written against the orfa pytest plugin.
+
+Not collected here (the name is not test_*): tests/sim/test_pytest_plugin.py
+and tests/host/test_install.py copy it into a temporary directory as
+test_robot_code.py and run pytest on it there, as a user would.
+"""
+
+import pytest
+import serial
+
+F_CPU = 7372800
+
+
+def test_default_board_on_the_wire(orfa_sim_board):
+    assert orfa_sim_board.board == "m32d"
+    assert " atmega32 @ " in orfa_sim_board.banner
+    with serial.serial_for_url(orfa_sim_board.port, baudrate=115200, timeout=5) as port:
+        port.write(b"V\n")
+        assert port.read_until(b"\r\n") == b"V1.1\r\n"
+
+
+def test_simulated_time(orfa_sim_board):
+    start = orfa_sim_board.control.time()
+    reached = orfa_sim_board.wait_s(0.25)
+    assert reached >= start + F_CPU // 4
+    assert orfa_sim_board.control.time() >= reached    # it runs on after the wait
+
+
+@pytest.mark.orfa_board("m128s", eeproms=[0xA0])
+def test_marker_sets_board_and_options(orfa_sim_board):
+    assert " atmega128 @ " in orfa_sim_board.banner
+    with orfa_sim_board.gateway(timeout=5) as gw:
+        assert gw.request("S A0 P") == "SWP"          # the marker's EEPROM
+        assert gw.request("S A2 P") == "ERROR 06"     # nothing there
+
+
+@pytest.mark.parametrize("orfa_sim_board", ["m32d", "m128s"], indirect=True)
+def test_indirect_board(orfa_sim_board):
+    mcu = {"m32d": "atmega32", "m128s": "atmega128"}[orfa_sim_board.board]
+    assert " %s @ " % mcu in orfa_sim_board.banner
+    with orfa_sim_board.gateway(timeout=5) as gw:
+        assert gw.request("S A0 P") == "ERROR 06"     # no EEPROM unless asked
+
+
+def test_default_robot(orfa_sim_robot):
+    with orfa_sim_robot.gateway(timeout=5) as gw:
+        own = [d.uid for d in gw.drivers()]
+        # the M32-D slave at 0x12 has the drivers of the M32-D gateway
+        assert [d.uid for d in gw.drivers(0x12)] == own
+        m128s = [d.uid for d in gw.drivers(0x10)]
+        assert m128s[0] == 0x0000 and m128s != own
+        assert gw.request("S 14 P") == "ERROR 06"     # no third slave
+    # the control socket reaches the slave's own pins: an input after reset
+    assert orfa_sim_robot.control.slave(0x10).pin("F0")[1] == "in"
+
+
+@pytest.mark.orfa_robot(gateway="m128s", slaves=[("m32d", 0x16)])
+def test_marker_robot(orfa_sim_robot):
+    assert " atmega128 @ " in orfa_sim_robot.banner
+    with orfa_sim_robot.gateway(timeout=5) as gw:
+        assert gw.request("S 16 P") == "SWP"
+        assert gw.request("S 10 P") == "ERROR 06"
+        assert len(gw.drivers(0x16)) > len(gw.drivers())   # an M32-D has motors
