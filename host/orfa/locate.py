@@ -105,6 +105,9 @@ def build_hint() -> str:
                 % (" and ".join(settings), SIM_ENV, FIRMWARE_ENV))
     if in_work_tree():
         return "run `make all-boards sim` in %s (`make robot` for the test robot)" % REPO_ROOT
-    return ("this orfa was installed without the simulator (ORFA_SKIP_BUILD=1, or"
-            " no toolchain): reinstall it from the source tree after running"
+    if PACKAGE_SIM.is_file():
+        return ("not part of the installed orfa (it has the builds of `make all-boards"
+                " robot sim`): give the ELF's path, or set %s" % FIRMWARE_ENV)
+    return ("this orfa was installed without the simulator (ORFA_SKIP_BUILD=1):"
+            " reinstall it from the source tree after running"
             " tools/setup.sh there, or set %s and %s" % (SIM_ENV, FIRMWARE_ENV))
