@@ -35,7 +35,8 @@ except ImportError:                    # older: the wheel package's
 
 ROOT = Path(__file__).resolve().parent
 SKIP = os.environ.get("ORFA_SKIP_BUILD", "") not in ("", "0")
-BOARDS = ("m32d", "m128s")
+# Every board of boards/, each in the Makefile's MODES.
+BOARDS = sorted(p.parent.name for p in (ROOT / "boards").glob("*/board.mk"))
 MODES = ("gate", "slave")
 MAKE_GOALS = ["all-boards", "robot", "build/sim/orfa-sim"]
 SETUP_HINT = ("run tools/setup.sh (it installs them on Debian), or set"

@@ -19,6 +19,8 @@ import os
 from pathlib import Path
 from typing import Iterable, List, Optional
 
+from .boardmap import BOARDS
+
 PACKAGE_DIR = Path(__file__).resolve().parent
 #: The repository root (host/orfa/../..); meaningful only in a work tree.
 REPO_ROOT = PACKAGE_DIR.parents[1]
@@ -27,7 +29,6 @@ PACKAGE_SIM = PACKAGE_DIR / "_sim" / "orfa-sim"
 PACKAGE_FIRMWARE = PACKAGE_DIR / "_firmware"
 SIM_ENV = "ORFA_SIM"
 FIRMWARE_ENV = "ORFA_FIRMWARE"
-BOARDS = ("m32d", "m128s")
 
 
 def in_work_tree() -> bool:

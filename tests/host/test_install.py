@@ -22,6 +22,9 @@ from pathlib import Path
 import pytest
 import serial
 
+from orfa import boardmap
+from orfa.boardmap import BOARDS
+
 ROOT = Path(__file__).resolve().parents[2]
 WHEELHOUSE = ROOT / "build" / "pip" / "wheelhouse"
 #: wheel: setuptools older than 70.1 (the venv's) builds wheels with it
@@ -100,16 +103,20 @@ def test_simulator_and_firmware_are_in_the_package(installed, tmp_path):
             "    for m in ('gate', 'slave'):\n"
             "        print(s.firmware_path(b, m))\n"
             "print(s.slave_firmware_path('m128s', 0x10))\n"
-            "print(s.slave_firmware_path('m32d', 0x12))\n")
+            "print(s.slave_firmware_path('m32d', 0x12))\n"
+            "from orfa import boardmap\n"
+            "print(boardmap.load('m32d').name)\n")
     r = run([installed.bin / "python", "-c", code], cwd=tmp_path)
     assert r.returncode == 0, r.stderr
-    module, sim, *elfs = [Path(line) for line in r.stdout.splitlines()]
+    module, sim, *elfs, name = r.stdout.splitlines()
+    module, sim, elfs = Path(module), Path(sim), [Path(elf) for elf in elfs]
+    assert name == boardmap.load("m32d").name     # the board map is in the package too
     package = installed.site / "orfa"
     assert module == package / "__init__.py"
     assert sim == package / "_sim" / "orfa-sim" and os.access(str(sim), os.X_OK)
     assert filecmp.cmp(str(sim), str(ROOT / "build" / "sim" / "orfa-sim"), shallow=False)
     want = [package / "_firmware" / ("%s-%s" % (b, m)) / "orfa.elf"
-            for b in ("m32d", "m128s") for m in ("gate", "slave")]
+            for b in BOARDS for m in ("gate", "slave")]
     want += [package / "_firmware" / "robot" / "m128s-0x10" / "orfa.elf",
              package / "_firmware" / "robot" / "m32d-0x12" / "orfa.elf"]
     assert elfs == want

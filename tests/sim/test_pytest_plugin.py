@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from orfa.boardmap import BOARDS
 from orfa.sim import BUILD_HINT, firmware_path, missing_builds
 
 HERE = Path(__file__).resolve().parent
@@ -73,7 +74,7 @@ def test_bad_option_is_a_usage_error(tmp_path):
 
 @pytest.mark.parametrize("decorator,fixture,message", [
     ("@pytest.mark.orfa_board('m8')", "orfa_sim_board",
-     "orfa_board: board 'm8' is not one of m32d, m128s"),
+     "orfa_board: board 'm8' is not one of %s" % ", ".join(BOARDS)),
     ("@pytest.mark.orfa_board('m32d', 'm128s')", "orfa_sim_board",
      "orfa_board takes one board and SimBoard options, not ('m32d', 'm128s')"),
     ("@pytest.mark.orfa_board(colour='red')", "orfa_sim_board",
@@ -85,9 +86,9 @@ def test_bad_option_is_a_usage_error(tmp_path):
     ("@pytest.mark.orfa_robot(slaves=[('m128s',)])", "orfa_sim_robot",
      "orfa_robot: slave ('m128s',) is not (board, addr) or (board, addr, elf)"),
     ("@pytest.mark.orfa_robot(slaves=[('m64', 0x10)])", "orfa_sim_robot",
-     "orfa_robot slave: board 'm64' is not one of m32d, m128s"),
+     "orfa_robot slave: board 'm64' is not one of %s" % ", ".join(BOARDS)),
     ("@pytest.mark.orfa_robot(gateway='m8')", "orfa_sim_robot",
-     "orfa_robot gateway: board 'm8' is not one of m32d, m128s"),
+     "orfa_robot gateway: board 'm8' is not one of %s" % ", ".join(BOARDS)),
     ("@pytest.mark.orfa_robot('m32d')", "orfa_sim_robot",
      "orfa_robot takes keywords (gateway=, slaves=, SimBoard options), not ('m32d',)"),
 ])
