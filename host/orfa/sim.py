@@ -200,7 +200,12 @@ class SimBoard:
             if time.monotonic() > deadline:
                 self._fail("orfa-sim made no link within %.0f s" % self.start_timeout)
             time.sleep(0.01)
+        # the simulator prints its line just after it makes the link
         self.banner = self._read("stdout")
+        while not self.banner.endswith("\n") and self.proc.poll() is None \
+                and time.monotonic() < deadline:
+            time.sleep(0.002)
+            self.banner = self._read("stdout")
         return self
 
     def _read(self, name: str) -> str:
