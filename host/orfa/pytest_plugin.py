@@ -108,7 +108,11 @@ def _run(make) -> Iterator[SimBoard]:
     try:
         yield sim
     finally:
-        sim.stop()
+        status = sim.stop()
+    # SIGTERM ends a healthy simulator with 0; 1 is a crashed firmware
+    if status not in (None, 0):
+        pytest.fail("orfa: orfa-sim exited with %d: %s"
+                    % (status, sim.final_stderr.strip() or "(no message)"), pytrace=False)
 
 
 @pytest.fixture

@@ -131,16 +131,22 @@ def test_simulator_and_firmware_are_in_the_package(installed, tmp_path):
     assert "Root-Is-Purelib: false" in wheel and "Tag: py3-none-linux_" in wheel, wheel
 
 
-def test_orfa_sim_answers_on_its_port(installed, tmp_path):
-    proc = subprocess.Popen([str(installed.bin / "orfa"), "sim", "--board", "m32d"],
+@pytest.mark.parametrize("args,requests", [
+    ([], [(b"V\n", b"V1.1\r\n")]),
+    # a robot: the slave's ELF from the package (the test robot's at 0x10)
+    (["--slave", "m128s:0x10"], [(b"S 10 P\n", b"SWP\r\n"), (b"S 12 P\n", b"ERROR 06\r\n")]),
+])
+def test_orfa_sim_answers_on_its_port(installed, tmp_path, args, requests):
+    proc = subprocess.Popen([str(installed.bin / "orfa"), "sim", "--board", "m32d"] + args,
                             cwd=str(tmp_path), env=clean_env(), stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     try:
         port = proc.stdout.readline().strip()
         assert port, proc.stderr.read() if proc.poll() is not None else "no port printed"
         with serial.serial_for_url(port, baudrate=115200, timeout=10) as link:
-            link.write(b"V\n")
-            assert link.read_until(b"\r\n") == b"V1.1\r\n"
+            for request, reply in requests:
+                link.write(request)
+                assert link.read_until(b"\r\n") == reply
     finally:
         proc.send_signal(signal.SIGTERM)
         _, err = proc.communicate(timeout=10)

@@ -125,3 +125,15 @@ def test_firmware_directory_setting(tmp_path):
     assert status == 1 and summary(out) == {"error": 1}, out
     assert "orfa: %s is missing: ORFA_FIRMWARE=%s set" % (
         fw / "m128s-gate" / "orfa.elf", fw) in out, out
+
+
+def test_a_simulator_that_did_not_end_well_is_reported(tmp_path):
+    """A simulator that dies during the test (here killed; a crashed
+    firmware ends it with 1) is an error at teardown, with its status."""
+    text = ("import signal\n\n"
+            "def test_x(orfa_sim_board):\n"
+            "    orfa_sim_board.proc.send_signal(signal.SIGKILL)\n"
+            "    orfa_sim_board.proc.wait()\n")
+    status, out = user_pytest(tmp_path, text)
+    assert status == 1 and summary(out) == {"passed": 1, "error": 1}, out
+    assert "orfa: orfa-sim exited with -9: " in out, out
