@@ -91,15 +91,16 @@ class BuildWithSimulator(build_py):
     """build_py, then the simulator and the firmware into the package."""
 
     def run(self):
+        editable = getattr(self, "editable_mode", False)
+        # make first: a missing toolchain is the first and last thing said
+        files = build_artefacts() if not (SKIP or editable) else {}
         super().run()
-        if getattr(self, "editable_mode", False):
+        if editable:
             return
         # build/pip outlives a build: no copy from an earlier one stays
         for rel in ("_sim", "_firmware"):
             self.remove_tree(Path(self.build_lib) / "orfa" / rel)
-        if SKIP:
-            return
-        for rel, source in build_artefacts().items():
+        for rel, source in files.items():
             target = Path(self.build_lib) / "orfa" / rel
             self.mkpath(str(target.parent))
             self.copy_file(str(source), str(target))    # keeps the x bit
