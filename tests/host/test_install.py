@@ -210,3 +210,13 @@ def test_missing_toolchain_stops_the_install_with_one_message(installed, tmp_pat
     assert message in out, out
     assert "Traceback" not in out, out
     assert not (tmp_path / "t" / "orfa").exists()
+
+
+def test_orfa_flash_writes_the_packages_hex(installed, tmp_path):
+    """orfa flash finds the build through the same lookup: the package's copy."""
+    r = run([installed.bin / "orfa", "flash", "--dry-run", "--board", "m128s", "--mode", "slave"],
+            cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    hex_path = installed.site / "orfa" / "_firmware" / "m128s-slave" / "orfa.hex"
+    assert r.stdout == "avrdude -c usbasp -p %s -U flash:w:%s:i\n" % (
+        boardmap.load("m128s").avrdude_part, hex_path), r.stdout
