@@ -26,9 +26,8 @@
  *    wanted; here write results are skipped and read results decoded, and
  *    the record loop is inside the reply loop (the manual closed the loop
  *    before it);
- *  - the first read asked for records 1.. of driver MAX_PER_PKG*i + 1 as the
- *    manual does, and a count of 0 (impossible: introspection counts
- *    itself) is reported instead of read on.
+ *  - a count of 0 (impossible: introspection counts itself) is reported
+ *    instead of read on, and every call's return code is checked.
  */
 #include <errno.h>
 #include <stdio.h>
