@@ -4,6 +4,7 @@
 #   make all-boards     every board and mode
 #   make robot          the slave boards of the simulated test robot
 #   make size           flash and static RAM of every build in build/
+#   make map            host/orfa/maps/<board>.json from the C definitions
 #   make sim            build/sim/orfa-sim
 #   make unit           host-compiled unit tests of the parser and register logic
 #   make fuzz-short     each libFuzzer harness a few seconds (about a minute in all)
@@ -97,7 +98,7 @@ $(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 
-.PHONY: print-baud-rates firmware all-boards robot size sim unit fuzz fuzz-short test bench soak demo demo-robot clean setup
+.PHONY: map map-board print-baud-rates firmware all-boards robot size sim unit fuzz fuzz-short test bench soak demo demo-robot clean setup
 .DEFAULT_GOAL := firmware
 
 firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
@@ -132,6 +133,23 @@ robot:
 
 size:
 	@tools/size.sh build
+
+# The board map (tools/mapgen.c): registers, UIDs, pins, status and error
+# codes as the firmware is built, for the host package, tests and docs.
+MAP_OUT ?= host/orfa/maps
+map:
+	@set -e; for b in $(BOARDS); do \
+		$(MAKE) --no-print-directory BOARD=$$b MODE=gate map-board; done
+
+map-board: tools/mapgen.c boards/$(BOARD)/board.mk
+	@mkdir -p build/map $(MAP_OUT)
+	gcc -std=c99 -Wall -Wextra -Werror -I. -Iboards/$(BOARD) \
+		'-DORFA_DRIVER_LIST=$(foreach d,$(BOARD_DRIVERS),X($(d)))' \
+		'-DMAP_AVRDUDE_PART="$(BOARD_AVRDUDE_PART)"' '-DMAP_FUSES="$(BOARD_FUSES)"' \
+		tools/mapgen.c -o build/map/mapgen-$(BOARD)
+	build/map/mapgen-$(BOARD) > $(MAP_OUT)/$(BOARD).json.new
+	@python3 -c 'import json,sys; json.load(open(sys.argv[1]))' $(MAP_OUT)/$(BOARD).json.new
+	@mv $(MAP_OUT)/$(BOARD).json.new $(MAP_OUT)/$(BOARD).json
 
 print-baud-rates:
 	@echo $(BAUD_RATES)

@@ -5,6 +5,7 @@
 #include "firmware/regmap.h"
 
 #define DRV_adc_NREGS 2
+#define DRV_adc_REGS(X) X("RC", 0) X("RD", 0)
 
 /* Settings byte of RC. */
 #define ADC_SET_REF_MASK 0x03  /* 00 AREF, 01 AVCC, 10/11 internal 2.56 V */

@@ -9,6 +9,7 @@
 #define GPIO_COUNT_PORT(letter) + 1
 #define GPIO_NPORTS (0 BOARD_GPIO_PORTS(GPIO_COUNT_PORT))
 #define DRV_gpio_NREGS (2 * GPIO_NPORTS)
+#define DRV_gpio_REGS(X) X("VALUE_%c", 1) X("MODE_%c", 1)
 
 #define DRV_gpio_UID BOARD_GPIO_UID
 #define DRV_gpio_MAJOR 1

@@ -5,6 +5,7 @@
 #include "firmware/regmap.h"
 
 #define DRV_motor_NREGS 4
+#define DRV_motor_REGS(X) X("PWM1", 0) X("PWM2", 0) X("DIR1", 0) X("DIR2", 0)
 
 #define DRV_motor_UID 0x0060
 #define DRV_motor_MAJOR 1

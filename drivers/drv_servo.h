@@ -6,6 +6,7 @@
 #include "firmware/regmap.h"
 
 #define DRV_servo_NREGS 2
+#define DRV_servo_REGS(X) X("RS", 0) X("SP", 0)
 #define SERVO_CHANNELS BOARD_SERVO_CHANNELS
 #define SERVO_MIN_US 500
 #define SERVO_MAX_US 2500

@@ -5,6 +5,7 @@
 #include "firmware/regmap.h"
 
 #define DRV_spi_NREGS 2
+#define DRV_spi_REGS(X) X("DATA", 0) X("CONFIG", 0)
 #define SPI_CHANNELS 4
 #define SPI_BUF 64
 

@@ -5,6 +5,7 @@
 #include "firmware/regmap.h"
 
 #define DRV_intro_NREGS 2
+#define DRV_intro_REGS(X) X("INTRO", 0) X("STATUS", 0)
 
 #define DRV_intro_UID 0x0000
 #define DRV_intro_MAJOR 1

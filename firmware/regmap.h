@@ -11,17 +11,23 @@
 
 #include "firmware/flash.h"
 
-/* Status register values (docs/registers.md). */
+/* Status register values (docs/registers.md): X(name, code, meaning). The
+ * host's board map (tools/mapgen.c) takes names and meanings from here. */
+#define REG_STATUS_LIST(X) \
+	X(OK, 0x00, "the last operation succeeded") \
+	X(BAD_LENGTH, 0x01, "the write had a length the register does not take") \
+	X(BAD_VALUE, 0x02, "a value out of range (a driver number above the count, a channel that does not exist, ...)") \
+	X(PIN_BUSY, 0x03, "a pin the operation needs belongs to another function") \
+	X(NOT_WRITABLE, 0x04, "the register cannot be written") \
+	X(NOT_READABLE, 0x05, "the register cannot be read") \
+	X(READ_WRAPPED, 0x06, "introspection read past the last driver and went on with driver 1") \
+	X(NOT_BOUND, 0x07, "SPI channel without a chip-select line") \
+	X(NO_REGISTER, 0x08, "a write frame named a register that no driver maps")
+
 typedef enum {
-	REG_OK = 0x00,
-	REG_BAD_LENGTH = 0x01,
-	REG_BAD_VALUE = 0x02,
-	REG_PIN_BUSY = 0x03,
-	REG_NOT_WRITABLE = 0x04,
-	REG_NOT_READABLE = 0x05,
-	REG_READ_WRAPPED = 0x06,
-	REG_NOT_BOUND = 0x07,
-	REG_NO_REGISTER = 0x08,
+#define REG_STATUS_ENUM(name, code, text) REG_##name = code,
+	REG_STATUS_LIST(REG_STATUS_ENUM)
+#undef REG_STATUS_ENUM
 } reg_status_t;
 
 #define REGMAP_INTRO_REG   0x00
@@ -45,6 +51,10 @@ typedef enum {
  *       puts up to `max` bytes of the register's data at `dst` and returns
  *       how many; 0 means the register cannot be read. The regmap asks again
  *       when a read frame wants more bytes than one answer gave.
+ *   DRV_name_REGS(X)
+ *       the register names in order, X(name, per_port): per_port 0 is one
+ *       register, 1 one register per GPIO port with %c in the name standing
+ *       for the port's letter (the host's board map, tools/mapgen.c)
  *   DRV_name_SAFE()
  *       a statement-like macro: the driver's link-loss safe state, applied
  *       as if the host had written it (drv_name_safe() for motors and

@@ -18,6 +18,7 @@
 #include "firmware/regmap.h"
 
 #define DRV_sys_NREGS 2
+#define DRV_sys_REGS(X) X("RESET", 0) X("FAILSAFE", 0)
 
 #define DRV_sys_UID 0x0002
 #define DRV_sys_MAJOR 1

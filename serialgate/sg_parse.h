@@ -10,16 +10,22 @@
 
 #include <stdint.h>
 
-/* The protocol's error codes. */
+/* The protocol's error codes (docs/protocol.md): X(name, code, when). The
+ * host's board map (tools/mapgen.c) takes names and meanings from here. */
+#define SG_ERR_LIST(X) \
+	X(INTERNAL, 0x01, "internal parser error") \
+	X(COMMAND, 0x02, "unknown command letter") \
+	X(HEX, 0x03, "not a hex digit where a byte is expected, or a byte with one digit") \
+	X(DATA, 0x04, "wrong data, a request or reply over its limit, or characters lost") \
+	X(NO_P, 0x05, "the line ended before the P of an I2C request") \
+	X(ADDR_NACK, 0x06, "no ACK for an address byte (no device, bus not to be had, register not readable)") \
+	X(DATA_NACK, 0x07, "no ACK for a data byte (or a local write a driver rejects)")
+
 typedef enum {
 	SG_OK = 0x00,
-	SG_ERR_INTERNAL = 0x01,
-	SG_ERR_COMMAND = 0x02,
-	SG_ERR_HEX = 0x03,
-	SG_ERR_DATA = 0x04,
-	SG_ERR_NO_P = 0x05,
-	SG_ERR_ADDR_NACK = 0x06,
-	SG_ERR_DATA_NACK = 0x07,
+#define SG_ERR_ENUM(name, code, text) SG_ERR_##name = code,
+	SG_ERR_LIST(SG_ERR_ENUM)
+#undef SG_ERR_ENUM
 } sg_err_t;
 
 #define SG_LINE_MAX   128  /* characters of a request before its terminator */

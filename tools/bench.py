@@ -22,6 +22,7 @@ runs print the same figures, cycle for cycle.
 """
 
 import argparse
+import re
 import subprocess
 import sys
 import time
@@ -32,6 +33,7 @@ sys.path.insert(0, str(ROOT / "host"))
 
 import serial  # noqa: E402
 
+from orfa import boardmap  # noqa: E402
 from orfa.sim import SimBoard, firmware_path, parse_trace  # noqa: E402
 from orfa.simctl import RX_MAX, SimControlError  # noqa: E402
 
@@ -120,20 +122,34 @@ def read_replies(port, count):
     return replies
 
 
-# Requests that reach every driver (register numbers from docs/registers.md).
-EXERCISE = {
-    "m32d": ["S AA 02 55 0F P", "S AA 06 0F 0F S AB 01 P", "S AA 0B 00 02 02 P",
-             "S AA 0A 00 9F 00 00 P", "S AA 0A S AB 03 P", "S AA 0B S AB 09 P",
-             "S AA 0C 05 F0 P", "S AA 0D S AB 10 P", "S AA 0E 80 60 00 01 P",
-             "S AA 0E 00 00 00 00 P", "S AA 00 01 S AB 3C P"],
-    "m128s": ["S AA 02 55 0F P", "S AA 04 0F 0F S AB 01 P", "S AA 07 00 00 02 P",
-              "S AA 06 00 9F 00 00 P", "S AA 06 S AB 03 P", "S AA 07 S AB 09 P",
-              "S AA 08 05 F0 P", "S AA 09 S AB 10 P", "S AA 00 01 S AB 3C P"],
+# Requests that reach every driver, written with register names ({gpio.VALUE_A})
+# that the board map turns into numbers.
+EXERCISE_TEXT = {
+    "m32d": ["S AA {gpio.VALUE_A} 55 0F P", "S AA {gpio.MODE_A} 0F 0F S AB 01 P",
+             "S AA {spi.CONFIG} 00 02 02 P", "S AA {spi.DATA} 00 9F 00 00 P",
+             "S AA {spi.DATA} S AB 03 P", "S AA {spi.CONFIG} S AB 09 P",
+             "S AA {adc.RC} 05 F0 P", "S AA {adc.RD} S AB 10 P",
+             "S AA {motor.PWM1} 80 60 00 01 P", "S AA {motor.PWM1} 00 00 00 00 P",
+             "S AA 00 01 S AB 3C P"],
+    "m128s": ["S AA {gpio.VALUE_A} 55 0F P", "S AA {gpio.MODE_A} 0F 0F S AB 01 P",
+              "S AA {spi.CONFIG} 00 00 02 P", "S AA {spi.DATA} 00 9F 00 00 P",
+              "S AA {spi.DATA} S AB 03 P", "S AA {spi.CONFIG} S AB 09 P",
+              "S AA {adc.RC} 05 F0 P", "S AA {adc.RD} S AB 10 P", "S AA 00 01 S AB 3C P"],
 }
+
+
+def with_registers(board: str, text: str) -> str:
+    """"S AA {spi.DATA} S AB 03 P" -> "S AA 0A S AB 03 P" on the M32-D."""
+    m = boardmap.load(board)
+    return re.sub(r"\{(\w+)\.(\w+)\}", lambda g: "%02X" % m.reg(g.group(1), g.group(2)), text)
+
+
+EXERCISE = {b: [with_registers(b, t) for t in texts] for b, texts in EXERCISE_TEXT.items()}
 # Servo channels measured: (SP register, [(channel, us, signal)]).
 SERVOS = {
-    "m32d": (0x13, [(0, 500, "A0"), (1, 1500, "A1"), (9, 2500, "C6"), (13, 1234, "B2")]),
-    "m128s": (0x0B, [(0, 500, "servo0"), (9, 1500, "servo9"), (18, 2500, "servo18"),
+    "m32d": (boardmap.load("m32d").reg("servo", "SP"),
+             [(0, 500, "A0"), (1, 1500, "A1"), (9, 2500, "C6"), (13, 1234, "B2")]),
+    "m128s": (boardmap.load("m128s").reg("servo", "SP"), [(0, 500, "servo0"), (9, 1500, "servo9"), (18, 2500, "servo18"),
                      (31, 1234, "servo31")]),
 }
 SERVO_LOAD = "S AA 00 01 S AB 06 P\r"
@@ -451,10 +467,11 @@ def bench_speed(nboards):
 # gateway, and the board as the test robot's slave behind an M32-D gateway.
 
 WD_MS = F_CPU // 1000
-#: docs/registers.md "sys": each board's RESET register (FAILSAFE = +1),
-#: its servo SP register and a servo pin.
-WD_SYS = {"m32d": 0x14, "m128s": 0x0C}
-WD_SERVO = {"m32d": (0x13, "A3"), "m128s": (0x0B, "servo3")}
+#: Each board's sys RESET register (FAILSAFE = +1), its servo SP register
+#: and a servo pin (the board maps).
+WD_SYS = {b: boardmap.load(b).reg("sys", "RESET") for b in boardmap.BOARDS}
+WD_SERVO = {"m32d": (boardmap.load("m32d").reg("servo", "SP"), "A3"),
+            "m128s": (boardmap.load("m128s").reg("servo", "SP"), "servo3")}
 WD_FAILSAFE_MS = 100
 
 

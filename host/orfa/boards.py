@@ -1,28 +1,27 @@
-"""What the host knows of each board (SPEC section 1)."""
+"""What the host knows of each board (SPEC section 1), from the board maps
+(orfa.boardmap: generated from the firmware's C definitions)."""
+
+from . import boardmap
 
 #: Driver UIDs each board can have, in register order. Builds may leave
 #: drivers out (`make DRIVERS=...`); introspection then lists fewer.
-BOARD_UIDS = {
-    "m32d": (0x0000, 0x0020, 0x0001, 0x0040, 0x0060, 0x0031, 0x0002),
-    "m128s": (0x0000, 0x0021, 0x0001, 0x0040, 0x0030, 0x0002),
-}
+BOARD_UIDS = {board: boardmap.load(board).uids for board in boardmap.BOARDS}
 
 #: The sys driver: reset causes and the link-loss failsafe.
-SYS_UID = 0x0002
+SYS_UID = boardmap.load("m32d").driver("sys").uid
 
-#: The sys driver's registers (UID 0x0002, always built in and last, so
-#: they follow every other driver's; docs/registers.md "sys"): RESET and
-#: FAILSAFE of each board with all its drivers. A build that leaves drivers
-#: out moves them down: ask introspection then (Gateway.sys_register).
-SYS_REGISTER = {"m32d": 0x14, "m128s": 0x0C}
+#: The sys driver's RESET register (FAILSAFE follows it) of each board with
+#: all its drivers (UID 0x0002, always built in and last; docs/registers.md
+#: "sys"). A build that leaves drivers out moves it down: ask introspection
+#: then (Gateway.sys_register).
+SYS_REGISTER = {board: boardmap.load(board).reg("sys", "RESET") for board in boardmap.BOARDS}
 
 #: RESET's bits (the MCU's MCUCSR layout), by cause name.
-RESET_CAUSES = {"power": 0x01, "external": 0x02, "brownout": 0x04,
-                "watchdog": 0x08, "jtag": 0x10}
-RESET_CAUSES_ALL = 0x1F
+RESET_CAUSES = dict(boardmap.load("m32d").reset_causes)
+RESET_CAUSES_ALL = sum(RESET_CAUSES.values())
 
 #: FAILSAFE's longest timeout in milliseconds (0 = off).
-FAILSAFE_MAX_MS = 18000
+FAILSAFE_MAX_MS = boardmap.load("m32d").limits["failsafe_max_ms"]
 
 
 def reset_causes(byte: int) -> frozenset:
@@ -39,14 +38,32 @@ def reset_cause_bits(causes) -> int:
         bits |= RESET_CAUSES[name]
     return bits
 
-DRIVER_NAMES = {
-    0x0000: "introspection",
-    0x0001: "SPI",
-    0x0002: "system (reset cause, failsafe)",
-    0x0020: "GPIO (4 ports)",
-    0x0021: "GPIO (2 ports)",
-    0x0030: "servos (32)",
-    0x0031: "servos (16)",
-    0x0040: "ADC",
-    0x0060: "motors",
+
+#: What each driver is, for people (tables of `orfa drivers`, docs).
+DRIVER_TITLES = {
+    "intro": "introspection",
+    "spi": "SPI",
+    "sys": "system (reset cause, failsafe)",
+    "gpio": "GPIO",
+    "servo": "servos",
+    "adc": "ADC",
+    "motor": "motors",
 }
+
+
+def driver_title(uid: int) -> str:
+    """A driver's title by UID: "servos (16)", "GPIO (4 ports)", ..."""
+    for board in boardmap.BOARDS:
+        m = boardmap.load(board)
+        drv = m.driver_by_uid(uid)
+        if drv is None:
+            continue
+        if drv.name == "servo":
+            return "servos (%d)" % m.servo_channels
+        if drv.name == "gpio":
+            return "GPIO (%d ports)" % len(m.gpio_ports)
+        return DRIVER_TITLES.get(drv.name, drv.name)
+    return "unknown"
+
+
+DRIVER_NAMES = {uid: driver_title(uid) for uid in boardmap.DRIVER_NAMES}

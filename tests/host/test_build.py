@@ -41,7 +41,7 @@ def test_unknown_mode_and_board(tmp_path):
     assert r.returncode != 0 and "BOARD=m64" in r.stderr
 
 
-@pytest.mark.parametrize("baud", ["1200", "115201", "9600x", "AUTO", "", "230400"])
+@pytest.mark.parametrize("baud", ["1200", "115201", "9600x", "AUTO", "", "230400", "250000"])
 def test_baud_that_is_not_a_line_rate_stops_the_build(baud, tmp_path):
     r = make("BOARD=m32d", "MODE=gate", "BAUD=" + baud, tmp_path=tmp_path)
     assert r.returncode != 0

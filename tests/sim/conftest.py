@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from orfa import boardmap
 from orfa import protocol as p
 from orfa.gateway import Gateway
 from orfa.sim import BOARDS, BUILD_HINT, SimBoard, missing_builds
@@ -232,35 +233,38 @@ F_CPU = 7372800
 #: One servo frame: 20 ms.
 SERVO_FRAME = 147456
 
-#: Registers and pins of each board (docs/registers.md, docs/boards.md).
-DRV_LAYOUT = {
-    "m32d": {
-        "gpio_ports": "ABCD", "gpio_val": 0x02, "gpio_mode": 0x06,
-        "spi": 0x0A, "adc": 0x0C, "motor": 0x0E, "servo": 0x12, "sys": 0x14,
-        "servo_channels": 16, "adc_port": "A",
-        "spi_pins": {"SS": "B4", "MOSI": "B5", "MISO": "B6", "SCK": "B7"},
-        # channel n's pin
-        "servo_pins": ["A0", "A1", "A2", "A3", "A4", "A5", "A6", "A7",
-                       "C7", "C6", "C5", "C4", "B3", "B2", "D5", "D4"],
-        # pins of functions that GPIO never has (UART, TWI, SPI, motors)
-        "fixed_scl": "C0",
-        "fixed_pins": {"D0": "UART", "D1": "UART", "C0": "TWI", "C1": "TWI",
-                       "B4": "SPI", "B5": "SPI", "B6": "SPI", "B7": "SPI",
-                       "D5": "MOTOR", "D4": "MOTOR", "B0": "MOTOR", "B1": "MOTOR"},
-    },
-    "m128s": {
-        "gpio_ports": "AF", "gpio_val": 0x02, "gpio_mode": 0x04,
-        "spi": 0x06, "adc": 0x08, "motor": None, "servo": 0x0A, "sys": 0x0C,
-        "servo_channels": 32, "adc_port": "F",
-        "spi_pins": {"SS": "B0", "SCK": "B1", "MOSI": "B2", "MISO": "B3"},
-        "servo_pins": ["servo%d" % n for n in range(32)],
-        "fixed_scl": "D0",
-        "fixed_pins": {"D2": "UART", "D3": "UART", "D0": "TWI", "D1": "TWI",
-                       "B0": "SPI", "B1": "SPI", "B2": "SPI", "B3": "SPI",
-                       "E3": "SERVO", "E4": "SERVO", "E5": "SERVO", "B7": "SERVO",
-                       "E6": "SERVO"},
-    },
-}
+def _layout(board: str) -> dict:
+    """Registers and pins of a board with all its drivers, from its map
+    (orfa.boardmap, generated from the firmware's C definitions)."""
+    m = boardmap.load(board)
+    label = lambda pin: "%s%d" % (pin.port, pin.bit)          # noqa: E731
+    servo_pins = sorted(m.pins_of("SERVO"), key=lambda pin: pin.index)
+    fixed = {}
+    for pin in m.pins:
+        kind = pin.function.split("_")[0]
+        if pin.function != "SERVO":          # a servo channel's pin is GPIO's when off
+            fixed[label(pin)] = kind
+    return {
+        "gpio_ports": m.gpio_ports,
+        "gpio_val": m.reg("gpio", "VALUE_" + m.gpio_ports[0]),
+        "gpio_mode": m.reg("gpio", "MODE_" + m.gpio_ports[0]),
+        "spi": m.reg("spi", "DATA"), "adc": m.reg("adc", "RC"),
+        "motor": m.reg("motor", "PWM1") if m.has("motor") else None,
+        "servo": m.reg("servo", "RS"), "sys": m.reg("sys", "RESET"),
+        "servo_channels": m.servo_channels, "adc_port": m.adc_port,
+        "spi_pins": {pin.function[4:]: label(pin) for pin in m.pins
+                     if pin.function.startswith("SPI_")},
+        # channel n's pin; the simulator's signal when counters drive them
+        "servo_pins": ([label(pin) for pin in servo_pins] if servo_pins
+                       else ["servo%d" % n for n in range(m.servo_channels)]),
+        "fixed_scl": label(m.pins_of("TWI_SCL")[0]),
+        # pins of functions that GPIO never has (UART, TWI, SPI, motors, counters)
+        "fixed_pins": fixed,
+    }
+
+
+#: Registers and pins of each board (docs/board-<board>.md).
+DRV_LAYOUT = {board: _layout(board) for board in boardmap.BOARDS}
 
 
 def us_to_cycles(us: float) -> float:

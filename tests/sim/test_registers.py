@@ -132,3 +132,13 @@ def test_gateway_drivers_helper(board):
     assert len(records) == n
     assert [r for r in records] == [p.DriverRecord.parse(board.record(i))
                                     for i in range(1, n + 1)]
+
+
+def test_the_board_map_is_what_the_firmware_answers(board):
+    """The generated map (host/orfa/maps/<board>.json) against the running
+    firmware: every record (UID, version, start, count) in order."""
+    from orfa import boardmap
+    m = boardmap.load(board.board)
+    records = board.gw.drivers()
+    assert [(r.uid, r.major, r.minor, r.start, r.count) for r in records] == \
+        [(d.uid, d.major, d.minor, d.start, d.count) for d in m.drivers]

@@ -1,0 +1,107 @@
+"""The board maps are the one source of truth of the host side: generated
+from the firmware's C definitions, read by Python, the tests, the benchmark
+and the docs. These tests fail when any of them drifts."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from orfa import boardmap, boards
+from orfa import protocol as p
+
+ROOT = Path(__file__).resolve().parents[2]
+MAPS = ROOT / "host" / "orfa" / "maps"
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory):
+    """The maps as `make map` writes them today, into a temporary folder."""
+    out = tmp_path_factory.mktemp("maps")
+    r = subprocess.run(["make", "--no-print-directory", "map", "MAP_OUT=%s" % out],
+                       cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stdout + r.stderr
+    return out
+
+
+@pytest.mark.parametrize("board", boardmap.BOARDS)
+def test_committed_map_is_what_the_c_gives(board, generated):
+    fresh = (generated / ("%s.json" % board)).read_text()
+    committed = (MAPS / ("%s.json" % board)).read_text()
+    assert committed == fresh, "host/orfa/maps/%s.json is stale: run `make map`" % board
+
+
+def test_generated_docs_are_current():
+    r = subprocess.run([sys.executable, str(ROOT / "tools" / "docgen.py"), "--check"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+
+
+def test_mapgen_refuses_a_driver_whose_names_do_not_match_its_registers(tmp_path):
+    """A driver that names fewer registers than it has stops `make map`."""
+    src = (ROOT / "tools" / "mapgen.c").read_text()
+    bad = tmp_path / "mapgen.c"
+    bad.write_text(src.replace("int main(void)\n{",
+                               "#undef DRV_adc_REGS\n#define DRV_adc_REGS(X) X(\"RC\", 0)\n"
+                               "int main(void)\n{"))
+    exe = tmp_path / "mapgen"
+    cc = subprocess.run(["gcc", "-std=c99", "-I%s" % ROOT, "-I%s" % (ROOT / "boards" / "m32d"),
+                         "-DORFA_DRIVER_LIST=X(gpio) X(adc)", '-DMAP_AVRDUDE_PART="m32"',
+                         '-DMAP_FUSES="lfuse:0xff"', str(bad), "-o", str(exe)],
+                        capture_output=True, text=True)
+    assert cc.returncode == 0, cc.stderr
+    r = subprocess.run([str(exe)], capture_output=True, text=True)
+    assert r.returncode != 0
+    assert "driver adc has 2 registers but names 1" in r.stderr
+
+
+@pytest.mark.parametrize("board", boardmap.BOARDS)
+def test_map_is_consistent(board):
+    m = boardmap.load(board)
+    start = 0
+    for drv in m.drivers:                       # contiguous from 00, as regmap.c
+        assert drv.start == start, drv
+        assert len(drv.registers) == drv.count
+        start += drv.count
+    assert m.drivers[0].name == "intro" and m.drivers[-1].name == "sys"
+    assert len(m.gpio_ports) * 2 == m.driver("gpio").count
+    raw = json.loads((MAPS / ("%s.json" % board)).read_text())
+    assert raw["board"] == board and raw["schema"] == 1
+
+
+def test_python_constants_follow_the_map():
+    m = boardmap.load("m32d")
+    assert {c: e.name for c, e in boardmap.ERRORS.items()} == {
+        1: "INTERNAL", 2: "COMMAND", 3: "HEX", 4: "DATA", 5: "NO_P",
+        6: "ADDR_NACK", 7: "DATA_NACK"}
+    assert sorted(int(c) for c in p.ErrorCode) == sorted(boardmap.ERRORS)
+    assert sorted(p.ERRORS_BY_CODE) == sorted(boardmap.ERRORS)
+    for board in boardmap.BOARDS:
+        bm = boardmap.load(board)
+        assert bm.limits["request_chars"] == p.MAX_REQUEST_CHARS
+        assert bm.limits["reply_chars"] == p.MAX_REPLY_CHARS
+        assert bm.f_cpu == p.F_CPU
+        assert bm.local_address == p.DEFAULT_LOCAL_ADDRESS
+        assert boards.BOARD_UIDS[board] == bm.uids
+        assert boards.SYS_REGISTER[board] == bm.reg("sys", "RESET")
+    assert boards.FAILSAFE_MAX_MS == m.limits["failsafe_max_ms"] == 18000
+    assert boards.RESET_CAUSES == {"power": 1, "external": 2, "brownout": 4,
+                                   "watchdog": 8, "jtag": 16}
+
+
+def test_lookups():
+    m = boardmap.load("m32d")
+    assert m.reg("servo", "SP") == 0x13 and boardmap.load("m128s").reg("servo", "sp") == 0x0B
+    with pytest.raises(KeyError, match="no driver 'motor'"):
+        boardmap.load("m128s").driver("motor")
+    with pytest.raises(KeyError, match="no register 'XX'"):
+        m.reg("servo", "XX")
+    with pytest.raises(ValueError, match="no board"):
+        boardmap.load("m64")
+    assert boardmap.by_uids(m.uids) is m
+    assert boardmap.by_uids([0x0000, 0x0020, 0x0002]) is m      # drivers left out
+    assert boardmap.by_uids([0x0000, 0x0021, 0x0030, 0x0002]).board == "m128s"
+    assert boardmap.by_uids([0x0000, 0x1234]) is None
+    assert boardmap.STATUS[3].name == "PIN_BUSY"
