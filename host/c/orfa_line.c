@@ -359,22 +359,11 @@ const char *orfa_strerror(int err)
 
 const char *orfa_code_str(int code)
 {
-	/* the firmware's names of the codes (serialgate/sg_parse.h) */
+	/* the firmware's list of the codes and their meanings */
 	switch (code) {
-	case SG_ERR_INTERNAL:
-		return "internal parser error";
-	case SG_ERR_COMMAND:
-		return "unknown command letter";
-	case SG_ERR_HEX:
-		return "not a hex byte";
-	case SG_ERR_DATA:
-		return "wrong data or over a limit";
-	case SG_ERR_NO_P:
-		return "line ended before P";
-	case SG_ERR_ADDR_NACK:
-		return "no ACK for the address: no such device";
-	case SG_ERR_DATA_NACK:
-		return "no ACK for a data byte: refused";
+#define ORFA_CODE_CASE(name, value, text) case value: return text;
+	SG_ERR_LIST(ORFA_CODE_CASE)
+#undef ORFA_CODE_CASE
 	}
 	return "unknown protocol error";
 }
