@@ -206,3 +206,11 @@ def test_no_reply(get_drivers):
     assert r.returncode == 1
     assert r.stdout == ""
     assert r.stderr == "get_drivers: %s: address 0xAA: no reply in time\n" % path
+
+
+def test_docs_sample_is_the_m32d_map():
+    """docs/c-library.md shows get_drivers' output for an M32-D: it must be
+    what the program prints for the board map as it is."""
+    doc = (ROOT / "docs" / "c-library.md").read_text()
+    shown = "".join(line[4:] + "\n" for line in doc.splitlines() if line.startswith("    UID "))
+    assert shown == listing(boardmap.load("m32d").drivers)
