@@ -4,6 +4,8 @@
 #   make all-boards     every board and mode
 #   make robot          the slave boards of the simulated test robot
 #   make size           flash and static RAM of every build in build/
+#   make flash          write the build's .hex with avrdude [PROGRAMMER=usbasp] [PORT=...]
+#   make fuses          write the board's fuses (boards/<board>/board.mk) with avrdude
 #   make map            host/orfa/maps/<board>.json from the C definitions
 #   make sim            build/sim/orfa-sim
 #   make unit           host-compiled unit tests of the parser and register logic
@@ -98,7 +100,7 @@ $(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 
-.PHONY: map map-board print-baud-rates firmware all-boards robot size sim unit fuzz fuzz-short test bench soak demo demo-robot clean setup
+.PHONY: map map-board print-baud-rates firmware flash fuses all-boards robot size sim unit fuzz fuzz-short test bench soak demo demo-robot clean setup
 .DEFAULT_GOAL := firmware
 
 firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
@@ -153,6 +155,31 @@ map-board: tools/mapgen.c boards/$(BOARD)/board.mk
 
 print-baud-rates:
 	@echo $(BAUD_RATES)
+
+# --- flashing a real board (avrdude; docs/flashing.md) ----------------------
+# The part and the fuses come from boards/$(BOARD)/board.mk. PROGRAMMER is
+# passed to avrdude as it is (avrdude knows its programmers); no PORT, no -P.
+# AVRDUDE_FLAGS: anything more for avrdude (-B 10 for a slow ISP clock, -v).
+AVRDUDE ?= avrdude
+PROGRAMMER ?= usbasp
+PORT ?=
+AVRDUDE_FLAGS ?=
+AVRDUDE_CMD = $(AVRDUDE) -c $(PROGRAMMER) -p $(BOARD_AVRDUDE_PART) \
+	$(if $(strip $(PORT)),-P $(strip $(PORT))) $(AVRDUDE_FLAGS)
+
+AVRDUDE_CHECK = command -v $(firstword $(AVRDUDE)) >/dev/null || { echo \
+	"make: $(firstword $(AVRDUDE)) not found: install avrdude (tools/setup.sh) or give AVRDUDE=/path/to/avrdude" >&2; \
+	exit 127; }
+
+# Built first with the same BAUD, ADDR, DRIVERS and BUILD as `make firmware`.
+flash: $(BUILD)/orfa.hex
+	@$(AVRDUDE_CHECK)
+	$(strip $(AVRDUDE_CMD) -U flash:w:$<:i)
+
+# name:0xVV in board.mk -> -U name:w:0xVV:m, in board.mk's order.
+fuses:
+	@$(AVRDUDE_CHECK)
+	$(strip $(AVRDUDE_CMD) $(foreach f,$(BOARD_FUSES),-U $(subst :,:w:,$(f)):m))
 
 # --- simulator (host C, Debian's libsimavr) --------------------------------
 SIM_SRC := $(wildcard sim/*.c sim/parts/*.c)
@@ -230,6 +257,7 @@ demo-robot: setup
 
 clean:
 	rm -rf build
+	@$(MAKE) --no-print-directory -C examples clean
 
 FORCE:
 

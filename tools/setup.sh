@@ -4,8 +4,9 @@
 set -eu
 
 # clang and its runtime (-fsanitize=fuzzer) for tests/fuzz: Debian's clang
-# is 14 on bookworm, whose libFuzzer comes in libclang-rt-14-dev.
-APT_PACKAGES="gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-14-dev"
+# is 14 on bookworm, whose libFuzzer comes in libclang-rt-14-dev. avrdude for
+# `make flash`, `make fuses` and `orfa flash` (the tests use a stand-in).
+APT_PACKAGES="gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-14-dev avrdude"
 # python module:pip package
 PY_PACKAGES="serial:pyserial pytest:pytest"
 

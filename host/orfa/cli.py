@@ -8,7 +8,7 @@ import sys
 import time
 from typing import List, Optional, TextIO
 
-from . import protocol as p
+from . import flash, protocol as p
 from .gateway import Gateway
 from .sim import BOARDS, SimBoard, SimError
 
@@ -133,6 +133,8 @@ def build_parser() -> argparse.ArgumentParser:
     req.add_argument("--timeout", type=float, default=2.0)
     req.add_argument("requests", nargs="+", metavar="REQUEST")
     req.set_defaults(func=cmd_request)
+
+    flash.add_parser(sub)
     return parser
 
 

@@ -1,0 +1,191 @@
+"""`orfa flash`: write a board's firmware or fuses with avrdude.
+
+The same command lines as `make flash` and `make fuses` (docs/flashing.md):
+
+    avrdude -c usbasp -p m32 [-P PORT] -U flash:w:build/m32d-gate/orfa.hex:i
+    avrdude -c usbasp -p m32 [-P PORT] -U lfuse:w:0xff:m -U hfuse:w:0xd9:m
+
+The argv is built by pure functions; `run` finds avrdude and runs it, its
+output passed through.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import List, Optional, Sequence
+
+from . import boardmap, ihex
+from .protocol import OrfaError
+from .sim import firmware_path
+
+PROGRAMMER = "usbasp"
+MODES = ("gate", "slave")
+#: Exit status when avrdude, the firmware or the board is missing.
+EXIT_SETUP = 2
+#: Exit status when avrdude ran and failed.
+EXIT_AVRDUDE = 1
+
+
+class FlashError(OrfaError):
+    """Flashing cannot start: no avrdude, no firmware, an unreadable file."""
+
+
+def board_map(board: str) -> boardmap.BoardMap:
+    """The board's map, whose avrdude part and fuses come from its board.mk
+    (BOARD_AVRDUDE_PART, BOARD_FUSES), as `make flash`/`make fuses` read them."""
+    if board not in boardmap.BOARDS:
+        raise FlashError("no such board %r: one of %s" % (board, ", ".join(boardmap.BOARDS)))
+    return boardmap.load(board)
+
+
+def avrdude_argv(part: str, programmer: str = PROGRAMMER, port: Optional[str] = None,
+                 avrdude: str = "avrdude", extra: Sequence[str] = ()) -> List[str]:
+    """avrdude, the programmer, the part, the port if one is given, extras."""
+    argv = [avrdude, "-c", programmer, "-p", part]
+    if port:
+        argv += ["-P", port]
+    return argv + list(extra)
+
+
+def flash_argv(board: str, hex_path: str, **kw) -> List[str]:
+    """Write `hex_path` (Intel HEX) to the board's flash."""
+    return avrdude_argv(board_map(board).avrdude_part, **kw) + ["-U", "flash:w:%s:i" % hex_path]
+
+
+def fuses_argv(board: str, **kw) -> List[str]:
+    """Write the board's fuses, in board.mk's order."""
+    bmap = board_map(board)
+    argv = avrdude_argv(bmap.avrdude_part, **kw)
+    for name, value in bmap.fuses.items():
+        argv += ["-U", "%s:w:0x%02x:m" % (name, value)]
+    return argv
+
+
+def build_hex(board: str, mode: str) -> Path:
+    """The .hex next to the board's ELF (`make`'s build/<board>-<mode>/orfa.hex)."""
+    return firmware_path(board, mode).with_suffix(".hex")
+
+
+def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str) -> Path:
+    """The Intel HEX to write: `given` (an ELF is converted), else the build's
+    .hex if it is as new as its ELF, else that ELF converted (an installed
+    package ships ELFs only). Conversions go to `tmpdir`."""
+    if given:
+        path = Path(given)
+        try:
+            with path.open("rb") as f:
+                head = f.read(4)
+        except OSError as exc:
+            raise FlashError("cannot read %s: %s" % (given, exc.strerror)) from None
+        if ihex.is_elf(head):
+            return _converted(path, tmpdir)
+        if head[:1] != b":":
+            raise FlashError("%s is neither Intel HEX nor an ELF file" % given)
+        return path
+    elf = firmware_path(board, mode)
+    hex_path = build_hex(board, mode)
+    if hex_path.is_file() and (not elf.is_file()
+                               or hex_path.stat().st_mtime >= elf.stat().st_mtime):
+        return _near(hex_path)
+    if elf.is_file():
+        return _converted(elf, tmpdir)
+    addr = " ADDR=0x10" if mode == "slave" else ""
+    raise FlashError("no firmware for %s %s: build it with `make BOARD=%s MODE=%s%s`,"
+                     " or give --hex FILE" % (board, mode, board, mode, addr))
+
+
+def _near(path: Path) -> Path:
+    """`path` relative to the current directory when it lies below it, so
+    `orfa flash` in the repository runs the very command `make flash` runs."""
+    try:
+        return path.relative_to(Path.cwd())
+    except ValueError:
+        return path
+
+
+def _converted(elf: Path, tmpdir: str) -> Path:
+    try:
+        text = ihex.elf_to_ihex(elf.read_bytes())
+    except OSError as exc:
+        raise FlashError("cannot read %s: %s" % (elf, exc.strerror)) from None
+    except ihex.ElfError as exc:
+        raise FlashError("%s: %s" % (elf, exc)) from None
+    out = Path(tmpdir) / (elf.stem + ".hex")
+    out.write_text(text)
+    return out
+
+
+def find_avrdude(name: str) -> str:
+    """The path of avrdude (`name` may be a path or a name on PATH)."""
+    found = shutil.which(name)
+    if not found:
+        raise FlashError("%s not found%s: install avrdude (tools/setup.sh, or"
+                         " `apt install avrdude`) or give --avrdude PATH"
+                         % (name, "" if os.sep in name else " on PATH"))
+    return found
+
+
+def run(argv: List[str]) -> int:
+    """Run avrdude with its output passed through; its exit status."""
+    exe = find_avrdude(argv[0])
+    try:
+        return subprocess.run([exe] + argv[1:]).returncode
+    except OSError as exc:
+        raise FlashError("cannot run %s: %s" % (exe, exc.strerror)) from None
+
+
+def cmd_flash(args) -> int:
+    kw = dict(programmer=args.programmer, port=args.port, avrdude=args.avrdude)
+    try:
+        with tempfile.TemporaryDirectory(prefix="orfa-flash-") as tmpdir:
+            if args.fuses:
+                argv = fuses_argv(args.board, **kw)
+            else:
+                hex_path = firmware_hex(args.board, args.mode, args.hex, tmpdir)
+                argv = flash_argv(args.board, str(hex_path), **kw)
+            if args.dry_run:
+                print(shlex.join(argv))
+                return 0
+            status = run(argv)
+    except FlashError as exc:
+        print("orfa: %s" % exc, file=sys.stderr)
+        return EXIT_SETUP
+    if status != 0:
+        print("orfa: avrdude failed (exit status %d)" % status, file=sys.stderr)
+        return EXIT_AVRDUDE
+    return 0
+
+
+def add_parser(subparsers) -> None:
+    """Register `flash` on an argparse subparsers object."""
+    p = subparsers.add_parser(
+        "flash", help="write a board's firmware (or fuses) with avrdude",
+        description="Write the firmware's Intel HEX to a board through an ISP"
+                    " programmer with avrdude, as `make flash` does; --fuses"
+                    " writes the board's fuses instead, as `make fuses`.")
+    p.add_argument("--board", choices=boardmap.BOARDS, default="m32d")
+    p.add_argument("--mode", choices=MODES, default="gate",
+                   help="which build (default %(default)s); a slave's bus address"
+                        " is the one it was built with")
+    what = p.add_mutually_exclusive_group()
+    what.add_argument("--hex", metavar="FILE",
+                      help="the Intel HEX (or ELF, converted to a temporary .hex)"
+                           " to write (default: the build's"
+                           " build/<board>-<mode>/orfa.hex, or its ELF)")
+    p.add_argument("--programmer", default=PROGRAMMER,
+                   help="avrdude's programmer, -c (default %(default)s)")
+    p.add_argument("--port", help="avrdude's -P (none by default: avrdude's own)")
+    what.add_argument("--fuses", action="store_true",
+                   help="write the board's fuses instead of the firmware")
+    p.add_argument("--avrdude", default=os.environ.get("AVRDUDE") or "avrdude",
+                   metavar="PATH", help="the avrdude to run (default: $AVRDUDE or"
+                                        " avrdude on PATH)")
+    p.add_argument("--dry-run", action="store_true",
+                   help="print the avrdude command and exit")
+    p.set_defaults(func=cmd_flash)
