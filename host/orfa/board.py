@@ -105,6 +105,7 @@ class Board:
     def drivers(self) -> List[p.DriverRecord]:
         """The introspection records, read once (refresh() reads again)."""
         if self._drivers is None:
+            self.gateway.in_step()
             self._drivers = self.gateway.drivers(self.addr)
         return list(self._drivers)
 

@@ -397,3 +397,11 @@ def test_lines_without_reply_have_no_pattern():
     assert flow.reply_pattern("    ") is None
     assert flow.reply_pattern("# SAA00P") is None
     assert flow.request_cost("SAA00P") == 7
+
+
+def test_introspection_after_a_stale_line(fake):
+    gw, line = fake(board_answers("m32d"))
+    line._out += b"ERROR 02\r\n"                    # left over from before
+    b = Board(gw)
+    assert b.map.board == "m32d"
+    assert line.written[0] == "V" and gw.resyncs == 1
