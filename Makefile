@@ -257,6 +257,7 @@ demo-robot: setup
 
 clean:
 	rm -rf build
+	@$(MAKE) --no-print-directory -C examples clean
 
 FORCE:
 

@@ -12,13 +12,16 @@
 
 /* How long one step waits for the bus: a slave may stretch SCL while it
  * applies a write, the longest an SPI exchange of 57 bytes at F_CPU/128
- * with the servo interrupts (61213 cycles, 30 ticks, measured in the
- * simulator); on top, the step's own bus time (twi_set_khz). A wait ends
- * more than TWI_WAIT_TICKS and at most one tick more after it began:
- * 8.9-9.2 ms at 100 kHz and faster, so an ERROR leaves within 10 ms. */
-#define TWI_WAIT_TICKS 32
-_Static_assert(CLOCK_TICKS_MS(8.5) <= TWI_WAIT_TICKS && TWI_WAIT_TICKS < CLOCK_TICKS_MS(9.3),
-	       "a wait of 8.5-9.5 ms");
+ * while the M32-D's servo interrupts take their cycles (58368 cycles of SPI;
+ * 60576-65938 over a servo frame's phases, measured in the simulator:
+ * docs/protocol.md; 32 ticks were too few for some phases). On top, the
+ * step's own bus time (twi_set_khz). A wait ends more than TWI_WAIT_TICKS
+ * and at most one tick more after it began: 9.4-9.7 ms at 100 kHz and
+ * faster, the most that still leaves a tick (0.28 ms) for the rest of the
+ * request and its reply within 10 ms. */
+#define TWI_WAIT_TICKS 34
+_Static_assert((TWI_WAIT_TICKS + 2) * CLOCK_TICK_CYCLES <= F_CPU / 100,
+	       "the wait, its phase and a tick for the reply within 10 ms");
 
 static struct {
 	uint8_t ticks;  /* clock ticks a step may take before it has failed */
@@ -38,7 +41,7 @@ uint16_t twi_set_khz(uint16_t khz)
 	/* On top of TWI_WAIT_TICKS, 8 SCL periods (period >> 8 ticks): a
 	 * byte takes 9, the ninth fits in TWI_WAIT_TICKS with the short
 	 * stretch a slave makes before a read; the long one (a write being
-	 * applied) delays a START or STOP, one period. At most 32 + 127
+	 * applied) delays a START or STOP, one period. At most 34 + 127
 	 * ticks (TWBR 255, TWPS 3): below 256. */
 	twi.ticks = (uint8_t)(TWI_WAIT_TICKS + (r.period >> 8));
 	return r.khz;

@@ -105,6 +105,7 @@ class Board:
     def drivers(self) -> List[p.DriverRecord]:
         """The introspection records, read once (refresh() reads again)."""
         if self._drivers is None:
+            self.gateway.in_step()
             self._drivers = self.gateway.drivers(self.addr)
         return list(self._drivers)
 
@@ -235,7 +236,7 @@ class Board:
             return err
         if after is None:
             try:
-                status = self.gateway.read_register(self.addr, self.register("intro", "STATUS"), 1)[0]
+                status = self._read_status()
             except p.OrfaError:
                 return err
         elif isinstance(after, p.OrfaError):
@@ -251,10 +252,15 @@ class Board:
         return refusal
 
     # --- status, reset cause, failsafe -----------------------------------------
+    def _read_status(self) -> int:
+        (result,) = self.gateway.transactions([self._status_frames()])
+        if isinstance(result, p.OrfaError):
+            raise result
+        return result[-1].data[0]
+
     def status(self) -> Status:
         """The status register: the result of the last register access."""
-        reg = self.register("intro", "STATUS")
-        return Status(self.gateway.read_register(self.addr, reg, 1)[0])
+        return Status(self._read_status())
 
     def reset_cause(self) -> FrozenSet[str]:
         """Why the board reset since the causes were last cleared:

@@ -180,6 +180,13 @@ class Gateway:
         self._dirty = False
         return dropped
 
+    def in_step(self) -> None:
+        """Resynchronise first if a timeout left the line out of step or
+        bytes wait that nobody asked for (run() and transactions() do this
+        on their own)."""
+        if self._dirty or self._waiting():
+            self.resync()
+
     def _read_line(self) -> str:
         """The next line; a line that is not even text comes back as it was
         (repr), so it is noise to every pattern. Timeouts mark the line out
@@ -208,8 +215,7 @@ class Gateway:
             if pattern is None:
                 raise ValueError("%r gets no reply (empty line or comment)" % line)
             patterns.append(pattern)
-        if self._dirty or self._waiting():
-            self.resync()
+        self.in_step()
         n = len(lines)
         out: List[Optional[Reply]] = [None] * n
         cost = [flow.request_cost(line) for line in lines]

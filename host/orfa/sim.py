@@ -1,4 +1,7 @@
-"""Simulated boards: start build/sim/orfa-sim on a firmware ELF, talk to its port.
+"""Simulated boards: start orfa-sim on a firmware ELF, talk to its port.
+
+The simulator and the ELFs are found as orfa.locate says: ORFA_SIM and
+ORFA_FIRMWARE, the installed package's copies, the repository's build/.
 
 Every SimBoard gets its own temporary directory (link path, trace file, the
 simulator's stdout/stderr), so any number run in parallel.
@@ -17,32 +20,25 @@ import time
 from pathlib import Path
 from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
+from . import locate
 from .gateway import Gateway
 from .protocol import DEFAULT_BAUD, F_CPU
 from .simctl import SimControl
 
-#: The repository root (host/orfa/../..), so nothing needs installing.
-REPO_ROOT = Path(__file__).resolve().parents[2]
-BOARDS = ("m32d", "m128s")
-BUILD_HINT = "run `make all-boards sim` in %s" % REPO_ROOT
+BOARDS = locate.BOARDS
+REPO_ROOT = locate.REPO_ROOT
+#: What to do about a missing build, as things were at import (build_hint()
+#: says it as things are now).
+BUILD_HINT = locate.build_hint()
+build_hint = locate.build_hint
+sim_path = locate.sim_path
+firmware_path = locate.firmware_path
+slave_firmware_path = locate.slave_firmware_path
+missing_builds = locate.missing_builds
 
 
 class SimError(RuntimeError):
     """The simulator could not be started or died."""
-
-
-def sim_path() -> Path:
-    return REPO_ROOT / "build" / "sim" / "orfa-sim"
-
-
-def firmware_path(board: str, mode: str = "gate") -> Path:
-    return REPO_ROOT / "build" / ("%s-%s" % (board, mode)) / "orfa.elf"
-
-
-def missing_builds(boards: Iterable[str] = BOARDS) -> List[Path]:
-    """The simulator and firmware files that are not built yet."""
-    paths = [sim_path()] + [firmware_path(b) for b in boards]
-    return [path for path in paths if not path.is_file()]
 
 
 class TraceEvent(NamedTuple):
@@ -70,15 +66,6 @@ def parse_trace(text: str) -> List[TraceEvent]:
 #: A slave board on the simulated bus: (board, 8-bit address, ELF or None).
 #: None means the board's slave build, build/<board>-slave/orfa.elf.
 SlaveSpec = Tuple[str, int, Union[str, Path, None]]
-
-
-def slave_firmware_path(board: str, addr: int) -> Path:
-    """The slave build for `board` at bus address `addr`: the test robot's
-    (`make robot`, build/robot/<board>-0x<ADDR>/) when there is one, else
-    build/<board>-slave/ (`make BOARD=<board> MODE=slave ADDR=<addr>`; the
-    address is compiled in, and the simulator warns when it differs)."""
-    robot = REPO_ROOT / "build" / "robot" / ("%s-0x%02X" % (board, addr)) / "orfa.elf"
-    return robot if robot.is_file() else firmware_path(board, "slave")
 
 
 def slave_option(spec: SlaveSpec) -> str:
@@ -187,7 +174,7 @@ class SimBoard:
         slave_elfs = [Path(opt.split(":", 2)[2]) for opt in self.slave_options]
         for path in [sim_path(), self.firmware] + slave_elfs:
             if not path.is_file():
-                raise SimError("%s is missing: %s" % (path, BUILD_HINT))
+                raise SimError("%s is missing: %s" % (path, build_hint()))
         self.dir = Path(tempfile.mkdtemp(prefix="orfa-sim-%s-" % self.board))
         self.port = str(self.dir / "tty")
         self.trace_path = self.dir / "trace.log" if self.want_trace else None
@@ -195,9 +182,16 @@ class SimBoard:
         self.vcd_path = self.dir / "board.vcd" if self.want_vcd else None
         self._stdout = open(self.dir / "stdout", "wb")
         self._stderr = open(self.dir / "stderr", "wb")
-        self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL,
-                                     stdout=self._stdout, stderr=self._stderr,
-                                     preexec_fn=_die_with(os.getpid()))
+        try:
+            self.proc = subprocess.Popen(self.command(), stdin=subprocess.DEVNULL,
+                                         stdout=self._stdout, stderr=self._stderr,
+                                         preexec_fn=_die_with(os.getpid()))
+        except OSError as exc:          # not executable, not a program
+            self._stdout.close()
+            self._stderr.close()
+            self.stop()
+            raise SimError("cannot run %s: %s; %s" % (
+                sim_path(), exc.strerror or exc, build_hint())) from None
         deadline = time.monotonic() + self.start_timeout
         while not os.path.exists(self.port):
             if self.proc.poll() is not None:
@@ -206,7 +200,12 @@ class SimBoard:
             if time.monotonic() > deadline:
                 self._fail("orfa-sim made no link within %.0f s" % self.start_timeout)
             time.sleep(0.01)
+        # the simulator prints its line just after it makes the link
         self.banner = self._read("stdout")
+        while not self.banner.endswith("\n") and self.proc.poll() is None \
+                and time.monotonic() < deadline:
+            time.sleep(0.002)
+            self.banner = self._read("stdout")
         return self
 
     def _read(self, name: str) -> str:

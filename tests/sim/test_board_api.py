@@ -3,7 +3,7 @@ an M32-D gateway's own drivers, an M128-S gateway's, and an M128-S and an
 M32-D slave behind the M32-D gateway (one robot). Servo widths and angles,
 motor duty and direction, ADC volts, GPIO levels, an SPI EEPROM, the status
 register's reasons, reset causes, 300 pipelined requests and noise on the
-line. The exact requests each call sends: tests/host/test_board_api.py."""
+line. The exact requests each call sends: tests/host/test_api_requests.py."""
 
 import time
 

@@ -9,7 +9,7 @@ from fake_line import FakeLine
 from orfa import (AddressNackError, BadValueError, Board, DataNackError, Gateway,
                   LimitError, NoDriverError, OrfaError, PinBusyError, ProtocolError,
                   RegisterError, ReplyTimeout, SerialError, ServoRange, Status)
-from orfa import errors
+from orfa import errors, flow
 from orfa.board import boardmap
 
 
@@ -369,3 +369,39 @@ def test_extra_error_line_among_equal_replies(fake):
     assert all(isinstance(r, ProtocolError) and "out of step" in str(r) for r in results[3:])
     assert line.written[-1] == "V"
     assert gw.run(["SA101P"]) == ["SR01P"]
+
+
+# --- which lines can answer a request (orfa.flow) --------------------------------------
+
+
+@pytest.mark.parametrize("request_, good, bad", [
+    ("V", ["V1.1", "ERROR 02"], ["V", "SWP", "ERROR 2"]),
+    ("x", ["X"], ["XX", "V1.1"]),
+    ("L", ["LAA"], ["L", "LAAA"]),
+    ("L 20", ["L20", "ERROR 04"], ["C0064"]),
+    ("C0064", ["C0063"], ["C63"]),
+    ("S AA 13 03 05 dc P", ["SWAAAAP", "ERROR 07"], ["SWAAAP", "SWAAAAAP"]),
+    ("S A0 10 S A1 02 P", ["SWASR4142P", "ERROR 06"], ["SWASR41P", "SRP"]),
+    ("S A0 10", ["ERROR 05"], ["SWAP"]),            # no P: only an error can answer
+    ("S AA 1", ["ERROR 03"], ["SWAP"]),
+    ("Q", ["ERROR 02"], ["Q"]),
+])
+def test_reply_patterns(request_, good, bad):
+    pattern = flow.reply_pattern(request_)
+    assert all(flow.plausible(pattern, r) for r in good), request_
+    assert not any(flow.plausible(pattern, r) for r in bad), request_
+
+
+def test_lines_without_reply_have_no_pattern():
+    assert flow.reply_pattern("") is None
+    assert flow.reply_pattern("    ") is None
+    assert flow.reply_pattern("# SAA00P") is None
+    assert flow.request_cost("SAA00P") == 7
+
+
+def test_introspection_after_a_stale_line(fake):
+    gw, line = fake(board_answers("m32d"))
+    line._out += b"ERROR 02\r\n"                    # left over from before
+    b = Board(gw)
+    assert b.map.board == "m32d"
+    assert line.written[0] == "V" and gw.resyncs == 1

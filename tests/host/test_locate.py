@@ -1,0 +1,112 @@
+"""orfa.locate: the order in which the simulator and the ELFs are looked up
+(ORFA_SIM / ORFA_FIRMWARE, the installed package's copies, the work tree's
+build/), and what the hint says in each case."""
+
+from pathlib import Path
+
+import pytest
+
+from orfa import locate, sim
+
+BUILD = locate.REPO_ROOT / "build"
+
+
+@pytest.fixture(autouse=True)
+def no_settings(monkeypatch):
+    monkeypatch.delenv("ORFA_SIM", raising=False)
+    monkeypatch.delenv("ORFA_FIRMWARE", raising=False)
+
+
+def touch(path: Path) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(b"\x7fELF")
+    return path
+
+
+@pytest.fixture
+def package(tmp_path, monkeypatch):
+    """Pretend the package carries copies (as installed) in tmp_path/pkg."""
+    pkg = tmp_path / "pkg"
+    monkeypatch.setattr(locate, "PACKAGE_SIM", pkg / "_sim" / "orfa-sim")
+    monkeypatch.setattr(locate, "PACKAGE_FIRMWARE", pkg / "_firmware")
+    return pkg
+
+
+def test_work_tree_uses_build():
+    assert locate.in_work_tree()
+    assert locate.sim_path() == BUILD / "sim" / "orfa-sim"
+    assert locate.firmware_path("m32d", "slave") == BUILD / "m32d-slave" / "orfa.elf"
+    assert "run `make all-boards sim` in %s" % locate.REPO_ROOT in locate.build_hint()
+
+
+def test_sim_module_gives_the_same_paths():
+    assert sim.sim_path() == locate.sim_path()
+    assert sim.firmware_path("m128s") == locate.firmware_path("m128s")
+    assert sim.slave_firmware_path("m32d", 0x12) == locate.slave_firmware_path("m32d", 0x12)
+
+
+def test_settings_come_first_and_are_final(tmp_path, monkeypatch, package):
+    touch(package / "_sim" / "orfa-sim")
+    touch(package / "_firmware" / "m32d-gate" / "orfa.elf")
+    monkeypatch.setenv("ORFA_SIM", str(tmp_path / "my-sim"))
+    monkeypatch.setenv("ORFA_FIRMWARE", str(tmp_path / "fw"))
+    # not there, and still the answer: no fall-back behind a setting
+    assert locate.sim_path() == tmp_path / "my-sim"
+    assert locate.firmware_path("m32d") == tmp_path / "fw" / "m32d-gate" / "orfa.elf"
+    assert locate.slave_firmware_path("m128s", 0x10) == tmp_path / "fw" / "m128s-slave" / "orfa.elf"
+    assert locate.missing_builds(["m32d"]) == [tmp_path / "my-sim",
+                                               tmp_path / "fw" / "m32d-gate" / "orfa.elf"]
+    assert locate.build_hint() == (
+        "ORFA_SIM=%s and ORFA_FIRMWARE=%s set (ORFA_SIM names an orfa-sim, ORFA_FIRMWARE a"
+        " directory laid out like the repository's build/; unset to use the installed copies)"
+        % (tmp_path / "my-sim", tmp_path / "fw"))
+
+
+def test_firmware_setting_is_laid_out_like_build(tmp_path, monkeypatch):
+    fw = tmp_path / "fw"
+    robot = touch(fw / "robot" / "m128s-0x14" / "orfa.elf")
+    slave = touch(fw / "m128s-slave" / "orfa.elf")
+    monkeypatch.setenv("ORFA_FIRMWARE", str(fw))
+    assert locate.slave_firmware_path("m128s", 0x14) == robot
+    assert locate.slave_firmware_path("m128s", 0x16) == slave     # no robot build there
+    assert locate.sim_path() == BUILD / "sim" / "orfa-sim"         # ORFA_SIM unset
+
+
+def test_package_copies_before_the_work_tree(package):
+    sim_copy = touch(package / "_sim" / "orfa-sim")
+    gate = touch(package / "_firmware" / "m128s-gate" / "orfa.elf")
+    assert locate.sim_path() == sim_copy
+    assert locate.firmware_path("m128s") == gate
+    # what the package lacks comes from the work tree's build/
+    assert locate.firmware_path("m32d") == BUILD / "m32d-gate" / "orfa.elf"
+
+
+def test_installed_hints(package, monkeypatch):
+    monkeypatch.setattr(locate, "in_work_tree", lambda: False)
+    assert locate.sim_path() == package / "_sim" / "orfa-sim"
+    assert locate.firmware_path("m32d") == package / "_firmware" / "m32d-gate" / "orfa.elf"
+    assert locate.build_hint().startswith(
+        "this orfa was installed without the simulator (ORFA_SKIP_BUILD=1)")
+    touch(package / "_sim" / "orfa-sim")
+    assert locate.build_hint() == (
+        "not part of the installed orfa (it has the builds of `make all-boards robot sim`):"
+        " give the ELF's path, or set ORFA_FIRMWARE")
+
+
+def test_simboard_names_the_missing_file_and_the_setting(tmp_path, monkeypatch):
+    monkeypatch.setenv("ORFA_SIM", str(tmp_path / "none"))
+    with pytest.raises(sim.SimError) as exc:
+        sim.SimBoard("m32d").start()
+    assert str(exc.value).startswith("%s is missing: ORFA_SIM=%s set (" % (
+        tmp_path / "none", tmp_path / "none"))
+
+
+def test_simboard_says_when_the_simulator_cannot_run(tmp_path, monkeypatch):
+    not_a_program = tmp_path / "orfa-sim"
+    not_a_program.write_text("just text\n")          # not executable
+    monkeypatch.setenv("ORFA_SIM", str(not_a_program))
+    board = sim.SimBoard("m32d", firmware=__file__)
+    with pytest.raises(sim.SimError) as exc:
+        board.start()
+    assert str(exc.value).startswith("cannot run %s: Permission denied; ORFA_SIM=" % not_a_program)
+    assert board.proc is None and board.dir is None

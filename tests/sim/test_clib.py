@@ -1,0 +1,216 @@
+"""The manual's C API (host/c, docs/c-library.md) through its example:
+`make -C examples` builds examples/get_drivers, which is run on the pty of a
+simulated board and robot, and on a pseudo-terminal where a reference model
+of SPEC (spec_model.py) plays a gateway whose board has 10 and more drivers.
+What it prints is compared with the board maps (orfa.boardmap, generated
+from the C definitions the firmware is built from)."""
+
+import os
+import select
+import subprocess
+import threading
+from pathlib import Path
+
+import pytest
+
+from conftest import require_builds, require_slave, running
+from orfa import boardmap
+from orfa.sim import SimBoard, SimRobot
+from spec_model import BoardModel, GatewayModel, Record
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLE = ROOT / "examples" / "get_drivers"
+PROG_TIMEOUT = 60
+M128S, M32D = 0x10, 0x12
+
+
+@pytest.fixture(scope="module")
+def get_drivers():
+    r = subprocess.run(["make", "--no-print-directory", "-s", "-C", str(ROOT / "examples")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert EXAMPLE.is_file()
+
+    def run(*args):
+        return subprocess.run([str(EXAMPLE)] + [str(a) for a in args], capture_output=True,
+                              text=True, timeout=PROG_TIMEOUT)
+    return run
+
+
+def listing(records) -> str:
+    """The example's output for these records (docs/c-library.md)."""
+    out = ""
+    for r in records:
+        out += "UID 0x%04X  version %d.%d  registers " % (r.uid, r.major, r.minor)
+        if r.count:
+            out += "0x%02X-0x%02X (%d)\n" % (r.start, r.start + r.count - 1, r.count)
+        else:
+            out += "none (0)\n"
+    return out
+
+
+# --- a simulated board and robot -----------------------------------------------
+
+@pytest.mark.parametrize("board", ["m32d", "m128s"])
+def test_local_drivers(get_drivers, board):
+    require_builds([board])
+    want = boardmap.load(board).drivers
+    with running(SimBoard(board)) as b:
+        for args in ((), ("AA",), ("0xaa",)):
+            r = get_drivers(b.sim.port, *args)
+            assert (r.returncode, r.stderr) == (0, ""), args
+            assert r.stdout == listing(want), args
+        assert r.stdout.startswith("UID 0x0000  version 1.0  registers 0x00-0x01 (2)\n")
+
+
+def test_slave_drivers(get_drivers):
+    require_builds(["m32d"])
+    slaves = [("m128s", M128S, require_slave("m128s", M128S)),
+              ("m32d", M32D, require_slave("m32d", M32D))]
+    with running(SimRobot("m32d", slaves=slaves)) as b:
+        for board, addr in (("m128s", M128S), ("m32d", M32D)):
+            r = get_drivers(b.sim.port, "%02X" % addr)
+            assert (r.returncode, r.stderr) == (0, ""), addr
+            assert r.stdout == listing(boardmap.load(board).drivers)
+
+
+def test_error_reply(get_drivers):
+    """No device at 0x42: the gateway's ERROR 06, one line, exit 1."""
+    require_builds(["m32d"])
+    with running(SimBoard("m32d")) as b:
+        r = get_drivers(b.sim.port, "42")
+        assert r.returncode == 1
+        assert r.stdout == ""
+        assert r.stderr == ("get_drivers: %s: address 0x42: ERROR 06 (%s)\n"
+                            % (b.sim.port, boardmap.ERRORS[6].text))
+        # the board is fine after it
+        assert b.gw.version() == "1.1"
+
+
+def test_missing_port(get_drivers):
+    r = get_drivers("/nonexistent/tty")
+    assert r.returncode == 1
+    assert r.stdout == ""
+    assert r.stderr == "get_drivers: /nonexistent/tty: No such file or directory\n"
+
+
+@pytest.mark.parametrize("args", [(), ("a", "b", "c"), ("",)])
+def test_usage(get_drivers, args):
+    r = get_drivers(*args)
+    assert r.returncode == 2
+    assert r.stderr.startswith("usage: get_drivers PORT [ADDRESS]") and r.stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize("address", ["11", "zz", "100", "-2", "0x", "AA "])
+def test_bad_address(get_drivers, address):
+    """Refused before the port is opened (the port does not exist here)."""
+    r = get_drivers("/nonexistent/tty", address)
+    assert r.returncode == 2
+    assert r.stderr.startswith("get_drivers: bad address '%s'" % address)
+    assert r.stderr.count("\n") == 1
+
+
+# --- a gateway with many drivers: the model on a pseudo-terminal ------------------
+
+class FakeGateway:
+    """SPEC's model answering on the master side of a pty: it answers only
+    when the host has gone quiet (QUIET s), so a host that sends more than
+    the gateway's receive ring holds is caught (`most_unanswered`)."""
+
+    QUIET = 0.05
+
+    def __init__(self, ndrivers: int):
+        records = [Record(0x0000, 1, 0, 0x00, 2)]
+        start = 2
+        for i in range(1, ndrivers):
+            records.append(Record(0x0100 + i, 1 + i % 3, i % 10, start, 1))
+            start += 1
+        self.records = records
+        self.model = GatewayModel(BoardModel("m32d", records), BoardModel("m32d", records[:1]),
+                                  slave_addr=0x10)
+        self.master, slave = os.openpty()
+        self.path = os.ttyname(slave)
+        self.slave = slave
+        self.requests = []
+        self.replies = []
+        self.most_unanswered = 0
+        self.stop = False
+        self.thread = threading.Thread(target=self.serve, daemon=True)
+        self.thread.start()
+
+    def serve(self):
+        buf = b""
+        while not self.stop:
+            ready, _, _ = select.select([self.master], [], [], self.QUIET)
+            if ready:
+                try:
+                    buf += os.read(self.master, 4096)
+                except OSError:
+                    buf = b""
+                continue
+            # quiet: answer every whole line received
+            self.most_unanswered = max(self.most_unanswered, len(buf))
+            while b"\n" in buf:
+                line, buf = buf.split(b"\n", 1)
+                reply = self.model.reply(line.decode("ascii"))
+                if reply is None:
+                    continue
+                self.requests.append(line.decode("ascii"))
+                self.replies.append(reply)
+                os.write(self.master, reply)
+
+    def close(self):
+        self.stop = True
+        self.thread.join(5)
+        os.close(self.master)
+        os.close(self.slave)
+
+
+@pytest.mark.parametrize("ndrivers", [1, 9, 10, 11, 20, 200])
+def test_many_drivers(get_drivers, ndrivers):
+    fake = FakeGateway(ndrivers)
+    try:
+        r = get_drivers(fake.path)
+    finally:
+        fake.close()
+    assert (r.returncode, r.stderr) == (0, "")
+    assert r.stdout == listing(fake.records)
+    # the count, then the records ten at a time from driver 1: never a read
+    # of 0 bytes (ERROR 04), ten records in exactly the 127-character reply
+    full, rest = divmod(ndrivers, 10)
+    want = ["SAA0000SAB01P"]
+    want += ["SAA00%02XSAB3CP" % (10 * i + 1) for i in range(full)]
+    if rest:
+        want.append("SAA00%02XSAB%02XP" % (10 * full + 1, 6 * rest))
+    assert fake.requests == want
+    assert all(not reply.startswith(b"ERROR") for reply in fake.replies)
+    for req, reply in zip(want[1:], fake.replies[1:]):
+        if req.endswith("3CP"):
+            assert len(reply) == 127 + 2, reply
+    # SPEC's flow rule: never more requests unanswered than the ring holds
+    assert fake.most_unanswered <= 252, fake.most_unanswered
+    if ndrivers == 200:
+        # 21 requests of 14 characters: the library had to wait for replies
+        assert fake.most_unanswered > 14 * 10
+
+
+def test_no_reply(get_drivers):
+    """A port where nothing answers: one line, exit 1, after the timeout."""
+    master, slave = os.openpty()
+    path = os.ttyname(slave)
+    try:
+        r = get_drivers(path)
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert r.returncode == 1
+    assert r.stdout == ""
+    assert r.stderr == "get_drivers: %s: address 0xAA: no reply in time\n" % path
+
+
+def test_docs_sample_is_the_m32d_map():
+    """docs/c-library.md shows get_drivers' output for an M32-D: it must be
+    what the program prints for the board map as it is."""
+    doc = (ROOT / "docs" / "c-library.md").read_text()
+    shown = "".join(line[4:] + "\n" for line in doc.splitlines() if line.startswith("    UID "))
+    assert shown == listing(boardmap.load("m32d").drivers)
