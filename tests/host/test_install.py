@@ -220,3 +220,20 @@ def test_orfa_flash_writes_the_packages_hex(installed, tmp_path):
     hex_path = installed.site / "orfa" / "_firmware" / "m128s-slave" / "orfa.hex"
     assert r.stdout == "avrdude -c usbasp -p %s -U flash:w:%s:i\n" % (
         boardmap.load("m128s").avrdude_part, hex_path), r.stdout
+
+
+def test_issue_commands_run_from_the_venv(installed, tmp_path):
+    """The commands a new user tries first, from outside the repository."""
+    from orfa import boardmap
+    orfa = installed.bin / "orfa"
+    r = run([orfa, "--sim", "m32d", "scan"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines()[0].split() == list("0123456789abcdef")
+    assert "50: -- -- -- -- -- 55 --" in r.stdout         # the gateway itself, 0xAA
+    r = run([orfa, "--sim", "m32d", "drivers"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    rows = [line.split() for line in r.stdout.splitlines()[2:]]
+    assert [(int(row[0], 16), row[1]) for row in rows] == \
+        [(d.uid, d.name) for d in boardmap.load("m32d").drivers]
+    r = run([orfa, "--sim", "m32d", "servo", "3", "1500"], cwd=tmp_path)
+    assert r.returncode == 0 and r.stderr == "", r.stderr
