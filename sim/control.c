@@ -136,10 +136,22 @@ static void cmd_rx(control_t *c, reply_t *r, int argc, char **argv)
 	uint8_t bytes[CONTROL_LINE / 2];
 	size_t n = 0;
 	uint64_t at, now = c->avr->cycle, free_at, room, end;
+	/* `+N`: N cycles from the cycle this request is answered at, so a batch
+	 * (`rx +N ...`, `wait M`, ...) keeps its spacing whatever the wall clock */
+	int rel = argc >= 2 && argv[1][0] == '+';
 
-	if (argc < 3 || parse_u64(argv[1], &at) < 0) {
-		rp(r, "ERR rx CYCLE HEX...: CYCLE decimal, then the bytes in hex");
+	if (argc < 3 || (rel && argv[1][1] == '+') || parse_u64(argv[1] + rel, &at) < 0) {
+		rp(r, "ERR rx CYCLE HEX...: CYCLE decimal (or +N: N cycles from now), "
+		   "then the bytes in hex");
 		return;
+	}
+	if (rel) {
+		if (at > CONTROL_RX_AHEAD) {
+			rp(r, "ERR rx: +%" PRIu64 " is more than %" PRIu64 " cycles ahead", at,
+			   (uint64_t)CONTROL_RX_AHEAD);
+			return;
+		}
+		at += now;
 	}
 	for (int i = 2; i < argc; i++) {
 		if (parse_hex(argv[i], bytes, &n, sizeof(bytes)) < 0) {
@@ -283,7 +295,7 @@ static void cmd_spi(board_model_t *bm, reply_t *r)
 static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
-	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx CYCLE HEX... | line | signals | "
+	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx [+]CYCLE HEX... | line | signals | "
 	"srf08 ADDR [range MM [MM2] | light N] | i2c [stuck N | hold-scl on|off] | fault hang | "
 	"reset external|power|brownout | help; "
 	"a slave board's pins, signals and inputs as 10/A5, other requests with @10 "

@@ -196,6 +196,13 @@ class SimControl:
             raise ValueError("rx takes 1..%d bytes, not %d" % (RX_MAX, len(data)))
         return int(self.request("rx %d %s" % (cycle, bytes(data).hex().upper())))
 
+    def rx_after(self, cycles: int, data: bytes) -> int:
+        """As rx, the first start bit `cycles` after the cycle the simulator
+        answers at (`rx +N`): never past, however late the request arrives."""
+        if not 1 <= len(data) <= RX_MAX:
+            raise ValueError("rx takes 1..%d bytes, not %d" % (RX_MAX, len(data)))
+        return int(self.request("rx +%d %s" % (cycles, bytes(data).hex().upper())))
+
     def rx_stream(self, cycle: int, line: bytes, until: int, slip: int) -> Tuple[int, int]:
         """`line` (a request and its terminator) again and again on the serial
         line, back to back, from `cycle` (or `slip` cycles after now, should
@@ -301,4 +308,7 @@ class _SlaveView(SimControl):
         pass
 
     def rx(self, cycle: int, data: bytes) -> int:
+        raise SimControlError("rx: only the gateway's serial line reaches the PC")
+
+    def rx_after(self, cycles: int, data: bytes) -> int:
         raise SimControlError("rx: only the gateway's serial line reaches the PC")
