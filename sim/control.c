@@ -295,7 +295,7 @@ static void cmd_spi(board_model_t *bm, reply_t *r)
 static const char control_help[] =
 	"time | wait N | pin P | drive P 0|1|z | adc CH [MV] | avcc [MV] | aref [MV] | "
 	"level SIG | edges SIG [SINCE] | measure SIG [N [SINCE]] | spi | spidev P | "
-	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx [+]CYCLE HEX... | line | signals | "
+	"stack [FROM] | isr [clear] | peek ADDR [LEN] | rx CYCLE HEX... | line | signals | "
 	"srf08 ADDR [range MM [MM2] | light N] | i2c [stuck N | hold-scl on|off] | fault hang | "
 	"reset external|power|brownout | help; "
 	"a slave board's pins, signals and inputs as 10/A5, other requests with @10 "

@@ -22,7 +22,7 @@ AT = 1 << 24
 FAR = 1 << 32
 BYTE = 640                                 # cycles per byte at 115200 baud, 8N1
 REQUEST = b"S AA 00 00 S AB 01 P\r"        # the driver count, through introspection
-USAGE = "ERR rx CYCLE HEX...: CYCLE decimal, then the bytes in hex"
+USAGE = "ERR rx CYCLE HEX...: CYCLE decimal (or +N: N cycles from now), then the bytes in hex"
 
 
 def fresh(board):
@@ -157,6 +157,25 @@ def test_bad_rx_requests_are_refused_and_schedule_nothing():
             "ERR rx: too many bytes: 1, room for 0 (at most 32768 scheduled)"
         with pytest.raises(ValueError):
             ctl.rx(at + room * BYTE, b"")
+        for line in ("rx + 56", "rx ++5 56", "rx +-5 56", "rx +x 56"):
+            assert error(ctl, line) == USAGE, line
+        assert error(ctl, "rx +%d 56" % (1 << 42)) == \
+            "ERR rx: +%d is more than %d cycles ahead" % (1 << 42, 1 << 40)
         assert "rx CYCLE HEX..." in ctl.request("help")
         assert sim.running
         assert sim.stop() == 0
+
+
+def test_rx_after_counts_from_the_cycle_it_is_answered_at():
+    """`rx +N`: the first start bit N cycles after the cycle the request is
+    answered at, here the end of the `wait` before it in the same batch."""
+    with fresh("m32d") as sim:
+        ctl = sim.control
+        woke, end, now = ctl.requests(["wait 1000", "rx +5000 56 0D", "time"])
+        assert int(end) == int(woke) + 5000 + 2 * BYTE == int(now) + 5000 + 2 * BYTE
+        ctl.wait(5000 + 2 * BYTE + 100)           # from a cycle >= now: past end
+        rx = sim.trace_events(kinds=["uart rx"])
+        assert [(e.cycle, e.fields[0]) for e in rx] == \
+            [(int(end) - BYTE, "56"), (int(end), "0D")]
+        later = ctl.rx_after(10, b"\r")
+        assert later >= int(end) + 100 + 10 + BYTE
