@@ -16,6 +16,13 @@ from typing import Dict, List, Optional, Tuple, Union
 RX_MAX = 480
 
 
+def parse_edges(reply: str) -> List[Tuple[int, int]]:
+    """An `edges` reply ("cycle:level ..." or "-") as [(cycle, level), ...]."""
+    if reply == "-":
+        return []
+    return [(int(c), int(lv)) for c, lv in (item.split(":") for item in reply.split())]
+
+
 class SimControlError(RuntimeError):
     """The simulator refused a request (its ``ERR ...`` text)."""
 
@@ -134,14 +141,24 @@ class SimControl:
     def edges(self, sig: str, since: Optional[int] = None) -> List[Tuple[int, int]]:
         """[(cycle, level), ...], oldest first."""
         sig = self._name(sig)
-        reply = self.request("edges %s" % sig if since is None else "edges %s %d" % (sig, since))
-        if reply == "-":
-            return []
-        out = []
-        for item in reply.split():
-            cycle, level = item.split(":")
-            out.append((int(cycle), int(level)))
-        return out
+        return parse_edges(self.request("edges %s" % sig if since is None
+                                        else "edges %s %d" % (sig, since)))
+
+    def window(self, sigs: List[str], cycles: int, during: List[str] = ()
+               ) -> Tuple[int, int, Dict[str, List[Tuple[int, int]]]]:
+        """Let `cycles` pass and take the edges of `sigs` in that window:
+        (start, end, {sig: [(cycle, level), ...]}), every edge at or after
+        start and before end. One batch (`time`, the requests `during`, e.g.
+        `rx +N ...`, at the window's start, `wait`, an `edges` per signal
+        answered at the wait's cycle), so the window is fixed in simulated
+        time however the wall clock goes; `cycles` should stay within the
+        1024 edges a signal keeps."""
+        during = list(during)
+        replies = self.requests(["time"] + during + ["wait %d" % cycles] +
+                                ["edges %s" % self._name(s) for s in sigs])
+        start, end = int(replies[0]), int(replies[1 + len(during)])
+        return start, end, {s: [e for e in parse_edges(r) if start <= e[0] < end]
+                            for s, r in zip(sigs, replies[2 + len(during):])}
 
     def measure(self, sig: str, n: Optional[int] = None, since: Optional[int] = None) -> Dict:
         """{"steady": 0|1} or {"high": (min, max, mean), "period": (...), "duty": f, "n": k}."""
