@@ -559,10 +559,10 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 			rp(&r, "ERR line: only the gateway's serial line reaches the PC");
 			return 0;
 		}
-		rp(&r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u",
+		rp(&r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u pty %u",
 		   (unsigned)u->host_baud, (unsigned)u->host_bit, (unsigned)usart_board_bit(u),
 		   (unsigned)u->ubrr, !!(u->avr->data[u->regs->ucsrb] & (1u << 4)),
-		   (uint64_t)u->rxen_since, (unsigned)u->fe_read);
+		   (uint64_t)u->rxen_since, (unsigned)u->fe_read, (unsigned)u->host_taken);
 	} else if (!strcasecmp(cmd, "rx")) {
 		if (cb != &c->board[0]) {
 			rp(&r, "ERR rx: only the gateway's serial line reaches the PC");

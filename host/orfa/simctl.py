@@ -255,9 +255,26 @@ class SimControl:
         """The gateway's serial line: `pc` the PC's rate (its port's termios),
         `bit` its bit time and `board` the board's (UBRR/U2X), in cycles;
         `ubrr`, `rxen`, `since` (the cycle RXEN last went on), `fe` (frames
-        with FE the firmware took from UDR)."""
+        with FE the firmware took from UDR), `pty` (bytes the simulator has
+        taken from the PC's port)."""
         words = self.request(self._board("line")).split()
         return {k: int(v) for k, v in zip(words[::2], words[1::2])}
+
+    def wait_taken(self, total: int, step: int = 1000, timeout: float = 30.0) -> int:
+        """Let simulated time pass, `step` cycles at a time, until the
+        simulator has taken `total` bytes from the PC's port (`line`'s pty):
+        a write to the port reaches it when the kernel gets to it, in wall
+        time. The cycle reached; SimControlError if the bytes never come."""
+        deadline = time.monotonic() + timeout
+        while True:
+            taken, now = self.requests(["line", "time"])
+            words = taken.split()
+            if int(words[words.index("pty") + 1]) >= total:
+                return int(now)
+            if time.monotonic() > deadline:
+                raise SimControlError("the simulator took %s of %d bytes from the port"
+                                      % (words[words.index("pty") + 1], total))
+            self.wait(step)
 
     def peek(self, addr: int, n: int = 1) -> bytes:
         """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
