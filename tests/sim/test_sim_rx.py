@@ -6,6 +6,7 @@ the board's state at a given cycle after power-up, which only a fresh board has.
 """
 
 import re
+import threading
 import time
 
 import pytest
@@ -100,12 +101,19 @@ def test_pty_bytes_queue_behind_scheduled_bytes():
     filler = b" " * 20000                  # 12.8 M cycles on the wire
     with fresh("m32d") as sim, serial.Serial(sim.port, 115200, timeout=REPLY_TIMEOUT) as port:
         ctl = sim.control
-        # 1 s simulated ahead (some 100 ms of wall time): the PC's bytes,
-        # sent right after, are on the line by then and still are after
-        at = ctl.time() + 7372800
-        assert ctl.rx(at, b"V\r") == at + 2 * BYTE
-        port.write(filler)
-        port.flush()
+        # the PC's bytes first, waited for in simulated time until the
+        # simulator has taken some (they stream for 12.8 M cycles); then V CR
+        # 1 s simulated ahead (`rx +N`), in the middle of them whatever the load
+        before = ctl.line()["pty"]
+        # the pty holds a few kB: the write returns once most is taken
+        writer = threading.Thread(target=port.write, args=(filler,))
+        writer.start()
+        try:
+            ctl.wait_taken(before + 1, step=100)
+            end = ctl.rx_after(7372800, b"V\r")
+        finally:
+            writer.join()
+        at = end - 2 * BYTE
         rx = wait_events(sim, "uart rx", len(filler) + 2, timeout=30)
         # the line overflowed the firmware's buffer long before the CR
         assert port.readline() == b"ERROR 04\r\n"
