@@ -6,6 +6,13 @@ from .protocol import (  # noqa: F401
     InternalError, LimitError, OrfaError, ProtocolError, Read, ReadResult,
     ReplyTimeout, UnknownCommandError, Write, WriteResult,
 )
+from .errors import (  # noqa: F401
+    BadLengthError, BadValueError, NoDriverError, NoRegisterError, NotBoundError,
+    NotReadableError, NotWritableError, PinBusyError, RegisterError, SerialError,
+    Status,
+)
 from .gateway import Gateway  # noqa: F401
+from .board import Board  # noqa: F401
+from .clients.servo import ServoRange  # noqa: F401
 
 __version__ = "0.1.0"

@@ -7,12 +7,35 @@ pseudo-terminal path (the simulator's link) and a real port are the same.
 from __future__ import annotations
 
 import time
-from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Sequence
+from collections import deque
+from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Sequence, Union
 
 import serial
 
 from . import boards
+from . import flow
 from . import protocol as p
+from .errors import SerialError
+
+
+def open_port(url: str, baudrate: int, timeout: float) -> serial.SerialBase:
+    """serial.serial_for_url, its errors as one-line SerialErrors."""
+    try:
+        return serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
+    except (serial.SerialException, OSError, ValueError) as e:
+        raise SerialError("cannot open %s: %s" % (url, _os_reason(e))) from e
+
+
+def _os_reason(e: BaseException) -> str:
+    """The OS's reason behind a pyserial error: "[Errno 2] No such file or
+    directory" rather than pyserial's message that repeats the path."""
+    for err in (e.__cause__, e.__context__, e):
+        if isinstance(err, OSError) and err.errno is not None and err.strerror:
+            return "[Errno %d] %s" % (err.errno, err.strerror)
+    return str(e)
+
+
+Reply = Union[str, p.OrfaError]
 
 
 class Gateway:
@@ -27,8 +50,14 @@ class Gateway:
                  wait: Optional[Callable[[float], None]] = None):
         self.timeout = timeout
         self.local = local_address
-        self.serial = serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
+        self.url = url
+        self.serial = open_port(url, baudrate, timeout)
         self._sys_reg: Dict[int, int] = {}
+        #: set when the line may hold replies nobody waits for (a timeout,
+        #: noise): the next run resynchronises first
+        self._dirty = False
+        #: times the line was brought back in step (noise, stale lines, timeouts)
+        self.resyncs = 0
         if autobaud:
             self.preamble(wait)
 
@@ -54,8 +83,17 @@ class Gateway:
     # --- lines ----------------------------------------------------------------
     def send(self, data: bytes) -> None:
         """Write raw bytes (no checks, no terminator added)."""
-        self.serial.write(data)
-        self.serial.flush()
+        try:
+            self.serial.write(data)
+            self.serial.flush()
+        except (serial.SerialException, OSError) as e:
+            raise SerialError("%s: %s" % (self.url, _os_reason(e))) from e
+
+    def _read_until(self) -> bytes:
+        try:
+            return self.serial.read_until(b"\n")
+        except (serial.SerialException, OSError) as e:
+            raise SerialError("%s: %s" % (self.url, _os_reason(e))) from e
 
     def read_reply(self, timeout: Optional[float] = None) -> str:
         """The next reply line without its CR LF; ReplyTimeout if none comes."""
@@ -65,7 +103,7 @@ class Gateway:
             left = deadline - time.monotonic()
             if left <= 0:
                 raise p.ReplyTimeout("no reply line (got %r)" % bytes(buf))
-            chunk = self.serial.read_until(b"\n")
+            chunk = self._read_until()
             buf += chunk
             if buf.endswith(b"\n") and not buf.endswith(b"\r\n"):
                 raise p.ProtocolError("reply line not ended by CR LF: %r" % bytes(buf))
@@ -94,6 +132,175 @@ class Gateway:
         data = b"".join(p.encode_request(line) for line in lines)
         self.send(data)
         return [self.read_reply() for _ in lines]
+
+    # --- batches: many requests in flight (SPEC section 2, flow) -----------------
+    def run(self, lines: Sequence[str]) -> List[str]:
+        """Send every request, pipelined, and return their reply texts in
+        order (`ERROR xx` replies included, as request() does).
+
+        Requests go out as long as fewer than 256 characters of them are
+        unanswered (flow.FLOW_WINDOW); each reply line is checked against
+        its request (flow.reply_pattern). A line that cannot be a reply is
+        noise: the gateway resynchronises with a `V` marker, and a request
+        whose reply was lost to the noise raises ProtocolError (after the
+        line is in step again). No reply in time: ReplyTimeout.
+        """
+        replies = self._exchange(lines)
+        for reply in replies:
+            if isinstance(reply, p.OrfaError):
+                raise reply
+        return replies  # type: ignore[return-value]
+
+    def transactions(self, items: Sequence[Sequence[p.Frame]]
+                     ) -> List[Union[List[p.FrameResult], p.OrfaError]]:
+        """Run many transactions pipelined (see run()); for each, its frame
+        results or the OrfaError its reply gave (an `ERROR xx`, a reply
+        lost to noise), so one refused item leaves the others' results."""
+        items = [list(frames) for frames in items]
+        lines = [p.format_transaction(frames) for frames in items]
+        out: List[Union[List[p.FrameResult], p.OrfaError]] = []
+        for frames, reply in zip(items, self._exchange(lines)):
+            if isinstance(reply, p.OrfaError):
+                out.append(reply)
+                continue
+            try:
+                out.append(p.parse_transaction(reply, frames))
+            except p.OrfaError as e:
+                out.append(e)
+        return out
+
+    def resync(self) -> int:
+        """Bring the line in step: send the `V` marker and drop every line
+        up to its `V1.1`. Returns the number of lines dropped."""
+        self.resyncs += 1
+        self.send(p.encode_request(flow.MARKER))
+        dropped = 0
+        while self._read_line() != flow.MARKER_REPLY:
+            dropped += 1
+        self._dirty = False
+        return dropped
+
+    def in_step(self) -> None:
+        """Resynchronise first if a timeout left the line out of step or
+        bytes wait that nobody asked for (run() and transactions() do this
+        on their own)."""
+        if self._dirty or self._waiting():
+            self.resync()
+
+    def _read_line(self) -> str:
+        """The next line; a line that is not even text comes back as it was
+        (repr), so it is noise to every pattern. Timeouts mark the line out
+        of step."""
+        try:
+            return self.read_reply()
+        except p.ReplyTimeout:
+            self._dirty = True
+            raise
+        except p.ProtocolError as e:
+            return "<noise: %s>" % e
+
+    def _waiting(self) -> int:
+        try:
+            return self.serial.in_waiting
+        except (AttributeError, NotImplementedError, serial.SerialException, OSError):
+            return 0
+
+    def _exchange(self, lines: Sequence[str]) -> List[Reply]:
+        """Pipelined requests; each reply text, or the error for a reply
+        lost to noise. See run()."""
+        lines = [p.check_request(line) for line in lines]
+        patterns = []
+        for line in lines:
+            pattern = flow.reply_pattern(line)
+            if pattern is None:
+                raise ValueError("%r gets no reply (empty line or comment)" % line)
+            patterns.append(pattern)
+        self.in_step()
+        n = len(lines)
+        out: List[Optional[Reply]] = [None] * n
+        cost = [flow.request_cost(line) for line in lines]
+        reserve = flow.request_cost(flow.MARKER)        # room for a marker, always
+        pending: deque = deque()
+        in_flight = 0
+        sent = 0
+        #: first request whose reply was an ERROR line: an extra line of
+        #: noise (a garbled request the board refused) looks the same, so
+        #: from there on the run is checked with a marker at its end
+        unsure_from: Optional[int] = None
+        while sent < n or pending:
+            batch = bytearray()
+            while sent < n and in_flight + cost[sent] + reserve < flow.FLOW_WINDOW:
+                batch += p.encode_request(lines[sent])
+                pending.append(sent)
+                in_flight += cost[sent]
+                sent += 1
+            if batch:
+                self.send(bytes(batch))
+            text = self._read_line()
+            i = pending[0]
+            if flow.plausible(patterns[i], text):
+                out[i] = text
+                pending.popleft()
+                in_flight -= cost[i]
+                if text.startswith("ERROR") and unsure_from is None:
+                    unsure_from = i
+                continue
+            # noise: stop sending, mark, and sort out the lines up to the marker
+            self.resyncs += 1
+            if unsure_from is not None:
+                # the noise may be the reply an extra ERROR line displaced
+                for j in range(unsure_from, i):
+                    out[j] = p.ProtocolError(
+                        "replies out of step from %r on (an extra line on the serial "
+                        "line); its result is unknown" % lines[j])
+                unsure_from = None
+            self.send(p.encode_request(flow.MARKER))
+            self._settle(list(pending), patterns, out, lines)
+            pending.clear()
+            in_flight = 0
+        if unsure_from is not None:
+            self.send(p.encode_request(flow.MARKER))
+            text = self._read_line()
+            if text != flow.MARKER_REPLY:
+                # a reply too many: somewhere from unsure_from on, an extra
+                # line took a request's place; those results are not trusted
+                self.resyncs += 1
+                while self._read_line() != flow.MARKER_REPLY:
+                    pass
+                for i in range(unsure_from, n):
+                    out[i] = p.ProtocolError(
+                        "replies out of step from %r on (an extra line on the serial "
+                        "line); its result is unknown" % lines[i])
+        return out  # type: ignore[return-value]
+
+    def _settle(self, waiting: List[int], patterns, out: List[Optional[Reply]],
+                lines: Sequence[str]) -> None:
+        """After noise: read every line up to the marker's reply and give
+        them to the requests still waiting, if they line up; otherwise
+        those requests lost their replies (ProtocolError)."""
+        markers_due = 1 + sum(1 for i in waiting if lines[i].strip(" ").upper().startswith("V"))
+        seen: List[str] = []
+        while True:
+            text = self._read_line()
+            if text == flow.MARKER_REPLY:
+                markers_due -= 1
+                if markers_due == 0:
+                    break
+            seen.append(text)
+        candidates = [t for t in seen if any(flow.plausible(patterns[i], t) for i in waiting)]
+        # the line that was noise came in the first waiting request's place:
+        # an extra line (all replies follow) or its reply garbled (one fewer)
+        for lost in (0, 1):
+            rest = waiting[lost:]
+            if len(candidates) == len(rest) and all(
+                    flow.plausible(patterns[i], t) for i, t in zip(rest, candidates)):
+                for i, t in zip(rest, candidates):
+                    out[i] = t
+                waiting = waiting[:lost]
+                break
+        for i in waiting:
+            out[i] = p.ProtocolError("the reply to %r was lost to noise on the serial line"
+                                     % lines[i])
 
     # --- commands -------------------------------------------------------------
     def version(self) -> str:

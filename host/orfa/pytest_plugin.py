@@ -148,12 +148,22 @@ def orfa_sim_robot(request) -> Iterator[SimRobot]:
 
 
 # --- typed API ------------------------------------------------------------------
-# The place for an `orfa_board` fixture once orfa.board (the typed Board API)
-# lands: a Board on orfa_sim_board's gateway, closed after the test, e.g.
-#
-#     @pytest.fixture
-#     def orfa_board(orfa_sim_board):
-#         with Board(orfa_sim_board.gateway()) as board:
-#             yield board
-#
-# and the same for a slave of orfa_sim_robot at its bus address.
+@pytest.fixture
+def orfa_board(orfa_sim_board):
+    """A Board (orfa.board, the typed API) on orfa_sim_board's own drivers:
+    `orfa_board.servo.set_width(3, 1500)`; its gateway is closed after."""
+    from .board import Board
+    with orfa_sim_board.gateway() as gw:
+        yield Board(gw)
+
+
+@pytest.fixture
+def orfa_robot_boards(orfa_sim_robot):
+    """{address: Board} of orfa_sim_robot: the gateway's own (its local
+    address, 0xAA) and each slave's, all on one serial link."""
+    from .board import Board
+    with orfa_sim_robot.gateway() as gw:
+        boards = {gw.local: Board(gw)}
+        for spec in orfa_sim_robot.slaves:
+            boards[spec[1]] = Board(gw, spec[1])
+        yield boards

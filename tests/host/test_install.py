@@ -159,7 +159,7 @@ def test_a_users_tests_run_with_the_plugin(installed, tmp_path):
     r = run([installed.bin / "pytest", "-p", "no:cacheprovider", "test_robot_code.py"],
             cwd=tmp_path)
     assert r.returncode == 0, r.stdout + r.stderr
-    assert r.stdout.strip().splitlines()[-1].startswith("===") and " 7 passed" in r.stdout, r.stdout
+    assert r.stdout.strip().splitlines()[-1].startswith("===") and " 9 passed" in r.stdout, r.stdout
     # loaded by its entry point: no -p, no conftest
     r = run([installed.bin / "pytest", "--help"], cwd=tmp_path)
     assert "--orfa-board={m32d,m128s}" in r.stdout

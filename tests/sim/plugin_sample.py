@@ -64,3 +64,22 @@ def test_marker_robot(orfa_sim_robot):
         assert gw.request("S 10 P") == "ERROR 06"
         uids = [d.uid for d in boardmap.load("m32d").drivers]
         assert [d.uid for d in gw.drivers(0x16)] == uids
+
+
+def test_typed_board_moves_a_servo(orfa_board, orfa_sim_board):
+    """The typed API on the simulated board: the width lands on the pin."""
+    orfa_board.servo.set_width(3, 1500)
+    assert orfa_board.servo.width(3) == 1500
+    ctl = orfa_sim_board.control
+    ctl.wait(3 * 147456)                                # three 20 ms frames
+    lo, hi, _ = ctl.measure("A3", 2, ctl.time() - 2 * 147456)["high"]   # servo 3: PA3
+    assert abs(lo - 1500 * F_CPU / 1e6) <= 4 and abs(hi - 1500 * F_CPU / 1e6) <= 4, (lo, hi)
+
+
+@pytest.mark.orfa_robot(gateway="m32d", slaves=[("m128s", 0x10)])
+def test_typed_boards_of_a_robot(orfa_robot_boards):
+    assert sorted(orfa_robot_boards) == [0x10, 0xAA]
+    slave = orfa_robot_boards[0x10]
+    assert slave.map.board == "m128s"
+    slave.servo.set_width(5, 2000)
+    assert slave.servo.widths(5, 1) == [2000]

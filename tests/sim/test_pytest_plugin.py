@@ -49,7 +49,7 @@ def summary(output):
 def test_sample_user_tests_pass(tmp_path):
     status, out = user_pytest(tmp_path, SAMPLE.read_text())
     assert status == 0, out
-    assert summary(out) == {"passed": 7}, out
+    assert summary(out) == {"passed": 9}, out
 
 
 def test_option_sets_the_default_board(tmp_path):

@@ -1,0 +1,316 @@
+"""A board's drivers as Python: `Board` for the gateway's own address or a
+slave's, found by introspection, with one client per driver.
+
+    with Board.open("/dev/ttyUSB0") as board:
+        board.servo.set_width(3, 1500)
+        print(board.adc.volts())
+
+Register numbers come from the board's introspection (each driver's start
+register) and the register names of the generated board map (their order
+within the driver): nothing here knows a number of its own. Refused writes
+and reads raise the RegisterError of the status register's reason
+(docs/python.md says what each call sends).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Dict, FrozenSet, Iterable, List, Optional, Sequence, Tuple
+
+from . import boardmap
+from . import boards
+from . import protocol as p
+from .errors import NoDriverError, Status, register_error
+from .gateway import Gateway
+
+
+@dataclass(frozen=True)
+class Op:
+    """One register access of a request: a write of `data`, or a read of
+    `count` bytes after a write of `data` (usually empty: a plain select)."""
+
+    kind: str                      # "w" or "r"
+    label: str                     # "servo SP", for messages
+    reg: int
+    data: bytes = b""
+    count: int = 0
+
+    @property
+    def action(self) -> str:
+        return "write" if self.kind == "w" else "read"
+
+
+@lru_cache(maxsize=None)
+def _uid_index() -> Dict[int, Tuple[boardmap.BoardMap, boardmap.DriverMap]]:
+    """Every driver UID of every board map: (BoardMap, DriverMap). A UID
+    names one driver on every board that has it (GPIO of 4 ports is 0x0020,
+    of 2 ports 0x0021), so a driver's facts follow from its UID even on a
+    build that left drivers out."""
+    index: Dict[int, Tuple[boardmap.BoardMap, boardmap.DriverMap]] = {}
+    for name in boardmap.BOARDS:
+        m = boardmap.load(name)
+        for d in m.drivers:
+            index.setdefault(d.uid, (m, d))
+    return index
+
+
+class Board:
+    """One ORFA board (the gateway itself, or a slave behind it)."""
+
+    def __init__(self, gateway: Gateway, addr: Optional[int] = None):
+        if addr is not None:
+            p.Write(addr)                 # checks the address (0..255)
+            addr &= 0xFE
+        self.gateway = gateway
+        self._addr = addr
+        self._owns_gateway = False
+        self._drivers: Optional[List[p.DriverRecord]] = None
+        self._clients: Dict[str, object] = {}
+
+    @classmethod
+    def open(cls, url: str, addr: Optional[int] = None, baudrate: int = p.DEFAULT_BAUD,
+             timeout: float = 2.0) -> "Board":
+        """A Board on its own Gateway(url); closing the board closes the port."""
+        board = cls(Gateway(url, baudrate=baudrate, timeout=timeout), addr)
+        board._owns_gateway = True
+        return board
+
+    def close(self) -> None:
+        if self._owns_gateway:
+            self.gateway.close()
+
+    def __enter__(self) -> "Board":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return "<Board 0x%02X%s>" % (self.addr, " (gateway)" if self.is_local else "")
+
+    # --- identity -------------------------------------------------------------
+    @property
+    def addr(self) -> int:
+        """The board's 8-bit address (the gateway's local address if None was given)."""
+        return self.gateway.local if self._addr is None else self._addr
+
+    @property
+    def is_local(self) -> bool:
+        """True for the gateway's own drivers (no bus in between)."""
+        return self._addr is None or self._addr == self.gateway.local & 0xFE
+
+    # --- introspection --------------------------------------------------------
+    @property
+    def drivers(self) -> List[p.DriverRecord]:
+        """The introspection records, read once (refresh() reads again)."""
+        if self._drivers is None:
+            self.gateway.in_step()
+            self._drivers = self.gateway.drivers(self.addr)
+        return list(self._drivers)
+
+    def refresh(self) -> None:
+        """Forget what introspection said (a board reflashed, reset)."""
+        self._drivers = None
+        self._clients.clear()
+
+    @property
+    def map(self):
+        """The generated BoardMap whose driver UIDs match, or None."""
+        return boardmap.by_uids([r.uid for r in self.drivers])
+
+    def driver_name(self, uid: int) -> Optional[str]:
+        """A UID's driver name ("servo"), None if no board map knows it."""
+        hit = _uid_index().get(uid)
+        return hit[1].name if hit else None
+
+    def _record(self, name: str):
+        """(record, BoardMap, DriverMap) of driver `name`; NoDriverError if absent."""
+        index = _uid_index()
+        for rec in self.drivers:
+            hit = index.get(rec.uid)
+            if hit is not None and hit[1].name == name:
+                return rec, hit[0], hit[1]
+        raise NoDriverError("0x%02X has no %s driver (its drivers: %s)"
+                            % (self.addr, name, ", ".join(
+                                self.driver_name(r.uid) or "%04X" % r.uid for r in self.drivers)))
+
+    def has(self, name: str) -> bool:
+        try:
+            self._record(name)
+        except NoDriverError:
+            return False
+        return True
+
+    def register(self, name: str, reg: str) -> int:
+        """Register `reg` of driver `name`: introspection's start plus the
+        register's place in the map ("servo", "SP" -> 0x13 on an M32-D)."""
+        rec, _, dmap = self._record(name)
+        return rec.start + dmap.offset(reg)
+
+    def board_map(self, name: str):
+        """The BoardMap the driver `name` of this board comes from (its
+        ports, channels)."""
+        return self._record(name)[1]
+
+    # --- register access ------------------------------------------------------
+    def op_write(self, name: str, reg: str, data: Iterable[int]) -> Op:
+        return Op("w", "%s %s" % (name, reg), self.register(name, reg), bytes(data))
+
+    def op_read(self, name: str, reg: str, count: int, select: Iterable[int] = b"") -> Op:
+        return Op("r", "%s %s" % (name, reg), self.register(name, reg), bytes(select), count)
+
+    def write(self, name: str, reg: str, data: Iterable[int]) -> None:
+        """Write data to a register; RegisterError if the board refuses it."""
+        self.execute([[self.op_write(name, reg, data)]])
+
+    def read(self, name: str, reg: str, count: int, select: Iterable[int] = b"") -> bytes:
+        """Read count bytes of a register (after writing `select` to it)."""
+        return self.execute([[self.op_read(name, reg, count, select)]])[0][0]
+
+    def _status_frames(self) -> List[p.Frame]:
+        return p.register_read_frames(self.addr, self.register("intro", "STATUS"), 1)
+
+    def _frames(self, item: Sequence[Op]) -> List[p.Frame]:
+        frames: List[p.Frame] = []
+        for op in item:
+            frames.append(p.Write(self.addr, bytes([op.reg]) + op.data))
+            if op.kind == "r":
+                frames.append(p.Read(self.addr, op.count))
+            if not self.is_local:
+                # a slave acknowledges before its driver decides: ask it
+                # in the same request (docs/registers.md "On a slave board")
+                frames += self._status_frames()
+        return frames
+
+    def execute(self, items: Sequence[Sequence[Op]]) -> List[List[bytes]]:
+        """Run groups of register accesses, one request per group, all
+        pipelined; for each group the data of its reads. On a slave each
+        access is followed by a status read in the same request; several
+        groups are each followed by a status request, so a refusal's reason
+        is the board's own even when later requests ran. The first refusal
+        raises (after every group ran)."""
+        items = [list(item) for item in items]
+        paired = len(items) > 1
+        requests: List[List[p.Frame]] = []
+        for item in items:
+            requests.append(self._frames(item))
+            if paired:
+                requests.append(self._status_frames())
+        results = self.gateway.transactions(requests)
+        out: List[List[bytes]] = []
+        first: Optional[p.OrfaError] = None
+        for k, item in enumerate(items):
+            res = results[2 * k if paired else k]
+            if isinstance(res, p.OrfaError):
+                after = results[2 * k + 1] if paired else None
+                first = first or self._refusal(item, res, after)
+                out.append([])
+                continue
+            reads, err = self._parse(item, res)
+            first = first or err
+            out.append(reads)
+        if first is not None:
+            raise first
+        return out
+
+    def _parse(self, item: Sequence[Op], res) -> Tuple[List[bytes], Optional[p.OrfaError]]:
+        reads: List[bytes] = []
+        pos = 0
+        for op in item:
+            pos += 1
+            if op.kind == "r":
+                reads.append(res[pos].data)
+                pos += 1
+            if not self.is_local:
+                status = res[pos + 1].data[0]
+                pos += 2
+                if status not in (Status.OK, Status.READ_WRAPPED):
+                    return reads, register_error(status, self.addr, op.label, op.action)
+        return reads, None
+
+    def _refusal(self, item: Sequence[Op], err: p.OrfaError, after) -> p.OrfaError:
+        """An ERROR 06/07 reply as the RegisterError of the status register's
+        reason (asked now, or the status request run right after)."""
+        if not isinstance(err, (p.AddressNackError, p.DataNackError)):
+            return err
+        if after is None:
+            try:
+                status = self._read_status()
+            except p.OrfaError:
+                return err
+        elif isinstance(after, p.OrfaError):
+            return err
+        else:
+            status = after[-1].data[0]
+        if status in (Status.OK, Status.READ_WRAPPED):
+            return err
+        kind = "w" if isinstance(err, p.DataNackError) else "r"
+        op = next((o for o in item if o.kind == kind), item[0])
+        refusal = register_error(status, self.addr, op.label, op.action, code=err.code)
+        refusal.__cause__ = err
+        return refusal
+
+    # --- status, reset cause, failsafe -----------------------------------------
+    def _read_status(self) -> int:
+        (result,) = self.gateway.transactions([self._status_frames()])
+        if isinstance(result, p.OrfaError):
+            raise result
+        return result[-1].data[0]
+
+    def status(self) -> Status:
+        """The status register: the result of the last register access."""
+        return Status(self._read_status())
+
+    def reset_cause(self) -> FrozenSet[str]:
+        """Why the board reset since the causes were last cleared:
+        "power", "external", "brownout", "watchdog", "jtag"."""
+        return boards.reset_causes(self.read("sys", "RESET", 1)[0])
+
+    def clear_reset_cause(self, causes: Optional[Iterable[str]] = None) -> None:
+        """Forget the reset causes (all, or the names given)."""
+        bits = boards.RESET_CAUSES_ALL if causes is None else boards.reset_cause_bits(causes)
+        self.write("sys", "RESET", [bits])
+
+    def failsafe(self) -> int:
+        """The link-loss failsafe's timeout in ms (0: off)."""
+        data = self.read("sys", "FAILSAFE", 2)
+        return data[0] << 8 | data[1]
+
+    def set_failsafe(self, ms: int) -> None:
+        """Motors stop and servos go limp after `ms` without a request; 0: off."""
+        if not isinstance(ms, int) or not 0 <= ms <= boards.FAILSAFE_MAX_MS:
+            raise ValueError("failsafe: 0..%d ms, not %r" % (boards.FAILSAFE_MAX_MS, ms))
+        self.write("sys", "FAILSAFE", [ms >> 8, ms & 0xFF])
+
+    # --- driver clients -------------------------------------------------------
+    def _client(self, name: str, factory):
+        if name not in self._clients:
+            self._record(name)            # NoDriverError if the board has none
+            self._clients[name] = factory(self)
+        return self._clients[name]
+
+    @property
+    def gpio(self):
+        from .clients.gpio import Gpio
+        return self._client("gpio", Gpio)
+
+    @property
+    def servo(self):
+        from .clients.servo import Servo
+        return self._client("servo", Servo)
+
+    @property
+    def motor(self):
+        from .clients.motor import Motor
+        return self._client("motor", Motor)
+
+    @property
+    def adc(self):
+        from .clients.adc import Adc
+        return self._client("adc", Adc)
+
+    @property
+    def spi(self):
+        from .clients.spi import Spi
+        return self._client("spi", Spi)

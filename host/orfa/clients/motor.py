@@ -1,0 +1,60 @@
+"""board.motor: the motor driver's PWMn and DIRn registers as signed duties."""
+
+from __future__ import annotations
+
+from typing import List, Optional
+
+
+class Motor:
+    def __init__(self, board):
+        self.board = board
+        regs = board.board_map("motor").driver("motor").registers
+        #: motors on the board (the map's PWMn registers): 2 on an M32-D
+        self.count: int = sum(1 for r in regs if r.startswith("PWM"))
+
+    def _n(self, n: int) -> int:
+        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= self.count:
+            raise ValueError("motor %r: motors are 1..%d" % (n, self.count))
+        return n
+
+    @staticmethod
+    def _duty(duty: int) -> int:
+        if not isinstance(duty, int) or isinstance(duty, bool) or not -255 <= duty <= 255:
+            raise ValueError("duty must be -255..255 (sign: direction), not %r" % (duty,))
+        return duty
+
+    def set(self, n: int, duty: int) -> None:
+        """Motor n (1 or 2) at duty -255..255 (sign: direction, 1 backward on
+        DIRn). The registers are read, then written back whole from PWM1
+        with motor n changed: one write, all of it or none (a refused PWM,
+        pin busy, leaves the direction too), the motors in the same period."""
+        n, duty = self._n(n), self._duty(duty)
+        duties = self.duties()
+        duties[n - 1] = duty
+        self.set_all(*duties)
+
+    def set_all(self, *duties: int) -> None:
+        """Every motor at once, one write from PWM1 (`80 60 00 01`): both
+        change in the same PWM period."""
+        if len(duties) != self.count:
+            raise ValueError("set_all takes %d duties, not %d" % (self.count, len(duties)))
+        duties = tuple(self._duty(d) for d in duties)
+        data = [abs(d) for d in duties] + [1 if d < 0 else 0 for d in duties]
+        self.board.write("motor", "PWM1", data)
+
+    def get(self, n: int) -> int:
+        """Motor n's signed duty (negative: backward)."""
+        return self.duties()[self._n(n) - 1]
+
+    def duties(self) -> List[int]:
+        """Every motor's signed duty, from one read of all the registers."""
+        data = self.board.read("motor", "PWM1", 2 * self.count)
+        pwm, dirs = data[:self.count], data[self.count:]
+        return [-d if r else d for d, r in zip(pwm, dirs)]
+
+    def stop(self, n: Optional[int] = None) -> None:
+        """PWM 0 for motor n, or every motor (one write); directions kept."""
+        if n is None:
+            self.board.write("motor", "PWM1", [0] * self.count)
+        else:
+            self.board.write("motor", "PWM%d" % self._n(n), [0])
