@@ -136,10 +136,22 @@ static void cmd_rx(control_t *c, reply_t *r, int argc, char **argv)
 	uint8_t bytes[CONTROL_LINE / 2];
 	size_t n = 0;
 	uint64_t at, now = c->avr->cycle, free_at, room, end;
+	/* `+N`: N cycles from the cycle this request is answered at, so a batch
+	 * (`rx +N ...`, `wait M`, ...) keeps its spacing whatever the wall clock */
+	int rel = argc >= 2 && argv[1][0] == '+';
 
-	if (argc < 3 || parse_u64(argv[1], &at) < 0) {
-		rp(r, "ERR rx CYCLE HEX...: CYCLE decimal, then the bytes in hex");
+	if (argc < 3 || (rel && argv[1][1] == '+') || parse_u64(argv[1] + rel, &at) < 0) {
+		rp(r, "ERR rx CYCLE HEX...: CYCLE decimal (or +N: N cycles from now), "
+		   "then the bytes in hex");
 		return;
+	}
+	if (rel) {
+		if (at > CONTROL_RX_AHEAD) {
+			rp(r, "ERR rx: +%" PRIu64 " is more than %" PRIu64 " cycles ahead", at,
+			   (uint64_t)CONTROL_RX_AHEAD);
+			return;
+		}
+		at += now;
 	}
 	for (int i = 2; i < argc; i++) {
 		if (parse_hex(argv[i], bytes, &n, sizeof(bytes)) < 0) {
@@ -547,10 +559,10 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 			rp(&r, "ERR line: only the gateway's serial line reaches the PC");
 			return 0;
 		}
-		rp(&r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u",
+		rp(&r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u pty %u",
 		   (unsigned)u->host_baud, (unsigned)u->host_bit, (unsigned)usart_board_bit(u),
 		   (unsigned)u->ubrr, !!(u->avr->data[u->regs->ucsrb] & (1u << 4)),
-		   (uint64_t)u->rxen_since, (unsigned)u->fe_read);
+		   (uint64_t)u->rxen_since, (unsigned)u->fe_read, (unsigned)u->host_taken);
 	} else if (!strcasecmp(cmd, "rx")) {
 		if (cb != &c->board[0]) {
 			rp(&r, "ERR rx: only the gateway's serial line reaches the PC");

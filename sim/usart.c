@@ -319,6 +319,7 @@ void usart_host_send(usart_t *u, const uint8_t *buf, size_t n)
 	for (size_t i = 0; i < n && u->host_len < USART_HOST_QUEUE; i++) {
 		u->host_q[(u->host_head + u->host_len) % USART_HOST_QUEUE] = buf[i];
 		u->host_len++;
+		u->host_taken++;
 	}
 	usart_rx_kick(u);
 }

@@ -22,7 +22,7 @@ from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, 
 
 from . import locate
 from .gateway import Gateway
-from .protocol import DEFAULT_BAUD, F_CPU
+from .protocol import AUTOBAUD_PREAMBLE, DEFAULT_BAUD, F_CPU, autobaud_wait_s
 from .simctl import SimControl
 
 BOARDS = locate.BOARDS
@@ -272,9 +272,32 @@ class SimBoard:
                 **kw) -> Gateway:
         """A Gateway on this board's port at `baudrate`; autobaud=True sends
         the BAUD=auto preamble and waits its quiet in simulated time (needs
-        control=True)."""
-        return Gateway(self.port, baudrate=baudrate, autobaud=autobaud,
-                       wait=self.wait_s if autobaud else None, **kw)
+        control=True; see preamble)."""
+        gw = Gateway(self.port, baudrate=baudrate, **kw)
+        if autobaud:
+            try:
+                self.preamble(gw.serial)
+            except BaseException:
+                gw.close()
+                raise
+        return gw
+
+    def pc_write(self, port, data: bytes) -> int:
+        """Write `data` to the PC's `port` (a pyserial port on self.port) and
+        let simulated time pass until the simulator has taken all of it (the
+        kernel hands it over in wall time; SimControl.wait_taken): what a
+        test measures from the returned cycle on does not depend on the
+        machine's load. Needs control=True."""
+        before = self.control.line()["pty"]
+        port.write(data)
+        port.flush()
+        return self.control.wait_taken(before + len(data))
+
+    def preamble(self, port) -> int:
+        """The BAUD=auto preamble at the port's rate, taken by the simulator
+        (pc_write), then its quiet in simulated time; the cycle reached."""
+        self.pc_write(port, AUTOBAUD_PREAMBLE)
+        return self.wait_s(autobaud_wait_s(port.baudrate))
 
     def speed(self) -> Optional[float]:
         """After stop(): world cycles per wall second while running free, in

@@ -16,6 +16,13 @@ from typing import Dict, List, Optional, Tuple, Union
 RX_MAX = 480
 
 
+def parse_edges(reply: str) -> List[Tuple[int, int]]:
+    """An `edges` reply ("cycle:level ..." or "-") as [(cycle, level), ...]."""
+    if reply == "-":
+        return []
+    return [(int(c), int(lv)) for c, lv in (item.split(":") for item in reply.split())]
+
+
 class SimControlError(RuntimeError):
     """The simulator refused a request (its ``ERR ...`` text)."""
 
@@ -134,14 +141,24 @@ class SimControl:
     def edges(self, sig: str, since: Optional[int] = None) -> List[Tuple[int, int]]:
         """[(cycle, level), ...], oldest first."""
         sig = self._name(sig)
-        reply = self.request("edges %s" % sig if since is None else "edges %s %d" % (sig, since))
-        if reply == "-":
-            return []
-        out = []
-        for item in reply.split():
-            cycle, level = item.split(":")
-            out.append((int(cycle), int(level)))
-        return out
+        return parse_edges(self.request("edges %s" % sig if since is None
+                                        else "edges %s %d" % (sig, since)))
+
+    def window(self, sigs: List[str], cycles: int, during: List[str] = ()
+               ) -> Tuple[int, int, Dict[str, List[Tuple[int, int]]]]:
+        """Let `cycles` pass and take the edges of `sigs` in that window:
+        (start, end, {sig: [(cycle, level), ...]}), every edge at or after
+        start and before end. One batch (`time`, the requests `during`, e.g.
+        `rx +N ...`, at the window's start, `wait`, an `edges` per signal
+        answered at the wait's cycle), so the window is fixed in simulated
+        time however the wall clock goes; `cycles` should stay within the
+        1024 edges a signal keeps."""
+        during = list(during)
+        replies = self.requests(["time"] + during + ["wait %d" % cycles] +
+                                ["edges %s" % self._name(s) for s in sigs])
+        start, end = int(replies[0]), int(replies[1 + len(during)])
+        return start, end, {s: [e for e in parse_edges(r) if start <= e[0] < end]
+                            for s, r in zip(sigs, replies[2 + len(during):])}
 
     def measure(self, sig: str, n: Optional[int] = None, since: Optional[int] = None) -> Dict:
         """{"steady": 0|1} or {"high": (min, max, mean), "period": (...), "duty": f, "n": k}."""
@@ -196,6 +213,13 @@ class SimControl:
             raise ValueError("rx takes 1..%d bytes, not %d" % (RX_MAX, len(data)))
         return int(self.request("rx %d %s" % (cycle, bytes(data).hex().upper())))
 
+    def rx_after(self, cycles: int, data: bytes) -> int:
+        """As rx, the first start bit `cycles` after the cycle the simulator
+        answers at (`rx +N`): never past, however late the request arrives."""
+        if not 1 <= len(data) <= RX_MAX:
+            raise ValueError("rx takes 1..%d bytes, not %d" % (RX_MAX, len(data)))
+        return int(self.request("rx +%d %s" % (cycles, bytes(data).hex().upper())))
+
     def rx_stream(self, cycle: int, line: bytes, until: int, slip: int) -> Tuple[int, int]:
         """`line` (a request and its terminator) again and again on the serial
         line, back to back, from `cycle` (or `slip` cycles after now, should
@@ -231,9 +255,26 @@ class SimControl:
         """The gateway's serial line: `pc` the PC's rate (its port's termios),
         `bit` its bit time and `board` the board's (UBRR/U2X), in cycles;
         `ubrr`, `rxen`, `since` (the cycle RXEN last went on), `fe` (frames
-        with FE the firmware took from UDR)."""
+        with FE the firmware took from UDR), `pty` (bytes the simulator has
+        taken from the PC's port)."""
         words = self.request(self._board("line")).split()
         return {k: int(v) for k, v in zip(words[::2], words[1::2])}
+
+    def wait_taken(self, total: int, step: int = 1000, timeout: float = 30.0) -> int:
+        """Let simulated time pass, `step` cycles at a time, until the
+        simulator has taken `total` bytes from the PC's port (`line`'s pty):
+        a write to the port reaches it when the kernel gets to it, in wall
+        time. The cycle reached; SimControlError if the bytes never come."""
+        deadline = time.monotonic() + timeout
+        while True:
+            taken, now = self.requests(["line", "time"])
+            words = taken.split()
+            if int(words[words.index("pty") + 1]) >= total:
+                return int(now)
+            if time.monotonic() > deadline:
+                raise SimControlError("the simulator took %s of %d bytes from the port"
+                                      % (words[words.index("pty") + 1], total))
+            self.wait(step)
 
     def peek(self, addr: int, n: int = 1) -> bytes:
         """n bytes of the MCU's data space from `addr` (SRAM, registers)."""
@@ -301,4 +342,7 @@ class _SlaveView(SimControl):
         pass
 
     def rx(self, cycle: int, data: bytes) -> int:
+        raise SimControlError("rx: only the gateway's serial line reaches the PC")
+
+    def rx_after(self, cycles: int, data: bytes) -> int:
         raise SimControlError("rx: only the gateway's serial line reaches the PC")

@@ -52,14 +52,12 @@ def build_gateway(board: str, baud) -> Path:
 _BUILT = set()
 
 
-def line_after(sim: SimBoard, port, cycles: int) -> bytes:
-    """Everything the board sent to the PC by `cycles` simulated cycles from
-    now: the simulator hands its output to the pty before it answers a
-    `wait`, so simulated time decides; the short sleep is only the kernel's
-    pty hand-over (a work queue) to the reading side."""
-    sim.control.wait(cycles)
-    time.sleep(0.05)
-    return port.read(port.in_waiting)
+def board_sent(sim: SimBoard, since: int) -> bytes:
+    """The bytes the board's firmware sent from cycle `since` on (the
+    trace's `uart tx`): what it answered, decided in simulated time; a
+    trace event is written before the simulator answers a later `wait`."""
+    return bytes(int(e.fields[0], 16) for e in sim.trace_events(kinds=["uart tx"])
+                 if e.cycle >= since)
 
 
 class Bench:

@@ -11,7 +11,7 @@ import random
 
 import pytest
 
-from conftest import REPLY_TIMEOUT, build_gateway, line_after, require_builds
+from conftest import REPLY_TIMEOUT, board_sent, build_gateway, require_builds
 from orfa.protocol import AUTOBAUD_PREAMBLE, BAUD_RATES, F_CPU
 from orfa.sim import BOARDS, SimBoard
 
@@ -61,12 +61,12 @@ def test_noise_first_then_the_preamble(board, noise_rate, rate):
     not 0x0D, then the preamble: the board ends talking at the right rate."""
     rng = random.Random("%s %d %d" % (board, noise_rate, rate))
     with start(board) as sim, sim.gateway(noise_rate, timeout=REPLY_TIMEOUT) as gw:
-        gw.send(noise(rng, 40))
+        sim.pc_write(gw.serial, noise(rng, 40))
         sim.wait_s(45 * 10 / noise_rate)
         gw.serial.baudrate = rate
-        gw.send(b"hello V S AA P \n" + noise(rng, 20))
+        sim.pc_write(gw.serial, b"hello V S AA P \n" + noise(rng, 20))
         sim.wait_s(40 * 10 / rate)
-        gw.preamble(sim.wait_s)
+        sim.preamble(gw.serial)
         talks(sim, gw, board, rate)
 
 
@@ -77,10 +77,10 @@ def test_a_preamble_at_a_wrong_rate_first_is_not_kept(board, wrong, rate):
     """0x0Ds at another rate, then quiet, look like a preamble and lock that
     rate; the real preamble after them moves it (no request was accepted)."""
     with start(board) as sim, sim.gateway(wrong, timeout=REPLY_TIMEOUT) as gw:
-        gw.preamble(sim.wait_s)
+        sim.preamble(gw.serial)
         assert sim.control.line()["board"] == F_CPU // wrong
         gw.serial.baudrate = rate
-        gw.preamble(sim.wait_s)
+        sim.preamble(gw.serial)
         talks(sim, gw, board, rate)
 
 
@@ -91,8 +91,8 @@ def test_a_slower_pc_later_brings_the_board_back_to_detection(board):
     with start(board) as sim, sim.gateway(115200, autobaud=True, timeout=REPLY_TIMEOUT) as gw:
         assert gw.request("V") == "V1.1"
         gw.serial.baudrate = 2400
-        gw.preamble(sim.wait_s)
-        gw.preamble(sim.wait_s)
+        sim.preamble(gw.serial)
+        sim.preamble(gw.serial)
         talks(sim, gw, board, 2400)
 
 
@@ -101,8 +101,10 @@ def test_the_preamble_gets_no_reply(board):
     """The eight CRs are empty lines: nothing comes back, before or after
     the rate is found."""
     with start(board) as sim, sim.gateway(19200, autobaud=True, timeout=REPLY_TIMEOUT) as gw:
-        gw.send(AUTOBAUD_PREAMBLE)
-        assert line_after(sim, gw.serial, F_CPU // 10) == b""
+        t0 = sim.control.time()
+        sim.pc_write(gw.serial, AUTOBAUD_PREAMBLE)
+        sim.control.wait(F_CPU // 10)
+        assert board_sent(sim, t0) == b""
         assert gw.request("V") == "V1.1"
 
 
@@ -112,5 +114,10 @@ def test_fixed_rate_build_does_not_answer_a_pc_at_9600(board):
     require_builds([board])
     with SimBoard(board, trace=True, control=True) as sim, \
             sim.gateway(9600, autobaud=True, timeout=REPLY_TIMEOUT) as gw:
-        gw.send(b"V\r")
-        assert b"V1.1" not in line_after(sim, gw.serial, F_CPU // 10)
+        t0 = sim.control.time()
+        sim.pc_write(gw.serial, b"V\r")
+        sim.control.wait(F_CPU // 10)
+        assert b"V1.1" not in board_sent(sim, t0)
+        # its receiver got frames from the PC's bits, never a 'V'
+        rx = [e for e in sim.trace_events(kinds=["uart rx"]) if e.cycle >= t0]
+        assert rx and not any(e.fields[0] == "56" for e in rx), rx

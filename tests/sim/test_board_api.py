@@ -342,7 +342,12 @@ def test_stale_reply_dropped_by_a_marker(sims):
     ctl = sim.control
     _, end = ctl.rx_stream(ctl.time() + 2000, b"Zz\n", 0, 2000)
     ctl.wait(max(1000, end + 20000 - ctl.time()))
-    time.sleep(0.05)                                # the pty's hand-over, as conftest.line_after
+    # the board has answered Zz in simulated time; its reply reaches the port
+    # when the kernel hands it over (wall time): wait for it, do not guess
+    deadline = time.monotonic() + REPLY_TIMEOUT
+    while not gw.serial.in_waiting:
+        assert time.monotonic() < deadline, "the reply to Zz never reached the port"
+        time.sleep(0.01)
     before = gw.resyncs
     assert b.servo.width(2) == 1700
     assert gw.resyncs == before + 1

@@ -76,6 +76,22 @@ def x_lines(pulses):
     return out + [("SCL", "0"), ("SDA", "0"), ("SCL", "1"), ("SDA", "1")]
 
 
+def hold_scl_during(ctl, req, lead=50 * MS, after=40 * MS):
+    """`req` on the serial line `lead` cycles from now, SCL held low `after`
+    cycles after its last byte: one batch, every cycle relative to the one
+    the simulator answers it at (`rx +N`, `wait`), so the hold lands at the
+    same point of the frame however late the wall clock delivers the batch.
+    The cycle the hold began."""
+    bit = ctl.line()["bit"]                     # the PC's bit time, cycles
+    end, held, _ = ctl.requests([
+        "rx +%d %s" % (lead, req.hex().upper()),
+        "wait %d" % (lead + 10 * bit * len(req) + after),
+        "i2c hold-scl on"])
+    end, held = int(end), int(held)
+    assert 0 <= held - (end + after) < 8, (end, held)    # within an instruction
+    return held
+
+
 def eeprom_works(b, value=0x5A):
     assert b.ask("S A0 70 %02X P" % value) == b"SWAAP\r\n"
     assert b.ask(READ) == b"SWASR%02XP\r\n" % value
@@ -193,9 +209,8 @@ def test_scl_held_after_the_address(sb):
     ctl = sb.sim.control
     assert sb.ask("C0001") == b"C0000\r\n"
     req = ("S A0 20 %s P\n" % " ".join("%02X" % i for i in range(7))).encode()
-    end = ctl.rx(ctl.time() + 50 * MS, req)
     mark = sb.mark()
-    ctl.requests(["wait %d" % (end + 40 * MS - ctl.time()), "i2c hold-scl on"])
+    hold_scl_during(ctl, req)
     assert sb.read_lines(1) == b"ERROR 07\r\n"
     kinds = twi_kinds(sb, mark)
     held = kinds.index(("twi hold-scl", "on"))
@@ -259,8 +274,7 @@ def test_slave_left_mid_frame_lets_go(robot, addr):
     try:
         assert b.ask("C0001") == b"C0000\r\n"
         req = ("S %02X %02X %s P\n" % (addr, rs, " ".join(["00"] * 7))).encode()
-        end = ctl.rx(ctl.time() + 50 * MS, req)
-        ctl.requests(["wait %d" % (end + 40 * MS - ctl.time()), "i2c hold-scl on"])
+        hold_scl_during(ctl, req)
         assert b.read_lines(1) == b"ERROR 07\r\n"
         ctl.wait(40 * MS)
         ev = b.events(mark)

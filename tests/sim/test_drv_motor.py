@@ -57,20 +57,28 @@ def test_pwm_duty_on_both_motors(drv, pwm):
 
 
 def test_pwm_frequency(drv):
-    drv.wr(reg(drv), bytes([0x80, 0x40]))
-    since = settle(drv)
+    """60 periods taken in one window fixed in simulated cycles (SimControl
+    .window): every period exactly 368 cycles, every pulse the same width,
+    and both lines rise together at the timer's BOTTOM."""
+    pwm = {"D5": 0x80, "D4": 0x40}
+    drv.wr(reg(drv), bytes([pwm["D5"], pwm["D4"]]))
+    drv.wait(4 * PWM_PERIOD)
+    start, end, edges = drv.ctl.window(list(PWM_PINS), 60 * PWM_PERIOD)
+    rises = {}
     for pin in PWM_PINS:
-        m = drv.measure(pin, since)
+        r = [c for c, level in edges[pin] if level == 1]
+        f = [c for c, level in edges[pin] if level == 0 and c > r[0]]
+        assert r[0] - start < PWM_PERIOD and end - r[-1] <= PWM_PERIOD, (pin, start, r, end)
+        assert {b - a for a, b in zip(r, r[1:])} == {PWM_PERIOD}, (pin, r)
+        highs = {fall - rise for rise, fall in zip(r, f)}
+        assert len(highs) == 1, (pin, highs)
+        # docs: duty = PWM/255 within 1/368 (brief: 1/256)
+        assert abs(highs.pop() / PWM_PERIOD - pwm[pin] / 255) <= 1 / 368, pin
+        m = drv.measure(pin, start)
         assert m["period"] == (PWM_PERIOD, PWM_PERIOD, float(PWM_PERIOD)), m
-    # both lines rise together at the timer's BOTTOM
-    r5 = [c for c, l in drv.edges("D5", since) if l == 1]
-    r4 = [c for c, l in drv.edges("D4", since) if l == 1]
-    # the two requests come a little wall time apart and each signal keeps
-    # its last 1024 edges: compare from the first rise both still hold
-    first = max(r5[0], r4[0])
-    r5 = [c for c in r5 if c >= first]
-    r4 = [c for c in r4 if c >= first]
-    assert r5[:10] == r4[:10]
+        rises[pin] = r
+    assert len(rises["D5"]) >= 60
+    assert rises["D5"] == rises["D4"]
 
 
 def test_shortest_pulses_never_drop(drv):
@@ -110,19 +118,31 @@ def test_four_byte_write_from_the_manual(drv):
 
 
 def test_both_motors_change_in_the_same_period(drv):
+    """The write goes on the serial line at a fixed cycle of a window fixed
+    in simulated time (`rx +N` inside SimControl.window), so the edges that
+    show the change are all still kept when the window is read."""
     drv.wr(reg(drv), bytes([50, 200]))
     drv.wait(10 * PWM_PERIOD)
-    t0 = drv.now()
-    drv.wr(reg(drv), bytes([150, 100]))
-    drv.wait(10 * PWM_PERIOD)
+    req = b"S%s%02X9664P\n" % (drv.wa.encode(), reg(drv))
+    lead = 1000
+    # the request's bytes, the bus and the driver (a few ms), then 10 periods
+    byte = 10 * drv.sim.control.line()["bit"]      # the PC's byte time
+    span = lead + len(req) * byte + 40000 + 10 * PWM_PERIOD
+    t0, end, edges = drv.ctl.window(list(PWM_PINS), span,
+                                    ["rx +%d %s" % (lead, req.hex().upper())])
+    assert drv.read_lines(1) == b"SWAAAP\r\n"
+    if drv.slave:
+        assert drv.status() == 0
 
     def first_new(pin, new):
         want = round(new * PWM_PERIOD / 255)
-        edges = drv.edges(pin, t0)
-        for i, (c, l) in enumerate(edges[:-1]):
-            if l == 1 and abs(edges[i + 1][0] - c - want) <= 1:
+        pin_edges = edges[pin]
+        assert pin_edges and pin_edges[0][0] - t0 < PWM_PERIOD, (pin, t0, pin_edges[:2])
+        for i, (c, l) in enumerate(pin_edges[:-1]):
+            if l == 1 and abs(pin_edges[i + 1][0] - c - want) <= 1:
+                assert end - c >= 10 * PWM_PERIOD, (pin, c, end)
                 return c
-        raise AssertionError((pin, edges[:8]))
+        raise AssertionError((pin, pin_edges[:8]))
     assert first_new("D5", 150) == first_new("D4", 100)
 
 

@@ -9,10 +9,11 @@ Fixed-rate firmware at other rates is built once into build/test-baud/.
 import pytest
 import serial
 
-from conftest import REPLY_TIMEOUT, build_gateway, line_after, require_builds
+from conftest import REPLY_TIMEOUT, board_sent, build_gateway, require_builds
 from orfa.gateway import Gateway
 from orfa.protocol import F_CPU
 from orfa.sim import BOARDS, SimBoard
+from orfa.simctl import SimControlError
 
 RXD = {"m32d": "D0", "m128s": "D2"}
 #: A cycle a fresh simulator has not reached when the test asks.
@@ -63,8 +64,8 @@ def test_rxd_pin_shows_the_pc_waveform(board):
 def resync(gw):
     """After garbage: `V` until its reply. The garbage's replies may still be
     on their way through the pty (the kernel hands bytes over when it gets
-    to it, after line_after's simulated wait), so the next request's reply
-    is the first V1.1, not the next line."""
+    to it), so the next request's reply is the first V1.1, not the next
+    line."""
     gw.send(b"V\r")
     lines = []
     while "V1.1" not in lines:
@@ -72,19 +73,32 @@ def resync(gw):
         assert len(lines) <= 4, lines          # a garbage line gets one reply at most
 
 
+def send_at_pc_rate(sim, rate, data=b"V\r", times=3):
+    """`data` from a PC at `rate`, `times` times, each on the line at a fixed
+    cycle (`rx +N`, at the PC's termios rate) with REPLY_CYCLES after it, all
+    in simulated time; the cycle the first one was scheduled from."""
+    ctl = sim.control
+    ctl.wait(1000)
+    assert ctl.line()["pc"] == rate            # the port's termios, seen
+    start = ctl.time()
+    for _ in range(times):
+        end, woke = ctl.requests(["rx +1000 %s" % data.hex().upper(),
+                                  "wait %d" % (1000 + len(data) * 10 * F_CPU // rate
+                                               + REPLY_CYCLES)])
+        assert int(woke) - int(end) >= REPLY_CYCLES
+    return start
+
+
 @pytest.mark.parametrize("board", BOARDS)
 def test_pc_at_9600_gets_no_valid_reply_from_a_115200_build(board):
     """The board's USART samples the PC's 9600 bits at 115200: framing
     errors (the firmware reads them: FE in UCSRA) and garbage, never V1.1."""
-    with sim_for(board) as sim, serial.Serial(sim.port, 9600, timeout=0) as port:
-        got = b""
-        for _ in range(3):
-            port.write(b"V\r")
-            got += line_after(sim, port, REPLY_CYCLES)
-        assert b"V1.1" not in got
+    with sim_for(board) as sim, serial.Serial(sim.port, 9600, timeout=0):
+        start = send_at_pc_rate(sim, 9600)
+        assert b"V1.1" not in board_sent(sim, start)
         line = sim.control.line()
         assert line["fe"] > 0                  # frames with FE taken from UDR
-        rx = sim.trace_events(kinds=["uart rx"])
+        rx = [e for e in sim.trace_events(kinds=["uart rx"]) if e.cycle >= start]
         assert any(e.fields[1:] == ("fe",) for e in rx)
         assert not any(e.fields[0] == "56" for e in rx)     # never a 'V'
 
@@ -92,12 +106,11 @@ def test_pc_at_9600_gets_no_valid_reply_from_a_115200_build(board):
 @pytest.mark.parametrize("board", BOARDS)
 def test_pc_at_115200_gets_no_valid_reply_from_a_9600_build(board):
     elf = build_gateway(board, 9600)
-    with sim_for(board, elf) as sim, serial.Serial(sim.port, 115200, timeout=0) as port:
-        got = b""
-        for _ in range(3):
-            port.write(b"V\r")
-            got += line_after(sim, port, REPLY_CYCLES)
-        assert b"V1.1" not in got
+    with sim_for(board, elf) as sim, serial.Serial(sim.port, 115200, timeout=0):
+        start = send_at_pc_rate(sim, 115200)
+        assert b"V1.1" not in board_sent(sim, start)
+        rx = [e for e in sim.trace_events(kinds=["uart rx"]) if e.cycle >= start]
+        assert rx and not any(e.fields[0] == "56" for e in rx), rx
 
 
 @pytest.mark.parametrize("rate", [2400, 9600, 57600])
@@ -129,19 +142,23 @@ def test_rx_requests_go_at_the_pc_rate():
 
 
 def test_pc_changing_its_rate_mid_session_is_followed():
+    """The PC's bytes are read at the rate its port had when the simulator
+    took them: each write is waited for in simulated time (SimBoard.pc_write)
+    before the rate changes."""
     with sim_for("m32d") as sim, Gateway(sim.port, timeout=REPLY_TIMEOUT) as gw:
         ctl = sim.control
         port = gw.serial
         assert gw.request("V") == "V1.1"
         port.baudrate = 9600
-        port.write(b"V\r")
-        got = line_after(sim, port, REPLY_CYCLES)
-        assert b"V1.1" not in got
+        t0 = ctl.time()
+        sim.pc_write(port, b"V\r")
+        ctl.wait(REPLY_CYCLES)
+        assert b"V1.1" not in board_sent(sim, t0)
         assert ctl.line()["pc"] == 9600
         port.baudrate = 115200
         # end the garbage line (whatever it answers), then talk again
-        port.write(b"\r")
-        line_after(sim, port, REPLY_CYCLES)
+        sim.pc_write(port, b"\r")
+        ctl.wait(REPLY_CYCLES)
         assert ctl.line()["pc"] == 115200
         resync(gw)
         assert gw.request("S AA 00 00 S AB 01 P") == "SWAASR07P"
@@ -150,11 +167,28 @@ def test_pc_changing_its_rate_mid_session_is_followed():
 def test_a_pc_that_moves_to_the_board_rate_is_heard():
     elf = build_gateway("m128s", 19200)
     with sim_for("m128s", elf) as sim, Gateway(sim.port, timeout=REPLY_TIMEOUT) as gw:
+        ctl = sim.control
         port = gw.serial
-        port.write(b"V\r")
-        assert b"V1.1" not in line_after(sim, port, REPLY_CYCLES)
+        t0 = ctl.time()
+        sim.pc_write(port, b"V\r")
+        ctl.wait(REPLY_CYCLES)
+        assert b"V1.1" not in board_sent(sim, t0)
         port.baudrate = 19200
-        port.write(b"\r")
-        line_after(sim, port, REPLY_CYCLES)
+        sim.pc_write(port, b"\r")
+        ctl.wait(REPLY_CYCLES)
         resync(gw)
         assert gw.request("V") == "V1.1"
+
+
+def test_line_counts_the_bytes_taken_from_the_port():
+    """`line`'s pty: every byte the simulator took from the PC's port, so a
+    test waits for its write in simulated time; a byte never written is
+    never counted (SimControlError after the timeout, one line)."""
+    with sim_for("m32d") as sim, serial.Serial(sim.port, 115200, timeout=REPLY_TIMEOUT) as port:
+        ctl = sim.control
+        before = ctl.line()["pty"]
+        sim.pc_write(port, b"V\r")
+        assert ctl.line()["pty"] == before + 2
+        assert port.readline() == b"V1.1\r\n"
+        with pytest.raises(SimControlError, match="took %d of %d bytes" % (before + 2, before + 3)):
+            ctl.wait_taken(before + 3, timeout=0.3)

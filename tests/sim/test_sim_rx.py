@@ -6,6 +6,7 @@ the board's state at a given cycle after power-up, which only a fresh board has.
 """
 
 import re
+import threading
 import time
 
 import pytest
@@ -22,7 +23,7 @@ AT = 1 << 24
 FAR = 1 << 32
 BYTE = 640                                 # cycles per byte at 115200 baud, 8N1
 REQUEST = b"S AA 00 00 S AB 01 P\r"        # the driver count, through introspection
-USAGE = "ERR rx CYCLE HEX...: CYCLE decimal, then the bytes in hex"
+USAGE = "ERR rx CYCLE HEX...: CYCLE decimal (or +N: N cycles from now), then the bytes in hex"
 
 
 def fresh(board):
@@ -100,12 +101,19 @@ def test_pty_bytes_queue_behind_scheduled_bytes():
     filler = b" " * 20000                  # 12.8 M cycles on the wire
     with fresh("m32d") as sim, serial.Serial(sim.port, 115200, timeout=REPLY_TIMEOUT) as port:
         ctl = sim.control
-        # 1 s simulated ahead (some 100 ms of wall time): the PC's bytes,
-        # sent right after, are on the line by then and still are after
-        at = ctl.time() + 7372800
-        assert ctl.rx(at, b"V\r") == at + 2 * BYTE
-        port.write(filler)
-        port.flush()
+        # the PC's bytes first, waited for in simulated time until the
+        # simulator has taken some (they stream for 12.8 M cycles); then V CR
+        # 1 s simulated ahead (`rx +N`), in the middle of them whatever the load
+        before = ctl.line()["pty"]
+        # the pty holds a few kB: the write returns once most is taken
+        writer = threading.Thread(target=port.write, args=(filler,))
+        writer.start()
+        try:
+            ctl.wait_taken(before + 1, step=100)
+            end = ctl.rx_after(7372800, b"V\r")
+        finally:
+            writer.join()
+        at = end - 2 * BYTE
         rx = wait_events(sim, "uart rx", len(filler) + 2, timeout=30)
         # the line overflowed the firmware's buffer long before the CR
         assert port.readline() == b"ERROR 04\r\n"
@@ -157,6 +165,25 @@ def test_bad_rx_requests_are_refused_and_schedule_nothing():
             "ERR rx: too many bytes: 1, room for 0 (at most 32768 scheduled)"
         with pytest.raises(ValueError):
             ctl.rx(at + room * BYTE, b"")
+        for line in ("rx + 56", "rx ++5 56", "rx +-5 56", "rx +x 56"):
+            assert error(ctl, line) == USAGE, line
+        assert error(ctl, "rx +%d 56" % (1 << 42)) == \
+            "ERR rx: +%d is more than %d cycles ahead" % (1 << 42, 1 << 40)
         assert "rx CYCLE HEX..." in ctl.request("help")
         assert sim.running
         assert sim.stop() == 0
+
+
+def test_rx_after_counts_from_the_cycle_it_is_answered_at():
+    """`rx +N`: the first start bit N cycles after the cycle the request is
+    answered at, here the end of the `wait` before it in the same batch."""
+    with fresh("m32d") as sim:
+        ctl = sim.control
+        woke, end, now = ctl.requests(["wait 1000", "rx +5000 56 0D", "time"])
+        assert int(end) == int(woke) + 5000 + 2 * BYTE == int(now) + 5000 + 2 * BYTE
+        ctl.wait(5000 + 2 * BYTE + 100)           # from a cycle >= now: past end
+        rx = sim.trace_events(kinds=["uart rx"])
+        assert [(e.cycle, e.fields[0]) for e in rx] == \
+            [(int(end) - BYTE, "56"), (int(end), "0D")]
+        later = ctl.rx_after(10, b"\r")
+        assert later >= int(end) + 100 + 10 + BYTE
