@@ -3,10 +3,11 @@
 # Idempotent and quiet when everything is there already.
 set -eu
 
+# make and gcc build the simulator, the unit tests and the board maps.
 # clang and its runtime (-fsanitize=fuzzer) for tests/fuzz: Debian's clang
 # is 14 on bookworm, whose libFuzzer comes in libclang-rt-14-dev. avrdude for
 # `make flash`, `make fuses` and `orfa flash` (the tests use a stand-in).
-APT_PACKAGES="gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-14-dev avrdude"
+APT_PACKAGES="make gcc gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-14-dev avrdude"
 # python module:pip package
 PY_PACKAGES="serial:pyserial pytest:pytest"
 
@@ -42,6 +43,13 @@ PYTHON=${PYTHON:-python3}
 if ! command -v "$PYTHON" >/dev/null 2>&1; then
 	echo "setup: installing python3"
 	apt_install python3 python3-pip
+fi
+
+# tests/host/test_install.py makes a venv with pip: Debian's python3 needs
+# python3-venv for that (ensurepip).
+if ! "$PYTHON" -c "import ensurepip" >/dev/null 2>&1; then
+	echo "setup: installing python3-venv"
+	apt_install python3-venv
 fi
 
 pip_missing=""

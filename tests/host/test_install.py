@@ -27,8 +27,9 @@ from orfa.boardmap import BOARDS
 
 ROOT = Path(__file__).resolve().parents[2]
 WHEELHOUSE = ROOT / "build" / "pip" / "wheelhouse"
-#: wheel: setuptools older than 70.1 (the venv's) builds wheels with it
-DEPS = ["pyserial", "pytest", "wheel"]
+#: setuptools: a venv of Python 3.12 and later has none to build with;
+#: wheel: setuptools older than 70.1 builds wheels with it
+DEPS = ["pyserial", "pytest", "setuptools", "wheel"]
 SAMPLE = ROOT / "tests" / "sim" / "plugin_sample.py"
 
 
@@ -47,7 +48,8 @@ def run(cmd, cwd, env=None, timeout=120):
 
 
 def fill_wheelhouse():
-    if (WHEELHOUSE / "complete").is_file():
+    marker = WHEELHOUSE / "complete"
+    if marker.is_file() and marker.read_text().split() == DEPS:
         return
     r = run([sys.executable, "-m", "pip", "download", "-q", "--only-binary", ":all:",
              "-d", WHEELHOUSE] + DEPS, cwd=ROOT)
