@@ -87,7 +87,7 @@ DRV_HW_motor := drivers/motor_hw.c
 DRV_HW_servo := $(foreach f,$(BOARD_SERVO_HW),drivers/$(f).c)
 
 FW_SRC := firmware/main.c firmware/regmap.c firmware/xact.c firmware/intro.c firmware/sys.c \
-	firmware/mcu.c firmware/clock.c firmware/pins.c firmware/board_pins.c firmware/port_io_avr.c \
+	firmware/mcu.c firmware/clock.c firmware/clock_now.c firmware/pins.c firmware/board_pins.c firmware/port_io_avr.c \
 	$(foreach d,$(DRIVERS),drivers/drv_$(d).c $(DRV_HW_$(d)))
 ifeq ($(MODE),gate)
 FW_SRC += firmware/uart.c $(if $(filter auto,$(BAUD)),firmware/autobaud.c,firmware/uart_rate.c) \

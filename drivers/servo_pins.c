@@ -55,6 +55,9 @@ static const __flash uint8_t line_mask[8] = { 1, 2, 4, 8, 16, 32, 64, 128 };
  * cleared. (Counting it only while TCNT2 < 128 lost it once the compare
  * interrupt ran 1024 cycles past it; then every wait in the interrupt saw
  * its edge recede by 256 ticks a wrap and never ended.) */
+/* Timer2 is the time base's and this driver's (its compare unit, OCR2). */
+_Static_assert(BOARD_CLOCK_TIMER == 2, "servo_pins.c plans edges on the time base's Timer2");
+
 static uint16_t servo_ticks(void)
 {
 	uint8_t t = TCNT2;

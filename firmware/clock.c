@@ -1,7 +1,6 @@
 #include "firmware/clock.h"
 
 #include <avr/interrupt.h>
-#include <util/atomic.h>
 
 #include "firmware/mcu.h"
 
@@ -18,13 +17,4 @@ void clock_init(void)
 ISR(MCU_CLOCK_OVF_vect)
 {
 	clock_wraps++;
-}
-
-uint16_t clock_now(void)
-{
-	uint16_t w;
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		w = clock_wraps;
-	}
-	return w;
 }

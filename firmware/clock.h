@@ -23,7 +23,14 @@ extern volatile uint16_t clock_wraps;
 void clock_init(void);
 
 /* Ticks since clock_init, wrapping every 65536 (18.2 s): differences of
- * two readings are exact up to that. */
+ * two readings are exact up to that. Interrupts stay on. */
 uint16_t clock_now(void);
+
+/* The low byte of clock_now(), one load (AVR: little-endian): enough for a
+ * bound below 256 ticks, and cheap in an interrupt. */
+static inline uint8_t clock_now8(void)
+{
+	return *(volatile const uint8_t *)&clock_wraps;
+}
 
 #endif

@@ -16,10 +16,8 @@
 /* The time base's 8-bit timer (the board file's BOARD_CLOCK_TIMER): the
  * same register and bit names on both MCUs, clk/8 = CSn1 on both. */
 #define MCU_CLOCK_TCCR     MCU_CAT3(TCCR, BOARD_CLOCK_TIMER, )
-#define MCU_CLOCK_TCNT     MCU_CAT3(TCNT, BOARD_CLOCK_TIMER, )
 #define MCU_CLOCK_CLK8     _BV(MCU_CAT3(CS, BOARD_CLOCK_TIMER, 1))
 #define MCU_CLOCK_TOIE     _BV(MCU_CAT3(TOIE, BOARD_CLOCK_TIMER, ))
-#define MCU_CLOCK_TOV      _BV(MCU_CAT3(TOV, BOARD_CLOCK_TIMER, ))
 #define MCU_CLOCK_OVF_vect MCU_CAT3(TIMER, BOARD_CLOCK_TIMER, _OVF_vect)
 
 #if defined(__AVR_ATmega32__)

@@ -32,19 +32,6 @@ static void sys_keep(uint8_t causes)
 	sys_kept.check = (uint8_t)~causes;
 }
 
-/* clock_now() without turning interrupts off: on the M32-D a main loop
- * that does so now and then delays the servo edge interrupt past its exact
- * cycle (measured: 200 streamed servo writes fell behind the wire). Two
- * equal readings in a row are not torn: the wraps are 2048 cycles apart. */
-__attribute__((noinline)) static uint16_t sys_clock(void)
-{
-	uint16_t t;
-	do {
-		t = clock_wraps;
-	} while (t != clock_wraps);
-	return t;
-}
-
 void sys_boot(uint8_t reset_flags)
 {
 	uint8_t causes = 0;
@@ -90,7 +77,7 @@ reg_status_t drv_sys_write(uint8_t reg, const uint8_t *data, uint8_t len)
 	 * the request may have come up to a tick after the one counted from.
 	 * Never early, at most two ticks (0.56 ms) late. */
 	sys.ticks = ms ? (uint16_t)(((uint32_t)ms * CLOCK_HZ + 999u) / 1000u + 1u) : 0;
-	sys.last = sys_clock();
+	sys.last = clock_now();
 	sys.tripped = 0;
 	sys_heard = 0;
 	return REG_OK;
@@ -117,11 +104,11 @@ void sys_poll(void)
 	}
 	if (sys_heard) {
 		sys_heard = 0;
-		sys.last = sys_clock();
+		sys.last = clock_now();
 		sys.tripped = 0;
 		return;
 	}
-	if (!sys.tripped && (uint16_t)(sys_clock() - sys.last) >= sys.ticks) {
+	if (!sys.tripped && (uint16_t)(clock_now() - sys.last) >= sys.ticks) {
 		sys.tripped = 1;
 		regmap_safe();
 	}

@@ -51,18 +51,11 @@ uint16_t twi_set_khz(uint16_t khz)
  * that gets nowhere resets the TWI (off and on again; TWBR/TWPS stay), so
  * the next request starts clean. The watchdog is fed only when the bus
  * made progress: a wait that never ends cannot keep a hung board alive. */
-/* The clock's low byte (AVR: little-endian): a bound is below 256 ticks,
- * so it suffices, and one load of it needs no interrupts held off. */
-static uint8_t twi_ticks_now(void)
-{
-	return *(volatile const uint8_t *)&clock_wraps;
-}
-
 static bool twi_wait_for(uint8_t mask, uint8_t want)
 {
-	uint8_t t0 = twi_ticks_now();
+	uint8_t t0 = clock_now8();
 	while ((TWCR & mask) != want) {
-		if ((uint8_t)(twi_ticks_now() - t0) > twi.ticks) {
+		if ((uint8_t)(clock_now8() - t0) > twi.ticks) {
 			TWCR = 0;
 			TWCR = _BV(TWEN);
 			return false;

@@ -67,7 +67,7 @@ ISR(TWI_vect)
 	/* TWIE off before interrupts are on again, or this one would come
 	 * back at once: TWINT is a level. Writing TWINT 0 leaves it set. */
 	TWCR = (uint8_t)(TWCR & ~(_BV(TWINT) | _BV(TWIE)));
-	slave_seen = (uint8_t)clock_now();
+	slave_seen = clock_now8();
 	sei();
 	uint8_t byte = TWDR;
 	uint8_t status = TW_STATUS;
@@ -92,7 +92,7 @@ void front_init(void)
 static bool slave_stalled(void)
 {
 	return slave_fsm_in_frame() &&
-	       (uint8_t)((uint8_t)clock_now() - slave_seen) > SLAVE_STALL_TICKS;
+	       (uint8_t)(clock_now8() - slave_seen) > SLAVE_STALL_TICKS;
 }
 
 void front_poll(void)
