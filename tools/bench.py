@@ -34,7 +34,7 @@ sys.path.insert(0, str(ROOT / "host"))
 import serial  # noqa: E402
 
 from orfa import boardmap  # noqa: E402
-from orfa.sim import SimBoard, firmware_path, parse_trace  # noqa: E402
+from orfa.sim import SimBoard, firmware_path, parse_trace, slave_firmware_path  # noqa: E402
 from orfa.simctl import RX_MAX, SimControlError  # noqa: E402
 
 F_CPU = 7372800
@@ -345,14 +345,10 @@ ROBOT = [("m128s", 0x10), ("m32d", 0x12), ("m128s", 0x14), ("m32d", 0x16),
          ("m128s", 0x18), ("m32d", 0x1A), ("m128s", 0x1C), ("m32d", 0x1E)]
 SLAVE_OF = {"m128s": 0x10, "m32d": 0x12}
 #: Drivers each board lists (introspection and sys included).
-DRIVER_COUNT = {"m128s": 6, "m32d": 7}
+DRIVER_COUNT = {b: len(boardmap.load(b).drivers) for b in boardmap.BOARDS}
 SLAVE_PIPELINE = 200
 #: Simulated cycles each speed row runs for.
 SPEED_CYCLES = 2 * F_CPU
-
-
-def robot_elf(board, addr):
-    return ROOT / "build" / "robot" / ("%s-0x%02X" % (board, addr)) / "orfa.elf"
 
 
 def scl_period(khz):
@@ -394,7 +390,7 @@ def bench_slave(board, count):
     """The slave figures of `board` as the test robot's slave behind an M32-D
     gateway, all requests scheduled at fixed cycles as bench_board's."""
     addr = SLAVE_OF[board]
-    elf = robot_elf(board, addr)
+    elf = slave_firmware_path(board, addr)
     rows = {}
     with SimBoard("m32d", control=True, slaves=[(board, addr, elf)]) as sim:
         ctl = sim.control
@@ -453,7 +449,7 @@ def bench_slave(board, count):
 def bench_speed(nboards):
     """World MHz per wall second running free with the gateway and the
     first nboards - 1 robot slaves."""
-    slaves = [(b, a, robot_elf(b, a)) for b, a in ROBOT[:nboards - 1]]
+    slaves = [(b, a, slave_firmware_path(b, a)) for b, a in ROBOT[:nboards - 1]]
     with SimBoard("m32d", control=True, slaves=slaves) as sim:
         ctl = sim.control
         ctl.wait(F_CPU // 10)                      # every board booted
@@ -506,7 +502,7 @@ def bench_watchdog(board, slave):
     the last request the board heard to the last edge of the pin}."""
     addr = SLAVE_OF[board] if slave else 0xAA
     gw_board = "m32d" if slave else board
-    slaves = [(board, addr, robot_elf(board, addr))] if slave else []
+    slaves = [(board, addr, slave_firmware_path(board, addr))] if slave else []
     w, r = "%02X" % addr, "%02X" % (addr | 1)
     rows = {}
     with SimBoard(gw_board, control=True, slaves=slaves) as sim, \
@@ -814,7 +810,7 @@ def main():
     row("static RAM (B)", "%14d", lambda r: r["footprint"][1])
     row("peak stack (B)", "%14d", lambda r: r["stack"]["peak"])
     print("%-*s" % (width, "SRAM never touched (%)") + "".join(
-        "%14.1f" % (100.0 * (slaves[b]["stack"]["deepest"] - heap_start_of(robot_elf(b, SLAVE_OF[b])))
+        "%14.1f" % (100.0 * (slaves[b]["stack"]["deepest"] - heap_start_of(slave_firmware_path(b, SLAVE_OF[b])))
                     / (slaves[b]["stack"]["ramend"] + 1 - SRAM_START[b])) for b in args.boards)
         + "%10s" % ">= 25")
     print()

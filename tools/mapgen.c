@@ -150,24 +150,19 @@ int main(void)
 	       SYS_RESET_POWER, SYS_RESET_EXTERNAL, SYS_RESET_BROWNOUT, SYS_RESET_WATCHDOG,
 	       SYS_RESET_JTAG);
 
+	/* The status values, then the protocol's errors: the same shape. */
+#define MAP_CODE(name, code, text) \
+	printf("%s\n    {\"code\": %d, \"name\": \"%s\", \"text\": \"%s\"}", \
+	       first ? "" : ",", code, #name, text); \
+	first = 0;
 	first = 1;
 	printf("  \"status\": [");
-#define MAP_STATUS(name, code, text) \
-	printf("%s\n    {\"code\": %d, \"name\": \"%s\", \"text\": \"%s\"}", \
-	       first ? "" : ",", code, #name, text); \
-	first = 0;
-	REG_STATUS_LIST(MAP_STATUS)
-#undef MAP_STATUS
+	REG_STATUS_LIST(MAP_CODE)
 	printf("\n  ],\n");
-
 	first = 1;
 	printf("  \"errors\": [");
-#define MAP_ERROR(name, code, text) \
-	printf("%s\n    {\"code\": %d, \"name\": \"%s\", \"text\": \"%s\"}", \
-	       first ? "" : ",", code, #name, text); \
-	first = 0;
-	SG_ERR_LIST(MAP_ERROR)
-#undef MAP_ERROR
+	SG_ERR_LIST(MAP_CODE)
 	printf("\n  ]\n}\n");
+#undef MAP_CODE
 	return 0;
 }

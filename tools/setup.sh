@@ -5,9 +5,10 @@ set -eu
 
 # make and gcc build the simulator, the unit tests and the board maps.
 # clang and its runtime (-fsanitize=fuzzer) for tests/fuzz: Debian's clang
-# is 14 on bookworm, whose libFuzzer comes in libclang-rt-14-dev. avrdude for
+# is 14 on bookworm, whose libFuzzer comes in libclang-rt-14-dev; the
+# libclang-rt-dev package follows the default clang of each release. avrdude for
 # `make flash`, `make fuses` and `orfa flash` (the tests use a stand-in).
-APT_PACKAGES="make gcc gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-14-dev avrdude"
+APT_PACKAGES="make gcc gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-dev avrdude"
 # python module:pip package
 PY_PACKAGES="serial:pyserial pytest:pytest"
 
@@ -60,11 +61,14 @@ for entry in $PY_PACKAGES; do
 		pip_missing="$pip_missing $package"
 	fi
 done
+# pip itself: the install test fetches its wheels with it, even where
+# pyserial and pytest came from Debian's packages.
+if ! "$PYTHON" -m pip --version >/dev/null 2>&1; then
+	echo "setup: installing python3-pip"
+	apt_install python3-pip
+fi
 if [ -n "$pip_missing" ]; then
 	echo "setup: pip installing$pip_missing"
-	if ! "$PYTHON" -m pip --version >/dev/null 2>&1; then
-		apt_install python3-pip
-	fi
 	# Debian's python marks itself externally managed (PEP 668).
 	"$PYTHON" -m pip install -q $pip_missing 2>/dev/null ||
 		"$PYTHON" -m pip install -q --break-system-packages $pip_missing

@@ -15,13 +15,12 @@ and reads raise the RegisterError of the status register's reason
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Dict, FrozenSet, Iterable, List, Optional, Sequence, Tuple
 
 from . import boardmap
 from . import boards
 from . import protocol as p
-from .errors import NoDriverError, Status, register_error
+from .errors import NOT_ERRORS, NoDriverError, Status, register_error
 from .gateway import Gateway
 
 
@@ -39,20 +38,6 @@ class Op:
     @property
     def action(self) -> str:
         return "write" if self.kind == "w" else "read"
-
-
-@lru_cache(maxsize=None)
-def _uid_index() -> Dict[int, Tuple[boardmap.BoardMap, boardmap.DriverMap]]:
-    """Every driver UID of every board map: (BoardMap, DriverMap). A UID
-    names one driver on every board that has it (GPIO of 4 ports is 0x0020,
-    of 2 ports 0x0021), so a driver's facts follow from its UID even on a
-    build that left drivers out."""
-    index: Dict[int, Tuple[boardmap.BoardMap, boardmap.DriverMap]] = {}
-    for name in boardmap.BOARDS:
-        m = boardmap.load(name)
-        for d in m.drivers:
-            index.setdefault(d.uid, (m, d))
-    return index
 
 
 class Board:
@@ -121,14 +106,13 @@ class Board:
 
     def driver_name(self, uid: int) -> Optional[str]:
         """A UID's driver name ("servo"), None if no board map knows it."""
-        hit = _uid_index().get(uid)
+        hit = boardmap.by_uid(uid)
         return hit[1].name if hit else None
 
     def _record(self, name: str):
         """(record, BoardMap, DriverMap) of driver `name`; NoDriverError if absent."""
-        index = _uid_index()
         for rec in self.drivers:
-            hit = index.get(rec.uid)
+            hit = boardmap.by_uid(rec.uid)
             if hit is not None and hit[1].name == name:
                 return rec, hit[0], hit[1]
         raise NoDriverError("0x%02X has no %s driver (its drivers: %s)"
@@ -225,7 +209,7 @@ class Board:
             if not self.is_local:
                 status = res[pos + 1].data[0]
                 pos += 2
-                if status not in (Status.OK, Status.READ_WRAPPED):
+                if status not in NOT_ERRORS:
                     return reads, register_error(status, self.addr, op.label, op.action)
         return reads, None
 
@@ -243,7 +227,7 @@ class Board:
             return err
         else:
             status = after[-1].data[0]
-        if status in (Status.OK, Status.READ_WRAPPED):
+        if status in NOT_ERRORS:
             return err
         kind = "w" if isinstance(err, p.DataNackError) else "r"
         op = next((o for o in item if o.kind == kind), item[0])

@@ -118,6 +118,7 @@ class BoardMap:
         return tuple(p for p in self.pins if p.function == function)
 
 
+@lru_cache(maxsize=None)
 def _read(board: str) -> dict:
     if board not in BOARDS:
         raise ValueError("no board %r (%s)" % (board, ", ".join(BOARDS)))
@@ -168,5 +169,22 @@ def by_uids(uids: Iterable[int]) -> Optional[BoardMap]:
     return None
 
 
+@lru_cache(maxsize=None)
+def _uid_index() -> Dict[int, Tuple[BoardMap, DriverMap]]:
+    index: Dict[int, Tuple[BoardMap, DriverMap]] = {}
+    for board in BOARDS:
+        for drv in load(board).drivers:
+            index.setdefault(drv.uid, (load(board), drv))
+    return index
+
+
+def by_uid(uid: int) -> Optional[Tuple[BoardMap, DriverMap]]:
+    """The driver a UID names, with the first board that has it, or None.
+    A UID names one driver on every board that has it (GPIO of 4 ports is
+    0x0020, of 2 ports 0x0021), so its facts follow from the UID even on a
+    build that left drivers out."""
+    return _uid_index().get(uid)
+
+
 #: Every UID a board can have -> the driver's name ("servo", "gpio", ...).
-DRIVER_NAMES: Dict[int, str] = {d.uid: d.name for b in BOARDS for d in load(b).drivers}
+DRIVER_NAMES: Dict[int, str] = {uid: drv.name for uid, (_, drv) in _uid_index().items()}

@@ -13,7 +13,7 @@ SYS_UID = boardmap.load("m32d").driver("sys").uid
 #: The sys driver's RESET register (FAILSAFE follows it) of each board with
 #: all its drivers (UID 0x0002, always built in and last; docs/registers.md
 #: "sys"). A build that leaves drivers out moves it down: ask introspection
-#: then (Gateway.sys_register).
+#: then (Board.register("sys", "RESET")).
 SYS_REGISTER = {board: boardmap.load(board).reg("sys", "RESET") for board in boardmap.BOARDS}
 
 #: RESET's bits (the MCU's MCUCSR layout), by cause name.
@@ -39,7 +39,7 @@ def reset_cause_bits(causes) -> int:
     return bits
 
 
-#: What each driver is, for people (tables of `orfa drivers`, docs).
+#: What each driver is, for people (the generated docs' driver tables).
 DRIVER_TITLES = {
     "intro": "introspection",
     "spi": "SPI",
@@ -53,17 +53,15 @@ DRIVER_TITLES = {
 
 def driver_title(uid: int) -> str:
     """A driver's title by UID: "servos (16)", "GPIO (4 ports)", ..."""
-    for board in boardmap.BOARDS:
-        m = boardmap.load(board)
-        drv = m.driver_by_uid(uid)
-        if drv is None:
-            continue
-        if drv.name == "servo":
-            return "servos (%d)" % m.servo_channels
-        if drv.name == "gpio":
-            return "GPIO (%d ports)" % len(m.gpio_ports)
-        return DRIVER_TITLES.get(drv.name, drv.name)
-    return "unknown"
+    hit = boardmap.by_uid(uid)
+    if hit is None:
+        return "unknown"
+    m, drv = hit
+    if drv.name == "servo":
+        return "servos (%d)" % m.servo_channels
+    if drv.name == "gpio":
+        return "GPIO (%d ports)" % len(m.gpio_ports)
+    return DRIVER_TITLES.get(drv.name, drv.name)
 
 
 DRIVER_NAMES = {uid: driver_title(uid) for uid in boardmap.DRIVER_NAMES}

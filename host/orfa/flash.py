@@ -22,7 +22,7 @@ from typing import List, Optional, Sequence
 
 from . import boardmap, ihex
 from .protocol import OrfaError
-from .sim import firmware_path
+from .locate import firmware_path
 
 PROGRAMMER = "usbasp"
 MODES = ("gate", "slave")
@@ -74,8 +74,8 @@ def build_hex(board: str, mode: str) -> Path:
 
 def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str) -> Path:
     """The Intel HEX to write: `given` (an ELF is converted), else the build's
-    .hex if it is as new as its ELF, else that ELF converted (an installed
-    package ships ELFs only). Conversions go to `tmpdir`."""
+    .hex if it is as new as its ELF, else that ELF converted (a .hex older
+    than its ELF, or none: an ELF given by ORFA_FIRMWARE alone). Conversions go to `tmpdir`."""
     if given:
         path = Path(given)
         try:

@@ -12,7 +12,7 @@ from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Sequence
 
 import serial
 
-from . import boards
+from . import boardmap
 from . import flow
 from . import protocol as p
 from .errors import SerialError
@@ -23,19 +23,32 @@ def open_port(url: str, baudrate: int, timeout: float) -> serial.SerialBase:
     try:
         return serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
     except (serial.SerialException, OSError, ValueError) as e:
-        raise SerialError("cannot open %s: %s" % (url, _os_reason(e))) from e
+        raise SerialError("cannot open %s: %s" % (url, os_reason(e))) from e
 
 
-def _os_reason(e: BaseException) -> str:
-    """The OS's reason behind a pyserial error: "[Errno 2] No such file or
-    directory" rather than pyserial's message that repeats the path."""
-    for err in (e.__cause__, e.__context__, e):
-        if isinstance(err, OSError) and err.errno is not None and err.strerror:
-            return "[Errno %d] %s" % (err.errno, err.strerror)
-    return str(e)
+def os_reason(e: BaseException, errno: bool = True) -> str:
+    """Why a port did not open, from the innermost OS error of the chain:
+    "[Errno 2] No such file or directory" (errno=False: without the
+    number) rather than pyserial's message that repeats the path; else the
+    innermost error's own text ("invalid URL")."""
+    seen = e
+    while True:
+        if isinstance(seen, OSError) and not isinstance(seen, serial.SerialException) \
+                and seen.strerror:
+            if errno and seen.errno is not None:
+                return "[Errno %d] %s" % (seen.errno, seen.strerror)
+            return seen.strerror
+        inner = seen.__cause__ or seen.__context__
+        if inner is None:
+            return str(seen)
+        seen = inner
 
 
 Reply = Union[str, p.OrfaError]
+
+
+#: The status register: introspection's second, on every board (SPEC 3).
+_STATUS_REGISTER = boardmap.load(boardmap.BOARDS[0]).reg("intro", "STATUS")
 
 
 class Gateway:
@@ -52,7 +65,7 @@ class Gateway:
         self.local = local_address
         self.url = url
         self.serial = open_port(url, baudrate, timeout)
-        self._sys_reg: Dict[int, int] = {}
+        self._boards: Dict[int, object] = {}
         #: set when the line may hold replies nobody waits for (a timeout,
         #: noise): the next run resynchronises first
         self._dirty = False
@@ -87,13 +100,13 @@ class Gateway:
             self.serial.write(data)
             self.serial.flush()
         except (serial.SerialException, OSError) as e:
-            raise SerialError("%s: %s" % (self.url, _os_reason(e))) from e
+            raise SerialError("%s: %s" % (self.url, os_reason(e))) from e
 
     def _read_until(self) -> bytes:
         try:
             return self.serial.read_until(b"\n")
         except (serial.SerialException, OSError) as e:
-            raise SerialError("%s: %s" % (self.url, _os_reason(e))) from e
+            raise SerialError("%s: %s" % (self.url, os_reason(e))) from e
 
     def read_reply(self, timeout: Optional[float] = None) -> str:
         """The next reply line without its CR LF; ReplyTimeout if none comes."""
@@ -108,19 +121,6 @@ class Gateway:
             if buf.endswith(b"\n") and not buf.endswith(b"\r\n"):
                 raise p.ProtocolError("reply line not ended by CR LF: %r" % bytes(buf))
         return p.strip_reply(bytes(buf))
-
-    def read_available(self, quiet: float = 0.3) -> bytes:
-        """Whatever arrives until the line has been quiet for `quiet` seconds."""
-        out = bytearray()
-        self.serial.timeout = quiet
-        try:
-            while True:
-                chunk = self.serial.read(4096)
-                if not chunk:
-                    return bytes(out)
-                out += chunk
-        finally:
-            self.serial.timeout = self.timeout
 
     def request(self, line: str) -> str:
         """Send one request, return its reply text (ERROR replies included)."""
@@ -365,51 +365,37 @@ class Gateway:
             records += p.DriverRecord.parse_many(data)
         return records
 
-    # --- the sys driver (docs/registers.md "sys") ---------------------------------
-    def sys_register(self, addr: Optional[int] = None) -> int:
-        """The RESET register of addr's sys driver (FAILSAFE follows it), from
-        its introspection record (asked once per address)."""
-        addr = self.local if addr is None else addr
-        if addr not in self._sys_reg:
-            recs = [r for r in self.drivers(addr) if r.uid == boards.SYS_UID]
-            if not recs:
-                raise p.OrfaError("0x%02X has no sys driver (UID %04X)" % (addr, boards.SYS_UID))
-            self._sys_reg[addr] = recs[0].start
-        return self._sys_reg[addr]
+    # --- the sys driver and the status register, by address ----------------------
+    # Shorthands for scripts that hold a Gateway: each is the Board's call
+    # (orfa.board) for that address (None: the gateway itself).
+    def board(self, addr: Optional[int] = None):
+        """The Board at addr (None: the gateway's own drivers), kept per address."""
+        from .board import Board                 # board.py imports this module
+        key = self.local if addr is None else addr & 0xFE
+        if key not in self._boards:
+            self._boards[key] = Board(self, None if key == self.local else key)
+        return self._boards[key]
 
     def reset_cause(self, addr: Optional[int] = None) -> FrozenSet[str]:
-        """Why addr (None: the gateway) reset since the causes were last
-        cleared: a set of "power", "external", "brownout", "watchdog", "jtag"."""
-        byte = self.read_register(addr, self.sys_register(addr), 1)[0]
-        return boards.reset_causes(byte)
+        """Why addr reset since the causes were last cleared: a set of
+        "power", "external", "brownout", "watchdog", "jtag"."""
+        return self.board(addr).reset_cause()
 
     def clear_reset_cause(self, addr: Optional[int] = None,
                           causes: Optional[Iterable[str]] = None) -> None:
         """Forget the reset causes (all, or the names given)."""
-        bits = boards.RESET_CAUSES_ALL if causes is None else boards.reset_cause_bits(causes)
-        self._sys_write(addr, 0, bytes([bits]))
+        self.board(addr).clear_reset_cause(causes)
 
     def failsafe(self, addr: Optional[int] = None) -> int:
         """The link-loss failsafe's timeout in milliseconds (0: off)."""
-        data = self.read_register(addr, self.sys_register(addr) + 1, 2)
-        return data[0] << 8 | data[1]
+        return self.board(addr).failsafe()
 
     def set_failsafe(self, addr: Optional[int], ms: int) -> None:
         """Motors stop and servos go limp when no request has reached addr
-        (None: the gateway) for `ms` milliseconds; 0 turns it off."""
-        if not 0 <= ms <= boards.FAILSAFE_MAX_MS:
-            raise ValueError("failsafe: 0..%d ms, not %r" % (boards.FAILSAFE_MAX_MS, ms))
-        self._sys_write(addr, 1, bytes([ms >> 8, ms & 0xFF]))
-
-    def _sys_write(self, addr: Optional[int], offset: int, data: bytes) -> None:
-        addr = self.local if addr is None else addr
-        self.write_register(addr, self.sys_register(addr) + offset, data)
-        if addr != self.local:
-            # a slave acknowledges before its driver decides: ask it
-            status = self.read_register(addr, 0x01, 1)[0]
-            if status:
-                raise p.OrfaError("0x%02X refused the sys write: status %02X" % (addr, status))
+        for `ms` milliseconds; 0 turns it off."""
+        self.board(addr).set_failsafe(ms)
 
     def status(self) -> int:
-        """The gateway's status register (result of the last register access)."""
-        return self.read_register(None, 0x01, 1)[0]
+        """The gateway's status register (result of the last register access);
+        one request, no introspection (Board.status() names the value)."""
+        return self.read_register(None, _STATUS_REGISTER, 1)[0]

@@ -56,17 +56,7 @@ class SimControl:
 
     def request(self, line: str) -> str:
         """Send one request, return its reply line (without newline)."""
-        self.sock.sendall(line.encode() + b"\n")
-        while b"\n" not in self._buf:
-            chunk = self.sock.recv(65536)
-            if not chunk:
-                raise SimControlError("orfa-sim closed the control socket")
-            self._buf += chunk
-        reply, self._buf = self._buf.split(b"\n", 1)
-        text = reply.decode()
-        if text.startswith("ERR"):
-            raise SimControlError(text)
-        return text
+        return self.requests([line])[0]
 
     def requests(self, lines: List[str]) -> List[str]:
         """Send several requests at once and return their replies. The
@@ -331,9 +321,6 @@ class _SlaveView(SimControl):
         self.addr = addr
         self._prefix = "%02X/" % addr
         self._at = "@%02X" % addr
-
-    def request(self, line: str) -> str:
-        return self._parent.request(line)
 
     def requests(self, lines: List[str]) -> List[str]:
         return self._parent.requests(lines)

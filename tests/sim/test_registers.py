@@ -1,8 +1,6 @@
 """The gateway's own register map at the local address (SPEC section 3,
 docs/registers.md): introspection and the status register."""
 
-import pytest
-
 from orfa import protocol as p
 
 from orfa.boards import BOARD_UIDS

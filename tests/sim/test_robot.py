@@ -158,8 +158,7 @@ def test_write_rejected_at_frame_end(rb, addr):
 def test_read_after_an_unmapped_register_gives_ff(rb, addr):
     """No register is selected after an unmapped one: a read in the same
     request gives FF (the read address is acknowledged), the status keeps 08."""
-    gw, boards = rb
-    b = boards[addr]
+    gw, _ = rb
     assert ask(gw, "S %02X 03 S %02X 01 P" % (addr, addr | 1))[:5] == b"SWASR"
     assert ask(gw, "S %02X FE S %02X 02 P" % (addr, addr | 1)) == b"SWASRFFFFP\r\n"
     assert ask(gw, "S %02X 01 S %02X 01 P" % (addr, addr | 1)) == b"SWASR08P\r\n"

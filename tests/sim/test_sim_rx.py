@@ -12,7 +12,7 @@ import time
 import pytest
 import serial
 
-from conftest import REPLY_TIMEOUT, require_builds
+from conftest import REPLY_TIMEOUT, board_sent, require_builds
 from orfa.sim import BOARDS, SimBoard
 from orfa.simctl import RX_MAX, SimControlError
 
@@ -31,15 +31,20 @@ def fresh(board):
     return SimBoard(board, trace=True, control=True)
 
 
-def wait_events(sim, kind, count, timeout=REPLY_TIMEOUT):
-    """The trace's `kind` events once there are `count` of them."""
+def wait_events(sim, kind, count, timeout=REPLY_TIMEOUT, settle=16 * BYTE):
+    """The trace's `kind` events once there are `count` of them, and still
+    `count` after `settle` more simulated cycles (none comes late). The
+    simulator writes an event before it answers a later `wait`, so simulated
+    time decides; the wall-clock deadline only bounds a run that hangs."""
+    ctl = sim.control
     deadline = time.monotonic() + timeout
-    while True:
-        events = sim.trace_events(kinds=[kind])
-        if len(events) >= count or time.monotonic() > deadline:
-            assert len(events) == count, (kind, len(events), count)
-            return events
-        time.sleep(0.02)
+    while len(sim.trace_events(kinds=[kind])) < count:
+        assert time.monotonic() < deadline, (kind, len(sim.trace_events(kinds=[kind])), count)
+        ctl.wait(BYTE)
+    ctl.wait(settle)
+    events = sim.trace_events(kinds=[kind])
+    assert len(events) == count, (kind, len(events), count)
+    return events
 
 
 def error(ctl, line):
@@ -117,8 +122,7 @@ def test_pty_bytes_queue_behind_scheduled_bytes():
         rx = wait_events(sim, "uart rx", len(filler) + 2, timeout=30)
         # the line overflowed the firmware's buffer long before the CR
         assert port.readline() == b"ERROR 04\r\n"
-        port.timeout = 0.3
-        assert port.read(1) == b""
+        assert board_sent(sim, 0) == b"ERROR 04\r\n"     # and nothing else, by now
     cycles = [e.cycle for e in rx]
     data = bytes(int(e.fields[0], 16) for e in rx)
     i = cycles.index(at + BYTE)

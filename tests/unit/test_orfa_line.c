@@ -9,17 +9,7 @@
 
 #include "orfa_line.h"
 
-static int failures, checks;
-
-#define CHECK(cond, ...) do { \
-	checks++; \
-	if (!(cond)) { \
-		failures++; \
-		printf("FAIL %s:%d: ", __FILE__, __LINE__); \
-		printf(__VA_ARGS__); \
-		printf("\n"); \
-	} \
-} while (0)
+#include "check.h"
 
 static orfa_req_t req;
 static orfa_reply_t out[ORFA_FRAMES_MAX];

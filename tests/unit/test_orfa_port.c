@@ -17,17 +17,7 @@
 
 #include "orfa.h"
 
-static int failures, checks;
-
-#define CHECK(cond, ...) do { \
-	checks++; \
-	if (!(cond)) { \
-		failures++; \
-		printf("FAIL %s:%d: ", __FILE__, __LINE__); \
-		printf(__VA_ARGS__); \
-		printf("\n"); \
-	} \
-} while (0)
+#include "check.h"
 
 static int master = -1;
 static char slave_path[128];
@@ -42,23 +32,39 @@ static void open_pty(void)
 	snprintf(slave_path, sizeof(slave_path), "%s", ptsname(master));
 }
 
-/* What the library sent: everything on the master side within `ms`. */
-static size_t sent(char *buf, size_t size, int ms)
+/* What the library sent: `lines` lines read from the master side (each poll
+ * bounded by a second, only so that a failing library cannot hang the test),
+ * the line count deciding when all has come. */
+static size_t sent(char *buf, size_t size, int lines)
 {
 	size_t n = 0;
 	struct pollfd pfd = {master, POLLIN, 0};
 
-	while (n + 1 < size && poll(&pfd, 1, ms) > 0) {
+	while (lines > 0 && n + 1 < size && poll(&pfd, 1, 1000) > 0) {
 		ssize_t got = read(master, buf + n, size - 1 - n);
 
 		if (got <= 0) {
 			break;
 		}
+		for (ssize_t i = 0; i < got; i++) {
+			lines -= buf[n + (size_t)i] == '\n';
+		}
 		n += (size_t)got;
-		ms = 20;
 	}
 	buf[n] = '\0';
 	return n;
+}
+
+/* Whether the library sent nothing: the master side stays empty for 100 ms
+ * (the library writes before its call returns, so its bytes would be
+ * there); what came, if anything, is in buf. */
+static size_t sent_nothing(char *buf, size_t size)
+{
+	struct pollfd pfd = {master, POLLIN, 0};
+	ssize_t got = poll(&pfd, 1, 100) > 0 ? read(master, buf, size - 1) : 0;
+
+	buf[got > 0 ? got : 0] = '\0';
+	return got > 0 ? (size_t)got : 0;
 }
 
 static void answer(const char *text)
@@ -114,7 +120,7 @@ static void test_exchange(orfa_t *o)
 	/* the manual's count request: raw line out, no CR added, no echo */
 	CHECK(intro(o, 0xAA, 0, 1) == ORFA_OK, "commit");
 	CHECK(orfa_pending(o) == 2, "pending %d", orfa_pending(o));
-	sent(buf, sizeof(buf), 1000);
+	sent(buf, sizeof(buf), 1);
 	CHECK(strcmp(buf, "SAA0000SAB01P\n") == 0, "sent %s", buf);
 	answer("SWAASR07P\r\n");
 	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_WRITE && r.size == 2 &&
@@ -130,7 +136,7 @@ static void test_exchange(orfa_t *o)
 	CHECK(intro(o, 0xAA, 1, 6) == ORFA_OK, "1");
 	CHECK(orfa_version(o) == ORFA_OK, "V");
 	CHECK(intro(o, 0x10, 0, 1) == ORFA_OK, "3");
-	sent(buf, sizeof(buf), 1000);
+	sent(buf, sizeof(buf), 3);
 	CHECK(strcmp(buf, "SAA0001SAB06P\nV\nS100000S1101P\n") == 0, "sent %s", buf);
 	CHECK(orfa_pending(o) == 5, "pending %d", orfa_pending(o));
 	answer("SWAASR000001000002P\r\nV1.");
@@ -146,7 +152,7 @@ static void test_exchange(orfa_t *o)
 	/* ERROR answers the whole request: its other result is gone */
 	CHECK(intro(o, 0x42, 0, 1) == ORFA_OK, "absent device");
 	CHECK(orfa_version(o) == ORFA_OK, "V after it");
-	sent(buf, sizeof(buf), 1000);
+	sent(buf, sizeof(buf), 2);
 	answer("ERROR 06\r\nV1.1\r\n");
 	CHECK(orfa_read_reply(o, &r) == ORFA_E_REPLY && orfa_reply_code(o) == 6, "ERROR 06");
 	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_VERSION, "next request");
@@ -160,7 +166,7 @@ static void test_exchange(orfa_t *o)
 	      orfa_tr_commit(o) == ORFA_E_ARG, "read of 0");
 	CHECK(orfa_tr_start(o) == ORFA_OK && orfa_tr_commit(o) == ORFA_E_ARG, "empty");
 	CHECK(orfa_local(o, 0) == ORFA_E_ARG && orfa_clock(o, 0) == ORFA_E_ARG, "L00, C0000");
-	CHECK(sent(buf, sizeof(buf), 100) == 0, "sent %s", buf);
+	CHECK(sent_nothing(buf, sizeof(buf)) == 0, "sent %s", buf);
 	CHECK(orfa_pending(o) == 0, "pending %d", orfa_pending(o));
 }
 
@@ -174,7 +180,7 @@ static void test_bad_lines(orfa_t *o)
 	CHECK(orfa_set_timeout(o, 100) == ORFA_OK, "timeout");
 	/* no reply: a timeout, the request still waits for its line */
 	CHECK(intro(o, 0xAA, 0, 1) == ORFA_OK, "commit");
-	sent(buf, sizeof(buf), 1000);
+	sent(buf, sizeof(buf), 1);
 	answer("SWAASR");
 	CHECK(orfa_read_reply(o, &r) == ORFA_E_TIMEOUT, "half a line");
 	answer("07P\r\n");
@@ -188,7 +194,7 @@ static void test_bad_lines(orfa_t *o)
 	strcpy(longline + 200, "\r\n");
 	CHECK(orfa_version(o) == ORFA_OK && orfa_version(o) == ORFA_OK &&
 	      orfa_version(o) == ORFA_OK && orfa_version(o) == ORFA_OK, "4 V");
-	sent(buf, sizeof(buf), 1000);
+	sent(buf, sizeof(buf), 4);
 	answer(longline);
 	answer("V1.1\n");
 	answer("SWP\r\n");
@@ -211,15 +217,15 @@ static void test_flow(orfa_t *o)
 	for (i = 0; i < 18; i++) {
 		CHECK(intro(o, 0xAA, 1, 6) == ORFA_OK, "commit %d", i);
 	}
-	CHECK(sent(buf, sizeof(buf), 1000) == 18 * 14, "sent %zu", strlen(buf));
+	CHECK(sent(buf, sizeof(buf), 18) == 18 * 14, "sent %zu", strlen(buf));
 	/* the 19th waits for a reply: none comes, nothing is sent */
 	CHECK(orfa_set_timeout(o, 100) == ORFA_OK, "timeout");
 	CHECK(intro(o, 0xAA, 1, 6) == ORFA_E_TIMEOUT, "19th without a reply");
-	CHECK(sent(buf, sizeof(buf), 100) == 0, "sent %s", buf);
+	CHECK(sent_nothing(buf, sizeof(buf)) == 0, "sent %s", buf);
 	/* one reply makes room for it */
 	answer("SWAASR000001000002P\r\n");
 	CHECK(intro(o, 0xAA, 1, 6) == ORFA_OK, "19th");
-	CHECK(sent(buf, sizeof(buf), 1000) == 14, "sent %s", buf);
+	CHECK(sent(buf, sizeof(buf), 1) == 14, "sent %s", buf);
 	CHECK(orfa_pending(o) == 2 * 19, "pending %d", orfa_pending(o));
 	for (i = 1; i < 19; i++) {
 		char line[32];
@@ -239,12 +245,12 @@ static void test_flow(orfa_t *o)
 	for (i = 0; i < ORFA_QUEUE_MAX; i++) {
 		CHECK(orfa_version(o) == ORFA_OK, "V %d", i);
 	}
-	sent(buf, sizeof(buf), 1000);
+	sent(buf, sizeof(buf), ORFA_QUEUE_MAX);
 	for (i = 0; i < ORFA_QUEUE_MAX; i++) {
 		answer("V1.1\r\n");
 	}
 	CHECK(orfa_version(o) == ORFA_E_FULL, "queue full");
-	CHECK(sent(buf, sizeof(buf), 100) == 0, "sent %s", buf);
+	CHECK(sent_nothing(buf, sizeof(buf)) == 0, "sent %s", buf);
 	for (i = 0; i < ORFA_QUEUE_MAX; i++) {
 		CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_VERSION, "V %d", i);
 	}

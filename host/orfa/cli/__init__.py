@@ -23,8 +23,6 @@ from .. import protocol as p
 from ..sim import BOARDS
 from . import bus, console, devices, simulate
 from .common import ADDRESS_RULE, PORT_ENV, UsageError, add_sim_devices, env_port, explain, number
-from .console import expects_reply, terminal  # noqa: F401  (kept for scripts)
-from .simulate import slave_spec  # noqa: F401
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 

@@ -113,7 +113,6 @@ def _check_fits(frames) -> str:
 
 
 def _transact(gw, frames, what: str):
-    _check_fits(frames)
     try:
         return gw.transaction(frames)
     except p.OrfaError as exc:

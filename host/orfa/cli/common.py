@@ -8,11 +8,9 @@ import contextlib
 import os
 from typing import Iterator, List, Optional
 
-import serial
-
 from .. import boardmap
 from .. import protocol as p
-from ..gateway import Gateway
+from ..gateway import Gateway, os_reason
 from ..sim import BOARDS, SimBoard, SimError
 
 #: The environment variable that gives --port its default.
@@ -75,27 +73,13 @@ def explain(exc: BaseException) -> str:
     return text
 
 
-def _os_reason(exc: BaseException) -> str:
-    """Why a port did not open, from the innermost error of the chain: the
-    OS's reason ("No such file or directory") or pyserial's ("invalid URL")."""
-    seen = exc
-    while True:
-        if isinstance(seen, OSError) and seen.strerror and not isinstance(
-                seen, serial.SerialException):
-            return seen.strerror
-        inner = seen.__cause__ or seen.__context__
-        if inner is None:
-            return str(seen)
-        seen = inner
-
-
 def open_gateway(url: str, args) -> Gateway:
     """A Gateway on url; a port that cannot be opened is a UsageError."""
     try:
         return Gateway(url, baudrate=args.baud, timeout=args.timeout,
                        autobaud=args.autobaud)
-    except (serial.SerialException, OSError, ValueError, p.OrfaError) as exc:
-        raise UsageError("cannot open %s: %s" % (url, _os_reason(exc))) from None
+    except (ValueError, p.OrfaError) as exc:         # SerialError, a bad rate
+        raise UsageError("cannot open %s: %s" % (url, os_reason(exc, errno=False))) from None
 
 
 def add_sim_devices(parser, suppress: bool = False) -> None:
@@ -132,7 +116,6 @@ def sim_board(board: str, args, **kw) -> SimBoard:
 def connect(args) -> Iterator[Gateway]:
     """The Gateway of --port URL (or $ORFA_PORT), or of a board --sim starts
     for this one command (stopped when the command ends)."""
-    sim = None
     devices = [opt for opt in ("eeprom", "slave", "adc", "spi") if getattr(args, opt, None)]
     if args.sim is None and devices:
         raise UsageError("--%s describes a simulated board: give --sim BOARD too" % devices[0])
@@ -140,21 +123,23 @@ def connect(args) -> Iterator[Gateway]:
         if args.port:
             raise UsageError("give --port or --sim, not both")
         try:
-            sim = sim_board(args.sim, args, trace=False).start()
+            sim = sim_board(args.sim, args, trace=False, control=args.autobaud).start()
         except (SimError, ValueError) as exc:
             raise UsageError(str(exc)) from None
-        url = sim.port
-    elif args.port:
+        try:
+            # the preamble's quiet passes in simulated time, not on the wall clock
+            with sim.gateway(args.baud, autobaud=args.autobaud, timeout=args.timeout) as gw:
+                yield gw
+        finally:
+            sim.stop()
+        return
+    if args.port:
         url = args.port
     else:
         raise UsageError("no board: give --port URL (or set %s) or --sim BOARD (%s)"
                          % (PORT_ENV, "|".join(BOARDS)))
-    try:
-        with open_gateway(url, args) as gw:
-            yield gw
-    finally:
-        if sim is not None:
-            sim.stop()
+    with open_gateway(url, args) as gw:
+        yield gw
 
 
 def hex_bytes(data: bytes) -> str:

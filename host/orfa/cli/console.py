@@ -31,10 +31,9 @@ def exchange(gw, line: str) -> Optional[str]:
     """Send one console line as it is; its reply, None when the board sends
     none (comment or empty line), or a `host: ...` line when the host
     cannot send it."""
-    if not line.strip(" "):
-        return None
-    if line.startswith("#"):
-        gw.send(line.encode("ascii", "replace") + p.REQUEST_TERMINATOR.encode())
+    if not expects_reply(line):
+        if line.strip(" "):                  # a comment: the board drops it too
+            gw.send(line.encode("ascii", "replace") + p.REQUEST_TERMINATOR.encode())
         return None
     try:
         data = line.encode("ascii")

@@ -114,10 +114,8 @@ def cmd_servo(args) -> int:
         elif args.angle is not None and args.angle is not READ:
             servo.set_angle(ch, args.angle, **kw)
         elif args.angle is READ:
-            if servo.width(ch) == 0:
-                print("off")
-            else:
-                print("%.1f" % servo.angle(ch, **kw))
+            us = servo.width(ch)                  # one read: the width is the angle
+            print("off" if us == 0 else "%.1f" % kw.get("range", ServoRange()).degrees(us))
         else:
             print(_show_width(servo.width(ch)))
     return 0
@@ -169,7 +167,7 @@ def cmd_motor(args) -> int:
             motor.stop()
             return 0
         if args.n is None:
-            rows = [[str(n), str(motor.get(n))] for n in range(1, motor.count + 1)]
+            rows = [[str(n), str(duty)] for n, duty in enumerate(motor.duties(), 1)]
             print(table(rows, ["motor", "duty"]))
             return 0
         n = _motor(args.n, motor.count)
@@ -304,9 +302,11 @@ def cmd_gpio(args) -> int:
                 gpio.write(ports, args.value, 0xFF if args.mask is None else args.mask)
             if args.output is not None or args.input is not None or args.value is not None:
                 return 0
-        rows = [[port, "0x%02X" % gpio.read(port), "{:08b}".format(gpio.read(port)),
-                 "0x%02X" % gpio.modes(port), "{:08b}".format(gpio.modes(port))]
-                for port in ports]
+        rows = []
+        for port in ports:
+            levels, modes = gpio.read(port), gpio.modes(port)
+            rows.append([port, "0x%02X" % levels, "{:08b}".format(levels),
+                         "0x%02X" % modes, "{:08b}".format(modes)])
     print(table(rows, ["port", "levels", "(7..0)", "modes", "(1 = output)"]))
     return 0
 

@@ -7,7 +7,6 @@ import argparse
 import os
 import signal
 import sys
-import time
 
 from .. import protocol as p
 from ..sim import BOARDS, SimError
@@ -78,8 +77,7 @@ def cmd_sim(args) -> int:
         if args.terminal:
             with board.gateway(args.baud, autobaud=args.autobaud) as gw:
                 return run_console(gw)
-        while board.running:
-            time.sleep(0.2)
+        board.proc.wait()                  # until it ends (or SIGTERM, Ctrl-C)
         print("orfa: the simulator stopped: %s" % board.stderr.strip(), file=sys.stderr)
         return 1
     except KeyboardInterrupt:
