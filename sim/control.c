@@ -561,7 +561,7 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 		}
 		rp(&r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u pty %u",
 		   (unsigned)u->host_baud, (unsigned)u->host_bit, (unsigned)usart_board_bit(u),
-		   (unsigned)u->ubrr, !!(u->avr->data[u->regs->ucsrb] & (1u << 4)),
+		   (unsigned)u->ubrr, usart_rxen(u),
 		   (uint64_t)u->rxen_since, (unsigned)u->fe_read, (unsigned)u->host_taken);
 	} else if (!strcasecmp(cmd, "rx")) {
 		if (cb != &c->board[0]) {
@@ -658,7 +658,6 @@ int control_open(control_t *c, const char *path, avr_t *avr, board_model_t *bm,
 	memset(c, 0, sizeof(*c));
 	c->fd = -1;
 	c->avr = avr;
-	c->bm = bm;
 	c->usart = usart;
 	c->board[0] = (control_board_t) { .addr = 0, .avr = avr, .bm = bm };
 	c->nboards = 1;

@@ -48,7 +48,6 @@ typedef struct control_t {
 	int fd;				/* listening socket, -1: off */
 	char *path;
 	avr_t *avr;			/* the gateway's: its cycle is world time */
-	board_model_t *bm;
 	control_board_t board[CONTROL_MAX_BOARDS];
 	int nboards;
 	usart_t *usart;			/* the board's serial port (`rx`) */

@@ -39,6 +39,11 @@ avr_cycle_count_t usart_byte_cycles(const usart_t *u)
 	return (avr_cycle_count_t)bits * per_bit * (u->ubrr + 1u);
 }
 
+int usart_rxen(const usart_t *u)
+{
+	return !!(usart_ucsrb(u) & BIT(UCSRB_RXEN));
+}
+
 uint32_t usart_board_bit(const usart_t *u)
 {
 	return ((u->ucsra & BIT(UCSRA_U2X)) ? 8u : 16u) * (u->ubrr + 1u);
@@ -173,7 +178,7 @@ static void usart_rx_dec_emit(void *param, avr_cycle_count_t when,
 {
 	usart_t *u = param;
 
-	if ((usart_ucsrb(u) & BIT(UCSRB_RXEN)) && t0 >= u->rxen_since) {
+	if (usart_rxen(u) && t0 >= u->rxen_since) {
 		trace_event(u->trace, when, fe ? "uart rx %02X fe" : "uart rx %02X", byte);
 		usart_rx_deliver(u, byte, fe);
 		usart_sync(u);
@@ -224,7 +229,7 @@ static void usart_rx_begin(usart_t *u, uint8_t byte, avr_cycle_count_t start,
 	u->rx_wire_byte = byte;
 	u->rx_wire_busy = 1;
 	u->rx_wire_end = end;
-	u->rx_wire_valid = !!(usart_ucsrb(u) & BIT(UCSRB_RXEN));
+	u->rx_wire_valid = usart_rxen(u);
 	/* Fast path: the rates agree and the receiver is not inside a frame
 	 * of its own, so it takes this byte whole at the end of its stop bit
 	 * (exactly as before the line had rates). Otherwise the receiver

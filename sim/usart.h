@@ -160,6 +160,9 @@ void usart_set_pin(usart_t *u, usart_pin_t pin, void *param);
 /* The board's bit time from UBRR/U2X, in cycles. */
 uint32_t usart_board_bit(const usart_t *u);
 
+/* Whether the firmware has its receiver on (RXEN). */
+int usart_rxen(const usart_t *u);
+
 /* Cycles one frame takes with the current UBRR/U2X/UCSRC settings. */
 avr_cycle_count_t usart_byte_cycles(const usart_t *u);
 
