@@ -8,9 +8,14 @@ set -eu
 # is 14 on bookworm, whose libFuzzer comes in libclang-rt-14-dev; the
 # libclang-rt-dev package follows the default clang of each release. avrdude for
 # `make flash`, `make fuses` and `orfa flash` (the tests use a stand-in).
-APT_PACKAGES="make gcc gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-dev avrdude"
-# python module:pip package
-PY_PACKAGES="serial:pyserial pytest:pytest"
+# chromium and chromium-driver: the dashboard's test drives a real headless
+# browser (Debian's; a browser that a PyPI package downloads cannot be fetched
+# on a closed network).
+APT_PACKAGES="make gcc gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-dev avrdude chromium chromium-driver"
+# python module:pip package. matplotlib draws `orfa plot`, flask serves
+# `orfa dash` (the extras orfa[plot] and orfa[dash]), selenium drives the
+# browser in the dashboard's test.
+PY_PACKAGES="serial:pyserial pytest:pytest matplotlib:matplotlib flask:flask selenium:selenium"
 
 if [ "$(id -u)" -eq 0 ]; then
 	SUDO=""
