@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import logging
 import signal
 
 from .common import UsageError, add_sim_devices, connect
@@ -41,12 +42,19 @@ def seconds(text: str) -> float:
     return value
 
 
-class _Terminated(Exception):
-    """SIGTERM: stop serving, exit 0."""
+class _Stop(Exception):
+    """A signal to stop serving (werkzeug's serve_forever swallows
+    KeyboardInterrupt, so Ctrl-C comes as this too): the exit status."""
+
+    def __init__(self, status: int):
+        super().__init__(status)
+        self.status = status
 
 
-def _terminate(*_):
-    raise _Terminated
+def _stop_with(status: int):
+    def handler(*_):
+        raise _Stop(status)
+    return handler
 
 
 def cmd_dash(args) -> int:
@@ -65,15 +73,19 @@ def cmd_dash(args) -> int:
         except OSError as exc:
             raise UsageError("cannot listen on %s:%d: %s"
                              % (host, port, exc.strerror or exc)) from None
-        previous = signal.signal(signal.SIGTERM, _terminate)
+        # the requests' log lines would bury the terminal
+        logging.getLogger("werkzeug").setLevel(logging.ERROR)
+        previous = {sig: signal.signal(sig, _stop_with(status))
+                    for sig, status in ((signal.SIGTERM, 0), (signal.SIGINT, 130))}
         try:
             dash.start()
             print(server.url, flush=True)
             server.serve_forever()
-        except _Terminated:
-            return 0
+        except _Stop as stop:
+            return stop.status
         finally:
-            signal.signal(signal.SIGTERM, previous)
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
             dash.close()
             server.httpd.server_close()
     return 0

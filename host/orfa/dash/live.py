@@ -112,19 +112,23 @@ class Dashboard:
 
     # --- the poller -------------------------------------------------------------
     def start(self) -> "Dashboard":
-        """Find the boards, then poll them on a thread of its own."""
+        """Find the boards, read them once (latest() has a snapshot from
+        now on), then poll them on a thread of its own."""
         if not self.boards:
             self.discover()
+        self.poll()
         self._thread = threading.Thread(target=self._run, name="orfa-dash-poller",
                                         daemon=True)
         self._thread.start()
         return self
 
     def _run(self) -> None:
-        while not self._stop.is_set():
-            self.poll()
+        while True:
             self._wake.wait(self.interval)
             self._wake.clear()
+            if self._stop.is_set():
+                return
+            self.poll()
 
     def poll(self) -> Dict[str, object]:
         """Read every board once and publish the snapshot."""
