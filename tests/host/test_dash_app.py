@@ -23,12 +23,12 @@ LOCAL = "%02X" % M32D.local_address
 
 @pytest.fixture
 def dash(monkeypatch):
-    """A Dashboard of the gateway's own M32-D on a scripted line (no scan);
+    """A Dashboard of the gateway's own M32-D on a scripted line (no slaves);
     `dash.line` is the fake, emptied after discovery."""
     table = {"L": "L" + LOCAL, "SAA130306A4P": "SWAAAAP"}
     line = FakeLine(board_answers("m32d", M32D.local_address, table))
     monkeypatch.setattr("orfa.gateway.serial.serial_for_url", lambda url, **kw: line)
-    d = Dashboard(Gateway("fake://", timeout=0.2), scan=False)
+    d = Dashboard(Gateway("fake://", timeout=0.2), slaves=())
     d.discover()
     del line.written[:]
     d.line = line
@@ -213,6 +213,9 @@ def test_without_flask_one_line_and_exit_2(monkeypatch, capsys):
     (["dash", "--port", "loop://", "--listen", "localhost:http"], "HOST:PORT like 127.0.0.1:8000"),
     (["dash", "--port", "loop://", "--listen", "127.0.0.1:70000"], "port 0..65535"),
     (["dash", "--port", "loop://", "--interval", "0"], "seconds, 0.01..3600"),
+    (["dash", "--port", "loop://", "--boards", "0x10,x"], "'x' is not a number"),
+    (["dash", "--port", "loop://", "--boards", "0x10", "--no-scan"],
+     "argument --no-scan: not allowed with argument --boards"),
 ])
 def test_bad_options_exit_2(argv, message, capsys):
     with pytest.raises(SystemExit) as exc:
@@ -225,6 +228,12 @@ def test_addr_does_not_apply(capsys):
     assert main(["dash", "--port", "loop://", "--addr", "0x10"]) == 2
     assert capsys.readouterr().err == \
         "orfa: dash shows every board on the bus: --addr does not apply\n"
+
+
+def test_boards_are_addresses(capsys):
+    assert main(["dash", "--port", "loop://", "--boards", "0x10,0x11"]) == 2
+    assert capsys.readouterr().err == ("orfa: --boards 0x11: an 8-bit address is even,"
+                                       " 0x00..0xFE (the 7-bit 0x11 is 0x22, or give --7bit)\n")
 
 
 def test_listen_forms():

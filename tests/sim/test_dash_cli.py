@@ -26,12 +26,16 @@ M32D, M128S = boardmap.load("m32d"), boardmap.load("m128s")
 TIMEOUT = 30
 
 
+def orfa(*args):
+    return [sys.executable, "-m", "orfa", "dash", "--sim", "m32d", "--slave", "m128s:0x10",
+            "--listen", "127.0.0.1:0"] + list(args)
+
+
 def start(*args):
     require_builds(["m32d"])
     require_slave("m128s", 0x10)
     proc = subprocess.Popen(
-        [sys.executable, "-m", "orfa", "dash", "--sim", "m32d", "--slave", "m128s:0x10",
-         "--listen", "127.0.0.1:0"] + list(args),
+        orfa(*args),
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
         env=dict(os.environ, PYTHONPATH=str(ROOT / "host")))
     url = proc.stdout.readline().strip()
@@ -113,6 +117,31 @@ def test_ctrl_c_exits_130():
     snapshot_after(url, 0)
     status, out, err = stop(proc, signal.SIGINT)
     assert (status, out, err) == (130, "", "")
+
+
+def test_other_devices_on_the_bus_are_listed():
+    proc, url = start("--eeprom", "0xA0")
+    try:
+        snap = snapshot_after(url, 0)
+    finally:
+        stop(proc, signal.SIGTERM)
+    assert [b["addr"] for b in snap["boards"]] == ["AA", "10"]
+    assert snap["others"] == ["A0"]
+
+
+def test_boards_named_instead_of_a_scan():
+    proc, url = start("--boards", "0x10", "--eeprom", "0xA0")
+    try:
+        snap = snapshot_after(url, 0)
+    finally:
+        stop(proc, signal.SIGTERM)
+    assert [b["addr"] for b in snap["boards"]] == ["AA", "10"]
+    assert snap["others"] == []
+    r = subprocess.run(orfa("--boards", "0xA0,0x10", "--eeprom", "0xA0"), capture_output=True,
+                       text=True, cwd=ROOT, timeout=TIMEOUT,
+                       env=dict(os.environ, PYTHONPATH=str(ROOT / "host")))
+    assert (r.returncode, r.stdout, r.stderr) == (
+        1, "", "orfa: 0xA0 is no ORFA board: its introspection matches no board map\n")
 
 
 def test_a_port_that_does_not_open():

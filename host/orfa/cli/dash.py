@@ -8,7 +8,7 @@ import importlib.util
 import logging
 import signal
 
-from .common import UsageError, add_sim_devices, connect
+from .common import UsageError, add_sim_devices, address, connect, number
 
 #: The address the page is served on unless --listen says otherwise.
 DEFAULT_LISTEN = ("127.0.0.1", 8000)
@@ -30,6 +30,11 @@ def listen_spec(text: str):
         raise argparse.ArgumentTypeError(
             "%r: HOST:PORT like 127.0.0.1:8000 (port 0..65535, 0: a free one)" % text)
     return (host or DEFAULT_LISTEN[0], value)
+
+
+def address_list(text: str):
+    """`0x10,0x12` -> [0x10, 0x12] (checked as addresses once --7bit is known)."""
+    return [number(part) for part in text.split(",")]
 
 
 def seconds(text: str) -> float:
@@ -65,8 +70,11 @@ def cmd_dash(args) -> int:
     from ..dash.live import Dashboard
     from ..dash.web import Server
     host, port = args.listen
+    slaves = [] if args.no_scan else None
+    if args.boards is not None:
+        slaves = [address(args, a, "--boards") for a in args.boards]
     with connect(args) as gw:
-        dash = Dashboard(gw, interval=args.interval, scan=not args.no_scan)
+        dash = Dashboard(gw, interval=args.interval, slaves=slaves)
         dash.discover()
         try:
             server = Server(dash, host, port)
@@ -109,8 +117,13 @@ def add_parsers(sub, common) -> None:
                           " free one). Anyone who reaches it can move the motors")
     cmd.add_argument("--interval", type=seconds, default=0.2, metavar="S",
                      help="seconds between two readings of the boards (default 0.2)")
-    cmd.add_argument("--no-scan", action="store_true",
-                     help="the gateway's own board only: do not look for slaves")
+    which = cmd.add_mutually_exclusive_group()
+    which.add_argument("--boards", type=address_list, metavar="ADDR[,ADDR...]",
+                       help="the slave boards to show, by bus address, instead of those a"
+                            " scan of the bus finds (finding them asks every device that"
+                            " answers for its introspection: a write of 00 00)")
+    which.add_argument("--no-scan", action="store_true",
+                       help="the gateway's own board only: do not look for slaves")
     add_sim_devices(cmd.add_argument_group("devices of the --sim board"), suppress=True)
     cmd.set_defaults(func=cmd_dash)
 

@@ -14,17 +14,14 @@ import math
 import queue
 import threading
 import time
-from typing import Callable, Dict, List, Optional
+from typing import Callable, Dict, List, Optional, Sequence
 
 from .. import protocol as p
 from ..board import Board
+from ..cli.bus import scan
 from ..cli.common import explain
 from ..gateway import Gateway
 from . import snapshot
-
-#: The 7-bit addresses probed for slaves: i2cdetect's range, as `orfa scan`.
-SCAN_FIRST, SCAN_LAST = 0x08, 0x77
-
 
 class ControlError(ValueError):
     """A control request that is wrong in itself (a field missing or out of
@@ -44,19 +41,21 @@ class Refused(Exception):
 
 
 class Dashboard:
-    """The boards behind `gateway`: its own, and with `scan` the ORFA slaves
-    that answer on its bus (other devices, an EEPROM, are listed by address)."""
+    """The boards behind `gateway`: its own, and the ORFA slaves at the
+    8-bit addresses `slaves`, or with None those that answer a scan of the
+    bus (other devices that answer, an EEPROM, are listed by address)."""
 
-    def __init__(self, gateway: Gateway, interval: float = 0.2, scan: bool = True):
+    def __init__(self, gateway: Gateway, interval: float = 0.2,
+                 slaves: Optional[Sequence[int]] = None):
         if not interval > 0:
             raise ValueError("the refresh interval must be above 0 s, not %r" % (interval,))
         self.gateway = gateway
         self.interval = interval
-        self.scan = scan
+        self.slaves = None if slaves is None else [a & 0xFE for a in slaves]
         self.lock = threading.Lock()
         self.boards: Dict[str, Board] = {}
         self.info: Dict[str, Dict[str, object]] = {}
-        #: 8-bit addresses of devices that answered the scan but are no ORFA board
+        #: devices that answered the scan but are no ORFA board (address keys)
         self.others: List[str] = []
         self.seq = 0
         self._latest: Optional[Dict[str, object]] = None
@@ -68,8 +67,10 @@ class Dashboard:
 
     # --- the boards -------------------------------------------------------------
     def discover(self) -> None:
-        """The gateway's own board, then each address that acknowledges a
-        probe and answers introspection with drivers a board map knows."""
+        """The gateway's own board, then each slave: those named, or each
+        address that acknowledges a probe (`orfa scan`) and answers
+        introspection with drivers a board map knows. A slave named that
+        is no ORFA board raises OrfaError."""
         with self.lock:
             gw = self.gateway
             local = gw.local_address()
@@ -78,21 +79,26 @@ class Dashboard:
                 raise p.OrfaError("the gateway's drivers match no board map (UIDs %s)"
                                   % " ".join("%04X" % r.uid for r in own.drivers))
             found = [own]
-            if self.scan:
-                addrs = [a << 1 for a in range(SCAN_FIRST, SCAN_LAST + 1)]
-                replies = gw.run(["S%02XP" % a for a in addrs])        # pipelined
-                for addr, reply in zip(addrs, replies):
-                    if reply != "SWP" or addr == local:
-                        continue
-                    board = Board(gw, addr)
-                    try:
-                        known = board.map is not None
-                    except (p.OrfaError, ValueError):
-                        known = False
-                    if known:
-                        found.append(board)
-                    else:
-                        self.others.append(snapshot.address_key(addr))
+            named = self.slaves is not None
+            addrs = self.slaves if named else [a << 1 for a in scan(gw)]
+            for addr in addrs:
+                if addr == local:
+                    continue
+                board = Board(gw, addr)
+                try:
+                    known = board.map is not None
+                except (p.OrfaError, ValueError) as exc:
+                    if named:
+                        raise p.OrfaError("0x%02X: no ORFA board answers: %s"
+                                          % (addr, explain(exc))) from None
+                    known = False
+                if known:
+                    found.append(board)
+                elif named:
+                    raise p.OrfaError("0x%02X is no ORFA board: its introspection"
+                                      " matches no board map" % addr)
+                else:
+                    self.others.append(snapshot.address_key(addr))
             for board in found:
                 key = snapshot.address_key(board.addr)
                 self.boards[key] = board
