@@ -56,7 +56,8 @@ def test_a_good_servo_control_sends_the_typed_apis_request(dash):
 
 
 @pytest.mark.parametrize("kind, body, message", [
-    ("servo", {"channel": 3, "us": 99999}, "servo: a width of 99999 us is outside 500..2500 (0: off)"),
+    ("servo", {"channel": 3, "us": 99999},
+     "servo: a width of 99999 us is outside 500..2500 (0: off)"),
     ("servo", {"channel": 3, "us": 499}, "servo: a width of 499 us is outside 500..2500 (0: off)"),
     ("servo", {"channel": 16, "us": 1500}, "servo: channel 16 is outside 0..15"),
     ("servo", {"channel": 3}, "servo: give us or angle (one of them)"),
@@ -66,12 +67,14 @@ def test_a_good_servo_control_sends_the_typed_apis_request(dash):
     ("servo", {"channel": True, "us": 1500}, "servo: channel must be an integer number, not True"),
     ("servo", {"channel": 3, "angle": 80}, "servo: angle 80 is outside -75..75"),
     ("servo", {"us": 1500}, "servo: channel is missing"),
-    ("servo", {"channel": 3, "us": 1500, "speed": 2}, "servo: unknown field speed (fields: channel, us, angle)"),
+    ("servo", {"channel": 3, "us": 1500, "speed": 2},
+     "servo: unknown field speed (fields: channel, us, angle)"),
     ("servo", [3, 1500], "servo: the body must be a JSON object"),
     ("motor", {"motor": 3, "duty": 10}, "motor: motor 3 is outside 1..2"),
     ("motor", {"motor": 1, "duty": -256}, "motor: duty -256 is outside -255..255"),
     ("motor", {"motor": 1, "duty": None}, "motor: duty must be an integer number, not null"),
-    ("gpio", {"port": "E", "bit": 0, "level": 1}, "gpio: port 'E': this board's ports are A, B, C, D"),
+    ("gpio", {"port": "E", "bit": 0, "level": 1},
+     "gpio: port 'E': this board's ports are A, B, C, D"),
     ("gpio", {"port": "B", "bit": 8, "level": 1}, "gpio: bit 8 is outside 0..7"),
     ("gpio", {"port": "B", "bit": 2}, "gpio: give level (0 or 1), output (true or false) or both"),
     ("gpio", {"port": "B", "bit": 2, "level": 2}, "gpio: level 2 is outside 0..1"),

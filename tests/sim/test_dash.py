@@ -37,9 +37,10 @@ GW_KEY, SLAVE_KEY = address_key(GW_MAP.local_address), address_key(SLAVE_ADDR)
 #: Wall-clock bound on any wait for the page (a safety net: what the page
 #: waits for is the server's next snapshot, a fraction of a second).
 PAGE_TIMEOUT = 20
-#: A servo's width is exact to 4 cycles on the M32-D and to the 8-cycle
-#: timer tick on the M128-S (docs/registers.md, Servos).
-WIDTH_TOL = {GATEWAY: 4, SLAVE: 8}
+#: Cycles a measured width may be off: the M32-D makes widths within 4
+#: cycles, the M128-S rounds them to its 8-cycle timer tick (half a tick)
+#: (docs/registers.md, Servos). Measured here: 1.2 and 0.6 cycles off.
+WIDTH_TOL = {GATEWAY: 4, SLAVE: 4}
 
 try:
     from selenium import webdriver
@@ -215,19 +216,24 @@ def test_slave_servo_control_moves_the_slaves_pin(page, robot):
 
 
 def test_gpio_control_sets_the_line(page, robot):
-    before = robot.control.pin("D6")
+    # the first line the map gives no other function (PC2 on an M32-D)
+    fixed = {(p.port, p.bit) for p in GW_MAP.pins}
+    port, bit = next((port, bit) for port in GW_MAP.gpio_ports for bit in range(8)
+                     if (port, bit) not in fixed)
+    pin = "%s%d" % (port, bit)
+    before = robot.control.pin(pin)
     assert before == (0, "in"), before
-    Select(page.find_element(By.ID, "b-%s-gpio-port" % GW_KEY)).select_by_value("D")
-    Select(page.find_element(By.ID, "b-%s-gpio-bit" % GW_KEY)).select_by_value("6")
+    Select(page.find_element(By.ID, "b-%s-gpio-port" % GW_KEY)).select_by_value(port)
+    Select(page.find_element(By.ID, "b-%s-gpio-bit" % GW_KEY)).select_by_value(str(bit))
     Select(page.find_element(By.ID, "b-%s-gpio-level" % GW_KEY)).select_by_value("1")
     Select(page.find_element(By.ID, "b-%s-gpio-dir" % GW_KEY)).select_by_value("out")
     page.find_element(By.ID, "b-%s-gpio-set" % GW_KEY).click()
-    cell = "b-%s-gpio-D6" % GW_KEY
-    wait_for(page, "PD6 an output, high", lambda d: (
+    cell = "b-%s-gpio-%s" % (GW_KEY, pin)
+    wait_for(page, "P%s an output, high" % pin, lambda d: (
         d.find_element(By.ID, cell).get_attribute("data-output"),
         d.find_element(By.ID, cell).get_attribute("data-level")) == ("1", "1"))
     robot.wait_s(0.001)
-    assert robot.control.pin("D6") == (1, "out")
+    assert robot.control.pin(pin) == (1, "out")
 
 
 def test_motor_control_runs_the_motor(page, robot):
@@ -262,7 +268,10 @@ def test_a_bad_width_is_an_error_and_changes_nothing(page, robot):
 def test_screenshot(page):
     servo_control(page, GW_KEY, 7, 1500)
     wait_for(page, "channel 7 at 1500 us", lambda d: text(d, "b-%s-servo-7" % GW_KEY) == "1500")
-    servo_control(page, GW_KEY, 14, 2100)       # PD5: motor 1 holds it: refused
+    # the servo channel on motor 1's PWM line: the running motor holds it
+    pwm = [p for p in GW_MAP.pins_of("MOTOR_PWM") if p.index == 0][0]
+    shared = [p.index for p in GW_MAP.pins_of("SERVO") if (p.port, p.bit) == (pwm.port, pwm.bit)]
+    servo_control(page, GW_KEY, shared[0], 2100)
     wait_for(page, "the refusal", lambda d: "PIN_BUSY" in (text(d, "message") or ""))
     servo_control(page, SLAVE_KEY, 20, 1800)
     wait_for(page, "the slave's channel 20 at 1800 us",
