@@ -11,7 +11,7 @@ import pytest
 from fake_line import FakeLine
 from orfa import Gateway, PinBusyError, ReplyTimeout, boardmap
 from orfa.cli import main
-from orfa.dash.live import ControlError, Dashboard, Refused, UnknownBoard
+from orfa.dash.live import ControlError, Dashboard, NotFound, Refused
 from test_api_requests import board_answers
 
 flask = pytest.importorskip("flask", reason="orfa dash needs Flask (pip install 'orfa[dash]')")
@@ -88,11 +88,34 @@ def test_a_bad_control_is_refused_before_the_line(dash, kind, body, message):
 
 
 def test_an_unknown_board_or_control(dash):
-    with pytest.raises(UnknownBoard, match=r"no board at '10' here \(boards: AA\)"):
+    with pytest.raises(NotFound, match=r"no board at '10' here \(boards: AA\)"):
         dash.control("10", "servo", {"channel": 3, "us": 1500})
-    with pytest.raises(UnknownBoard, match=r"no control 'spi' \(controls: servo, motor, gpio\)"):
+    with pytest.raises(NotFound, match=r"no control 'spi' \(controls: servo, motor, gpio\)"):
         dash.control(LOCAL, "spi", {})
     assert dash.line.written == []
+
+
+def test_a_board_that_fails_its_reading_shows_the_error(dash):
+    # the scripted line answers nothing but introspection: the status read
+    # gets ERROR 02, the board's card shows it, what it is stays
+    snap = dash.poll()
+    (board,) = snap["boards"]
+    assert board["error"] == "ERROR 02: unknown command letter"
+    assert board["name"] == M32D.name and "servo" not in board
+    assert (snap["seq"], dash.poll()["seq"]) == (1, 2)
+
+
+def test_subscribers_get_the_latest_snapshot_then_none_at_close(dash):
+    first = dash.poll()
+    q = dash.subscribe()
+    assert q.get_nowait() is first
+    second, third = dash.poll(), dash.poll()
+    assert q.get_nowait() is third and second["seq"] == 2     # a slow reader skips
+    dash.close()
+    assert q.get_nowait() is None
+    dash.unsubscribe(q)
+    dash.poll()
+    assert q.empty()
 
 
 def test_the_interval_must_be_positive():
@@ -175,7 +198,7 @@ def test_a_control_posts_json_to_the_dashboard():
 
 @pytest.mark.parametrize("outcome, status, error", [
     (ControlError("servo: channel 16 is outside 0..15"), 400, "servo: channel 16 is outside 0..15"),
-    (UnknownBoard("no board at '12' here (boards: AA)"), 404, "no board at '12' here (boards: AA)"),
+    (NotFound("no board at '12' here (boards: AA)"), 404, "no board at '12' here (boards: AA)"),
     (Refused("PB0 did not change: another function holds it"), 409,
      "PB0 did not change: another function holds it"),
     (PinBusyError(3, 0xAA, "motor PWM1", "write"), 409,

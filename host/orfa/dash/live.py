@@ -23,13 +23,14 @@ from ..cli.common import explain
 from ..gateway import Gateway
 from . import snapshot
 
+
 class ControlError(ValueError):
     """A control request that is wrong in itself (a field missing or out of
     range): the page gets the message, the board is not asked."""
 
 
-class UnknownBoard(KeyError):
-    """No board at that address on this dashboard."""
+class NotFound(KeyError):
+    """No board at that address on this dashboard, or no such control."""
 
     def __str__(self) -> str:
         return self.args[0]
@@ -112,7 +113,7 @@ class Dashboard:
             addr = -1
         found = self.boards.get(snapshot.address_key(addr)) if 0 <= addr <= 0xFF else None
         if found is None:
-            raise UnknownBoard("no board at %r here (boards: %s)"
+            raise NotFound("no board at %r here (boards: %s)"
                                % (key, ", ".join(self.boards) or "none"))
         return found
 
@@ -145,6 +146,8 @@ class Dashboard:
                     state = snapshot.read(board)
             except (p.OrfaError, OSError) as exc:
                 state = {"error": explain(exc)}
+            except Exception as exc:       # a bug: shown, and the poller goes on
+                state = {"error": "%s: %s" % (type(exc).__name__, exc)}
             states.append(dict(self.info[key], **state))
         self.seq += 1
         snap = {"seq": self.seq, "time": round(time.time(), 3), "interval": self.interval,
@@ -194,12 +197,12 @@ class Dashboard:
     # --- the controls -------------------------------------------------------------
     def control(self, key: str, kind: str, body: object) -> Dict[str, object]:
         """Run a control ("servo", "motor", "gpio") with its JSON body on the
-        board at `key`; what was set. UnknownBoard, ControlError (bad
+        board at `key`; what was set. NotFound, ControlError (bad
         request), Refused or an OrfaError (the board's answer)."""
         board = self.board(key)
         action = CONTROLS.get(kind)
         if action is None:
-            raise UnknownBoard("no control %r (controls: %s)" % (kind, ", ".join(CONTROLS)))
+            raise NotFound("no control %r (controls: %s)" % (kind, ", ".join(CONTROLS)))
         if not isinstance(body, dict):
             raise ControlError("%s: the body must be a JSON object" % kind)
         info = self.info[snapshot.address_key(board.addr)]

@@ -24,7 +24,7 @@ from flask import Flask, Response, jsonify, request
 from werkzeug.serving import make_server
 
 from .. import protocol as p
-from .live import ControlError, Dashboard, Refused, UnknownBoard, explain
+from .live import ControlError, Dashboard, NotFound, Refused, explain
 
 #: Seconds between SSE comments while no snapshot comes (a stream to a
 #: browser that went away ends at the next write).
@@ -59,7 +59,7 @@ def create_app(dash: Dashboard) -> Flask:
                           % kind, 400)
         try:
             return jsonify(dash.control(addr, kind, body))
-        except UnknownBoard as exc:
+        except NotFound as exc:
             return _error(str(exc), 404)
         except ControlError as exc:
             return _error(str(exc), 400)
