@@ -6,6 +6,7 @@ live simulated board through its control socket (`orfa plot --sim BOARD`,
 from __future__ import annotations
 
 import argparse
+import os
 import fnmatch
 import re
 import shlex
@@ -169,7 +170,7 @@ def _from_file(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]
     boards = trace.board_of()
     if args.board:
         boards[""] = args.board
-    return found, names, Namer(names, boards), f, args.trace
+    return found, names, Namer(names, boards), f, os.path.basename(args.trace)
 
 
 def _run_commands(port: str, args) -> None:
@@ -201,7 +202,8 @@ def _record(ctl: SimControl, f_cpu: int, args, commands
     edges: Dict[str, List[Tuple[int, int]]] = {n: [] for n in names}
     commands()
     since = t0
-    end = ctl.time() + _cycles(args.span, f_cpu)
+    zero = ctl.time()
+    end = zero + _cycles(args.span, f_cpu)
     lost = []
     while since < end:
         # one batch: the edges are read at the cycle the wait ends
@@ -218,7 +220,7 @@ def _record(ctl: SimControl, f_cpu: int, args, commands
         print("orfa: plot: %s changed too fast to record every edge live; write a VCD"
               " (orfa sim --vcd) for those" % " ".join(lost), file=sys.stderr)
     found = {n: waves.window(n, levels[n], edges[n], t0, since) for n in names}
-    return found, names, t0
+    return found, names, zero
 
 
 def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]:
@@ -234,6 +236,7 @@ def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]:
         try:
             t0 = sim.control.time()
             _run_commands(sim.port, args)
+            zero = sim.control.time()
             t1 = sim.control.wait(_cycles(args.span, boardmap.load(args.sim).f_cpu))
             sim.stop(keep_dir=True)
             trace = vcd.load(str(sim.vcd_path))
@@ -241,7 +244,8 @@ def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]:
             sim.stop()
         names = trace.names()
         found = {n: waves.window(n, trace.initial[n], trace.edges(n), t0, t1) for n in names}
-        return found, names, Namer(names, trace.board_of()), trace.f_cpu, "simulated %s" % args.sim
+        return (found, names, Namer(names, trace.board_of()), trace.f_cpu,
+                "simulated %s" % args.sim, zero)
     if args.do and not args.port:
         raise UsageError("--do with --control needs the board's --port (orfa sim prints it)")
     try:
@@ -252,23 +256,24 @@ def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]:
         names = ctl.signals()
         namer = Namer(names, {"": args.board} if args.board else None)
         main_map = namer.maps.get("") or boardmap.load("m32d")
-        found, names, t0 = _record(ctl, main_map.f_cpu, args,
+        found, names, zero = _record(ctl, main_map.f_cpu, args,
                                    lambda: _run_commands(args.port, args))
-    return found, names, namer, main_map.f_cpu, "simulator at %s" % args.control
+    return found, names, namer, main_map.f_cpu, "simulator at %s" % args.control, zero
 
 
-def _narrow(found: Dict[str, waves.Wave], args, f_cpu: int) -> Dict[str, waves.Wave]:
-    """Live: --from/--to count from the start of the recording."""
+def _narrow(found: Dict[str, waves.Wave], args, f_cpu: int, zero: int
+            ) -> Dict[str, waves.Wave]:
+    """Live: --from/--to count from the end of the --do commands (the start
+    of --for); the recording's whole window without them."""
     if args.start is None and args.stop is None:
         return found
     out = {}
     for n, w in found.items():
-        start = w.start + (_cycles(args.start, f_cpu) if args.start is not None else 0)
-        end = w.start + _cycles(args.stop, f_cpu) if args.stop is not None else w.end
+        start = zero + _cycles(args.start, f_cpu) if args.start is not None else w.start
+        end = zero + _cycles(args.stop, f_cpu) if args.stop is not None else w.end
         if end <= start:
             raise UsageError("--to must be after --from")
-        initial = w.level
-        out[n] = waves.window(n, initial, w.edges, start, min(end, w.end))
+        out[n] = waves.window(n, w.level, w.edges, max(start, w.start), min(end, w.end))
     return out
 
 
@@ -303,8 +308,8 @@ def cmd_plot(args) -> int:
     if args.do and not live:
         raise UsageError("--do runs commands on a live board: give --sim or --control")
     if live:
-        found, names, namer, f_cpu, source = _from_sim(args)
-        found = _narrow(found, args, f_cpu)
+        found, names, namer, f_cpu, source, zero = _from_sim(args)
+        found = _narrow(found, args, f_cpu, zero)
     else:
         found, names, namer, f_cpu, source = _from_file(args)
     patterns = [p for item in (args.signals or ()) for p in item.split(",") if p]
@@ -350,8 +355,8 @@ def add_parsers(sub, common) -> None:
                           " D5, 10/servo3) or patterns ('servo*'), also comma separated;"
                           " default: the servo, motor, SPI, I2C and UART lines that change")
     cmd.add_argument("--from", dest="start", type=parse_time, metavar="T",
-                     help="window start (1500, 1500us, 1.5ms, 0.02s); live: from the"
-                          " start of the recording")
+                     help="window start (1500, 1500us, 1.5ms, 0.02s); live: counted from"
+                          " the end of the --do commands")
     cmd.add_argument("--to", dest="stop", type=parse_time, metavar="T", help="window end")
     cmd.add_argument("--for", dest="span", type=parse_time, default=float(DEFAULT_FOR_US),
                      metavar="T", help="live: simulated time to record (default 50ms)")
