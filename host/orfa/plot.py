@@ -49,6 +49,11 @@ def annotations(rows: Sequence[Row], f_cpu: int) -> List[Annotation]:
     return out
 
 
+def require() -> None:
+    """PlotUnavailable (saying what to install) when matplotlib is missing."""
+    _matplotlib()
+
+
 def _matplotlib():
     try:
         import matplotlib

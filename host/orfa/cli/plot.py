@@ -302,6 +302,10 @@ def _trim(found: Dict[str, waves.Wave], chosen: Sequence[str]) -> Dict[str, wave
 
 
 def cmd_plot(args) -> int:
+    try:
+        drawing.require()                   # before a board starts and commands run
+    except drawing.PlotUnavailable as exc:
+        raise UsageError(str(exc)) from None
     live = args.sim is not None or args.control is not None
     if not live and not args.trace:
         raise UsageError("give a VCD file (orfa sim --vcd FILE) or --sim BOARD or --control PATH")
