@@ -9,6 +9,8 @@ definitions by `make map`).
 
 The Russian texts are tools/docgen_ru.py's, keyed by the map's names: a name
 the map has and that file lacks stops docgen (exit 1) with the names missing.
+Hand-written pages may hold generated tables between `<!-- docgen:NAME -->`
+and `<!-- /docgen:NAME -->` (BLOCKS): docs/ru/protocol.md's error codes.
 """
 
 from __future__ import annotations
@@ -239,6 +241,33 @@ def page_ru(board: str) -> str:
     return "\n".join(out)
 
 
+def errors_table_ru() -> str:
+    """The protocol's error codes, for docs/ru/protocol.md."""
+    missing = ["error %s" % c.name for c in boardmap.ERRORS.values() if c.name not in ru.ERRORS]
+    if missing:
+        raise MissingText("protocol: no Russian text for %s (add it to tools/docgen_ru.py)"
+                          % ", ".join(missing))
+    out = [ru.TEXT["errors_head"], "|---|---|---|"]
+    out += ["| `ERROR %02X` | %s | %s |" % (c.code, c.name, ru.ERRORS[c.name])
+            for c in boardmap.ERRORS.values()]
+    return "\n".join(out)
+
+
+#: Hand-written pages with generated blocks: `<!-- docgen:NAME -->` ...
+#: `<!-- /docgen:NAME -->` holds NAME's table.
+BLOCKS = {("ru", "docs/ru/protocol.md"): {"errors": errors_table_ru}}
+
+
+def fill_blocks(text: str, blocks) -> str:
+    for name, make in blocks.items():
+        begin, end = "<!-- docgen:%s -->\n" % name, "<!-- /docgen:%s -->" % name
+        head, found, rest = text.partition(begin)
+        if not found or end not in rest:
+            raise MissingText("no block %s%s in the page" % (begin.strip(), end))
+        text = head + begin + make() + "\n" + end + rest.partition(end)[2]
+    return text
+
+
 def pages(langs=LANGS) -> Dict[Path, str]:
     out = {}
     for b in boardmap.BOARDS:
@@ -246,6 +275,10 @@ def pages(langs=LANGS) -> Dict[Path, str]:
             out[ROOT / "docs" / ("board-%s.md" % b)] = page(b)
         if "ru" in langs:
             out[ROOT / "docs" / "ru" / ("board-%s.md" % b)] = page_ru(b)
+    for (lang, name), blocks in BLOCKS.items():
+        if lang in langs:
+            path = ROOT / name
+            out[path] = fill_blocks(path.read_text(), blocks)
     return out
 
 

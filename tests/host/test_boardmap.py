@@ -51,11 +51,24 @@ def docgen(monkeypatch):
 def test_docgen_writes_both_languages(docgen):
     names = sorted(str(p.relative_to(ROOT)) for p in docgen.pages())
     assert names == ["docs/board-m128s.md", "docs/board-m32d.md",
-                     "docs/ru/board-m128s.md", "docs/ru/board-m32d.md"]
+                     "docs/ru/board-m128s.md", "docs/ru/board-m32d.md",
+                     "docs/ru/protocol.md"]
     ru = docgen.pages(("ru",))[ROOT / "docs" / "ru" / "board-m32d.md"]
     assert "## Значения регистра статуса" in ru
     for c in boardmap.STATUS.values():
         assert "| `%02X` | %s | %s |" % (c.code, c.name, docgen.ru.STATUS[c.name]) in ru
+
+
+def test_docgen_fills_the_error_table_of_the_russian_protocol_page(docgen, tmp_path):
+    text = (ROOT / "docs" / "ru" / "protocol.md").read_text()
+    assert docgen.fill_blocks(text, {"errors": docgen.errors_table_ru}) == text
+    stale = text.replace("| `ERROR 05` | NO_P |", "| `ERROR 05` | OLD |")
+    assert stale != text
+    assert docgen.fill_blocks(stale, {"errors": docgen.errors_table_ru}) == text
+    for c in boardmap.ERRORS.values():
+        assert "| `ERROR %02X` | %s | %s |" % (c.code, c.name, docgen.ru.ERRORS[c.name]) in text
+    with pytest.raises(docgen.MissingText, match="no block <!-- docgen:errors -->"):
+        docgen.fill_blocks("# no table here\n", {"errors": docgen.errors_table_ru})
 
 
 def test_docgen_refuses_a_status_without_russian(docgen, monkeypatch, capsys):
