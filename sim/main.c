@@ -189,7 +189,8 @@ typedef struct sim_args_t {
 	int slave_count;
 } sim_args_t;
 
-/* The I2C addresses SPEC section 4 reserves (8-bit 0x00-0x0F, 0xF0-0xFF). */
+/* The I2C addresses a slave may not take (8-bit 0x00-0x0F, 0xF0-0xFF;
+ * docs/registers.md, "On a slave board"). */
 static int sim_addr_reserved(uint8_t addr8)
 {
 	return addr8 < 0x10 || addr8 >= 0xf0;
