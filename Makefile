@@ -24,8 +24,9 @@ BAUD ?= 115200
 ADDR ?= 0x10
 
 BOARDS := m32d m128s
-# The serial rates of SPEC section 2: a fixed-rate build takes one, BAUD=auto
-# detects them all (firmware/autobaud.c, host/orfa/boards.py reads this line).
+# The serial rates of docs/protocol.md ("The line"): a fixed-rate build takes
+# one, BAUD=auto detects them all (firmware/autobaud.c, host/orfa/boards.py
+# reads this line).
 BAUD_RATES := 2400 4800 9600 14400 19200 28800 38400 57600 76800 115200
 ifeq ($(filter $(BAUD),$(BAUD_RATES) auto),)
 $(error BAUD=$(BAUD) is not a rate of the line: use one of $(BAUD_RATES), or auto)
@@ -37,8 +38,9 @@ $(error BOARD=$(BOARD): no such board (boards/: $(notdir $(wildcard boards/*))))
 endif
 include boards/$(BOARD)/board.mk
 
-# The slave's bus address, 8-bit form (SPEC section 4): even, and not one of
-# the 7-bit addresses I2C reserves (8-bit 0x00-0x0F and 0xF0-0xFE).
+# The slave's bus address, 8-bit form (docs/registers.md, "On a slave board"):
+# even, and not one of the 7-bit addresses I2C reserves (8-bit 0x00-0x0F and
+# 0xF0-0xFE).
 ifeq ($(MODE),slave)
 ADDR_NUM := $(shell v=$$(printf '%d' '$(ADDR)' 2>/dev/null) && echo $$v)
 ifeq ($(strip $(ADDR)),)
@@ -230,7 +232,7 @@ test: setup
 
 # The pictures in docs/img/: each test file here saves its images in
 # $ORFA_SHOTS (default build/shots/); add a file to draw one more.
-DOC_IMAGE_TESTS := tests/sim/test_dash.py
+DOC_IMAGE_TESTS := tests/sim/test_dash.py tests/sim/test_plot.py
 doc-images:
 	@$(MAKE) --no-print-directory all-boards robot sim
 	ORFA_SHOTS=docs/img python3 -m pytest -q $(DOC_IMAGE_TESTS)
@@ -240,7 +242,7 @@ bench: setup
 	python3 tools/bench.py
 
 # Seeded random requests against a simulated robot, every reply compared with
-# the reference model of SPEC (tests/sim/spec_model.py); docs/testing.md.
+# the reference model of the protocol (tests/sim/spec_model.py); docs/testing.md.
 SOAK_REQUESTS ?= 100000
 SOAK_SEED ?= 8
 soak: setup

@@ -1,4 +1,4 @@
-/* GPIO driver (SPEC section 3): UID from the board (0x0020 M32-D, 0x0021
+/* GPIO driver (docs/registers.md, "GPIO"): UID from the board (0x0020 M32-D, 0x0021
  * M128-S), N ports: registers R..R+N-1 values, R+N..R+2N-1 modes. */
 #ifndef DRV_GPIO_H
 #define DRV_GPIO_H

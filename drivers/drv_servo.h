@@ -1,4 +1,4 @@
-/* RC servo driver (SPEC section 3): registers RS (compatibility) and SP. */
+/* RC servo driver (docs/registers.md, "Servos"): registers RS (compatibility) and SP. */
 #ifndef DRV_SERVO_H
 #define DRV_SERVO_H
 

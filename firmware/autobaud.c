@@ -1,6 +1,6 @@
 /*
  * BAUD=auto: the line's rate found from the PC's preamble of 0x0D
- * characters (SPEC section 2; design in docs/protocol.md, "Autobaud").
+ * characters (docs/protocol.md, "Autobaud", also the design).
  *
  * 0x0D in 8N1 is, in bit times: low 1 (start), high 1, low 1, high 2,
  * low 4, then the stop bit. The RXD pin is timed by counting loop

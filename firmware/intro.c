@@ -16,7 +16,7 @@ reg_status_t drv_intro_write(uint8_t reg, const uint8_t *data, uint8_t len)
 		return REG_BAD_LENGTH;
 	}
 	if (data[0] > regmap_driver_count()) {
-		/* SPEC: an N above the count is an error and the next read gives
+		/* docs/registers.md: an N above the count is an error and the next read gives
 		 * driver 1. */
 		intro_cursor = 1;
 		return REG_BAD_VALUE;

@@ -1,7 +1,8 @@
 /*
  * Pin ownership: every pin belongs to at most one function at a time
- * (SPEC section 1). GPIO has every pin of its ports that nobody else holds;
- * a driver that wants a pin held by another function is refused.
+ * (docs/registers.md, "Register maps"). GPIO has every pin of its ports that
+ * nobody else holds; a driver that wants a pin held by another function is
+ * refused.
  */
 #ifndef ORFA_PINS_H
 #define ORFA_PINS_H

@@ -1,7 +1,7 @@
 /*
  * The register map: a table in flash, built at compile time from the board's
  * driver list, that routes register reads and writes to drivers
- * (SPEC section 3). Both front ends (serial gateway, I2C slave) use it.
+ * (docs/registers.md). Both front ends (serial gateway, I2C slave) use it.
  */
 #ifndef ORFA_REGMAP_H
 #define ORFA_REGMAP_H
@@ -32,7 +32,7 @@ typedef enum {
 
 #define REGMAP_INTRO_REG   0x00
 #define REGMAP_STATUS_REG  0x01
-/* Longest read a driver is asked for at once (SPEC: 64-byte buffer). */
+/* Longest read a driver is asked for at once (docs/registers.md: 64 bytes). */
 #define REGMAP_READ_MAX    64
 
 /*
@@ -46,7 +46,8 @@ typedef enum {
  *       arrived: REG_OK, or why no write that starts so can be taken
  *       (whatever follows). Looks at the newest byte only, changes nothing,
  *       and is quick: a TWI slave asks it in its interrupt, to refuse the
- *       byte after (SPEC section 4). drv_name_write decides in the end.
+ *       byte after (docs/registers.md, "On a slave board"). drv_name_write
+ *       decides in the end.
  *   uint8_t drv_name_read(uint8_t reg, uint8_t *dst, uint8_t max);
  *       puts up to `max` bytes of the register's data at `dst` and returns
  *       how many; 0 means the register cannot be read. The regmap asks again

@@ -1,5 +1,5 @@
 /*
- * xact: register transactions one byte at a time (SPEC section 3), shared by
+ * xact: register transactions one byte at a time (docs/registers.md, "Frames"), shared by
  * both front ends. The serial gateway's local path and the TWI slave call the
  * same five events, in the shape of Zephyr's I2C target callbacks:
  *

@@ -1,7 +1,7 @@
 /*
- * The TWI slave's decisions (SPEC section 4), free of hardware: one call per
- * TWI event with its status code (avr-libc's TW_* names), one action back
- * for the thin interrupt layer in i2c_slave.c to put into TWCR/TWDR. Host
+ * The TWI slave's decisions (docs/registers.md, "On a slave board"), free of
+ * hardware: one call per TWI event with its status code (avr-libc's TW_*
+ * names), one action back for the thin interrupt layer in i2c_slave.c to put into TWCR/TWDR. Host
  * unit tests drive it with status sequences as the AVR TWI produces them.
  *
  * What the hardware decides first, and what follows here:

@@ -1,5 +1,5 @@
 /*
- * Executes a parsed request and writes its reply line (SPEC section 2).
+ * Executes a parsed request and writes its reply line (docs/protocol.md).
  * Hardware is reached only through twi_master.h, regmap.h and sg_out(), so
  * the executor is also compiled and tested on the host with fakes of them.
  */

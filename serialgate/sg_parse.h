@@ -1,5 +1,5 @@
 /*
- * The serial gateway's request parser (SPEC section 2, docs/protocol.md).
+ * The serial gateway's request parser (docs/protocol.md).
  *
  * Pure: no hardware, so it also compiles and is tested on the host. It takes
  * one character at a time as the UART delivers it, so that when a line's

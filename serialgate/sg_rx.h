@@ -1,9 +1,9 @@
 /*
  * The serial line's receive ring: characters in from the receive interrupt,
  * out to the parser in the main loop. When the ring overflows (a host that
- * breaks SPEC's flow rule), the characters lost are not silently dropped:
- * the ring writes what the parser needs so that every request still gets
- * exactly one reply, a lost one `ERROR 04` (SPEC section 2).
+ * breaks the flow rule of docs/protocol.md), the characters lost are not
+ * silently dropped: the ring writes what the parser needs so that every
+ * request still gets exactly one reply, a lost one `ERROR 04` (docs/protocol.md, "Flow").
  *
  * Pure: no hardware, so it compiles and is tested on the host too. The
  * interrupt calls sg_rx_put(), the main loop sg_rx_get() and, with
@@ -18,7 +18,7 @@
 /* 8-bit indices wrap for free. The ring holds 252 characters and keeps three
  * slots for the record of a lost run; with the line the parser holds while a
  * request executes, a host with fewer than 256 characters of requests
- * unanswered (SPEC) never overflows it. */
+ * unanswered (docs/protocol.md, "Flow") never overflows it. */
 #define SG_RX_SIZE 256
 #define SG_RX_RECORD 3
 

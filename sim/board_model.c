@@ -745,7 +745,7 @@ static void bm_hook_ocr(board_model_t *bm, avr_timer_t *t, uint16_t addr)
 
 /*
  * Writing TIFR / ETIFR: a 1 clears that flag, a 0 leaves it. simavr 1.6
- * clears every timer flag that is set whatever the value (SIMAVR-NOTES),
+ * clears every timer flag that is set whatever the value (docs/simulator.md),
  * so one flag cleared before enabling an interrupt would drop another
  * counter's pending compare. The board model owns these registers.
  */

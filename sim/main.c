@@ -44,6 +44,7 @@ typedef struct sim_t {
 	sim_board_t slave[SIM_MAX_SLAVES];
 	int twar_checked[WORLD_MAX_BOARDS];	/* slave's TWAR compared with --slave */
 	pty_t pty;
+	signal_t bus_busy;		/* "i2c", a signal of the gateway's */
 	vcd_t vcd;
 	control_t control;
 	int idle_throttle;
@@ -188,7 +189,8 @@ typedef struct sim_args_t {
 	int slave_count;
 } sim_args_t;
 
-/* The I2C addresses SPEC section 4 reserves (8-bit 0x00-0x0F, 0xF0-0xFF). */
+/* The I2C addresses a slave may not take (8-bit 0x00-0x0F, 0xF0-0xFF;
+ * docs/registers.md, "On a slave board"). */
 static int sim_addr_reserved(uint8_t addr8)
 {
 	return addr8 < 0x10 || addr8 >= 0xf0;
@@ -426,12 +428,15 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 }
 
 /* One VCD for every board: the gateway's signals in scope `board` under
- * their own names, a slave's in scope `board_10` as `10/servo3`. */
+ * their own names, a slave's in scope `board_10` as `10/servo3`; each
+ * scope's comment names its board ("board m32d OR-AVR-M32-D"). */
 static int sim_open_vcd(sim_t *sim, const char *path)
 {
 	static char scope[WORLD_MAX_BOARDS][16], prefix[WORLD_MAX_BOARDS][8];
+	static char about[WORLD_MAX_BOARDS][48];
 	signals_t *sets[WORLD_MAX_BOARDS];
 	const char *scopes[WORLD_MAX_BOARDS], *prefixes[WORLD_MAX_BOARDS];
+	const char *abouts[WORLD_MAX_BOARDS];
 	world_t *w = &sim->world;
 
 	for (int i = 0; i < w->nboards; i++) {
@@ -439,11 +444,15 @@ static int sim_open_vcd(sim_t *sim, const char *path)
 
 		snprintf(scope[i], sizeof(scope[i]), i ? "board_%s" : "board", b->prefix);
 		snprintf(prefix[i], sizeof(prefix[i]), i ? "%s/" : "", b->prefix);
+		snprintf(about[i], sizeof(about[i]), "board %s %s", b->board->name,
+			 b->board->title);
 		sets[i] = &b->bm.signals;
 		scopes[i] = scope[i];
 		prefixes[i] = prefix[i];
+		abouts[i] = about[i];
 	}
-	return vcd_open(&sim->vcd, path, SIM_FREQUENCY, sets, scopes, prefixes, w->nboards);
+	return vcd_open(&sim->vcd, path, SIM_FREQUENCY, sets, scopes, prefixes, abouts,
+			w->nboards);
 }
 
 /* Build the world: the bus and its EEPROMs, the gateway board with its
@@ -472,6 +481,11 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 		return rc;
 	}
 	w->boards[w->nboards++] = gw;
+	if (signal_add(&gw->bm.signals, &sim->bus_busy, "i2c", 0) < 0) {
+		fprintf(stderr, "orfa-sim: too many signals\n");
+		return 1;
+	}
+	w->bus.busy_signal = &sim->bus_busy;
 	for (int i = 0; i < args->slave_count; i++) {
 		rc = sim_board_init(&sim->slave[i], args->slave_board[i], args->slave_elf[i],
 				    args->slave_addr[i], &w->bus, &w->trace, sim_discard, NULL);

@@ -121,7 +121,8 @@ static void vcd_id(int index, char *out)
 }
 
 int vcd_open(vcd_t *v, const char *path, uint32_t frequency, signals_t *const *sets,
-	     const char *const *scope, const char *const *prefix, int n)
+	     const char *const *scope, const char *const *prefix,
+	     const char *const *about, int n)
 {
 	char id[3];
 	int base = 0;
@@ -141,6 +142,9 @@ int vcd_open(vcd_t *v, const char *path, uint32_t frequency, signals_t *const *s
 		set->vcd = v;
 		set->vcd_base = base;
 		fprintf(v->file, "$scope module %s $end\n", scope[k]);
+		if (about && about[k]) {
+			fprintf(v->file, "$comment %s $end\n", about[k]);
+		}
 		for (int i = 0; i < set->count; i++) {
 			vcd_id(base + i, id);
 			fprintf(v->file, "$var wire 1 %s %s%s $end\n", id, prefix[k],

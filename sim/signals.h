@@ -84,9 +84,11 @@ const signal_edge_t *signal_edge(const signal_t *s, unsigned i);
 
 /* A VCD at PATH of every signal of the N sets (call after all signal_add):
  * set i in scope SCOPE[i], each signal named PREFIX[i] followed by its own
- * name. 0 or -1 with errno. */
+ * name, the scope's comment ABOUT[i] (ABOUT or ABOUT[i] NULL: none). 0 or
+ * -1 with errno. */
 int vcd_open(vcd_t *v, const char *path, uint32_t frequency, signals_t *const *sets,
-	     const char *const *scope, const char *const *prefix, int n);
+	     const char *const *scope, const char *const *prefix,
+	     const char *const *about, int n);
 
 /* Write buffered VCD events older than NOW - SIGNALS_VCD_LAG cycles (all
  * with ALL). */

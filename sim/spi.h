@@ -1,7 +1,8 @@
 /*
  * spi.h: the simulator's own SPI master model, replacing simavr 1.6's
  * (every byte 743 cycles whatever SPR/SPI2X say, no modes; see
- * SIMAVR-NOTES.md), and the bus of virtual SPI devices behind it.
+ * docs/simulator.md, "What simavr 1.6 gets wrong"), and the bus of virtual SPI
+ * devices behind it.
  *
  * Registers SPCR/SPSR/SPDR are taken over after avr_init. Master mode:
  * a write to SPDR starts a byte; it takes 8 SCK periods, SCK period =

@@ -1,8 +1,8 @@
 /*
  * twi.h: the simulator's own model of the AVR TWI, replacing simavr 1.6's
  * (TWINT not cleared by writing 1, wrong address-phase status codes, bit
- * rate ignored: see SIMAVR-NOTES.md). It takes over TWBR/TWSR/TWAR/TWDR/TWCR
- * after avr_init and drives a twi_bus_t.
+ * rate ignored: see docs/simulator.md, "What simavr 1.6 gets wrong"). It takes
+ * over TWBR/TWSR/TWAR/TWDR/TWCR after avr_init and drives a twi_bus_t.
  *
  * Master mode follows the datasheet (status codes 08..58, 38, F8; TWINT,
  * TWEA, TWSTA, TWSTO, TWWC, TWEN, TWIE). Timing: SCL period

@@ -23,6 +23,7 @@ void twi_bus_init(twi_bus_t *bus, trace_t *trace)
 	bus->hold_scl = 0;
 	bus->pins = NULL;
 	bus->nlisteners = 0;
+	bus->busy_signal = NULL;
 }
 
 void twi_bus_attach(twi_bus_t *bus, twi_dev_t *dev)
@@ -44,6 +45,9 @@ void twi_bus_start(twi_bus_t *bus, uint64_t cycle)
 	bus->selected = NULL;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi start");
+	if (bus->busy_signal) {
+		signal_set(bus->busy_signal, cycle, 1);
+	}
 	for (twi_dev_t *d = bus->devs; d; d = d->next) {
 		if (d->ops->bus_start) {
 			d->ops->bus_start(d);
@@ -101,6 +105,9 @@ void twi_bus_stop(twi_bus_t *bus, uint64_t cycle)
 	bus->busy = 0;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi stop");
+	if (bus->busy_signal) {
+		signal_set(bus->busy_signal, cycle, 0);
+	}
 }
 
 /* Does a hold HOW stop an operation OP? */

@@ -17,6 +17,7 @@
 
 #include <stdint.h>
 
+#include "signals.h"
 #include "trace.h"
 
 typedef struct twi_dev_t twi_dev_t;
@@ -104,6 +105,9 @@ typedef struct twi_bus_t {
 	twi_line_fn listener[TWI_BUS_LISTENERS];
 	void *listener_param[TWI_BUS_LISTENERS];
 	int nlisteners;
+	/* the signal "i2c": 1 from the end of a START to the end of its STOP,
+	 * the bus's activity in the VCD and to `edges` (NULL: none) */
+	signal_t *busy_signal;
 } twi_bus_t;
 
 void twi_bus_init(twi_bus_t *bus, trace_t *trace);

@@ -1,8 +1,9 @@
 /*
  * usart.h: the simulator's own model of one AVR USART (asynchronous mode),
  * replacing simavr 1.6's (wrong byte times, no URSEL, UDRE bug, no overrun:
- * see SIMAVR-NOTES.md). It takes over the USART's registers after avr_init
- * and paces both directions of the wire in CPU cycles:
+ * see docs/simulator.md, "What simavr 1.6 gets wrong"). It takes over the
+ * USART's registers after avr_init and paces both directions of the wire in
+ * CPU cycles:
  *
  *   byte time = bit time * (1 start + data + parity + stop bits),
  *   bit time  = 16 * (UBRR + 1) cycles, 8 * (UBRR + 1) with U2X.

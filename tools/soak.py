@@ -3,9 +3,10 @@
 
     python3 tools/soak.py --requests 100000 --seed 8
 
-Seeded random requests, pipelined within SPEC's flow rule, against a
-simulated M32-D gateway with an EEPROM at A0 and an M128-S slave at 0x10;
-every reply compared with the reference model (tests/sim/spec_model.py).
+Seeded random requests, pipelined within the flow rule (docs/protocol.md),
+against a simulated M32-D gateway with an EEPROM at A0 and an M128-S slave
+at 0x10; every reply compared with the reference model
+(tests/sim/spec_model.py).
 Prints the figures at the end; exits 1 at the first difference (with the
 seed, the request's index, the request, expected and got)."""
 
@@ -24,7 +25,7 @@ def main() -> int:
     ap.add_argument("--requests", type=int, default=100000)
     ap.add_argument("--seed", type=int, default=8)
     ap.add_argument("--no-long-blank", action="store_true",
-                    help="no lines of 129 or more spaces (SPEC: empty, no reply)")
+                    help="no lines of 129 or more spaces (empty: no reply)")
     args = ap.parse_args()
     try:
         fig = run_soak(args.requests, args.seed, long_blank=not args.no_long_blank,

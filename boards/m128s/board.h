@@ -1,7 +1,7 @@
 /*
  * OR-AVR-M128-S: ATmega128 at 7.3728 MHz.
  *
- * Pin map (SPEC section 1):
+ * Pin map (docs/boards.md, docs/board-m128s.md):
  *
  *   port  7     6     5     4     3     2     1     0
  *   A     IO7   IO6   IO5   IO4   IO3   IO2   IO1   IO0    GPIO port A

@@ -1,7 +1,7 @@
 /*
  * OR-AVR-M32-D: ATmega32 at 7.3728 MHz.
  *
- * Pin map (SPEC section 1, reference wiring of the original board):
+ * Pin map (docs/boards.md, docs/board-m32d.md; reference wiring of the original board):
  *
  *   port  7     6     5     4     3     2     1     0
  *   A     S7    S6    S5    S4    S3    S2    S1    S0     servos 0-7 = ADC 7-0 = GPIO A

@@ -1,7 +1,7 @@
 # OR-AVR-M32-D: ATmega32 at 7.3728 MHz.
 BOARD_MCU := atmega32
 BOARD_F_CPU := 7372800UL
-# Drivers after introspection, in register order (SPEC section 1).
+# Drivers after introspection, in register order (docs/board-m32d.md).
 BOARD_DRIVERS := gpio spi adc motor servo
 # Servo pulse hardware: one MCU pin per channel, edges as planned.
 BOARD_SERVO_HW := servo_pins servo_plan

@@ -62,7 +62,7 @@ int orfa_read(orfa_t *o, uint8_t address, size_t count);
  * frame was refused (its error again) or the transaction is empty
  * (ORFA_E_ARG). Requests may be committed back to back without reading their
  * results (pipelining): when the requests in flight would overflow the
- * gateway's receive buffer (SPEC's flow rule) the commit first waits for
+ * gateway's receive buffer (the flow rule of docs/protocol.md) the commit first waits for
  * replies, keeping them for orfa_read_reply. */
 int orfa_tr_commit(orfa_t *o);
 

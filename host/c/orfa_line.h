@@ -10,7 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* The protocol's limits (SPEC section 2): characters of a request before its
+/* The protocol's limits (docs/protocol.md, "Limits"): characters of a request before its
  * terminator, of a reply before CR LF. orfa_line.c checks them against the
  * firmware's own definitions. */
 #define ORFA_REQUEST_MAX 128

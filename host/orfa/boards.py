@@ -1,4 +1,4 @@
-"""What the host knows of each board (SPEC section 1), from the board maps
+"""What the host knows of each board (docs/boards.md), from the board maps
 (orfa.boardmap: generated from the firmware's C definitions)."""
 
 from . import boardmap

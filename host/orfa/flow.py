@@ -1,8 +1,8 @@
 """Pipelining rules, pure: how many requests may be in flight, and which
 reply lines could answer a request (anything else is noise).
 
-SPEC section 2's flow rule: the firmware's receive buffer holds at least 256
-characters, so a host keeps fewer than 256 characters of requests (each with
+The flow rule of docs/protocol.md ("Flow"): the firmware's receive buffer holds
+at least 256 characters, so a host keeps fewer than 256 characters of requests (each with
 its terminator) unanswered. The gateway answers every request with exactly
 one line, in order.
 """

@@ -47,7 +47,7 @@ def os_reason(e: BaseException, errno: bool = True) -> str:
 Reply = Union[str, p.OrfaError]
 
 
-#: The status register: introspection's second, on every board (SPEC 3).
+#: The status register: introspection's second, on every board (docs/registers.md).
 _STATUS_REGISTER = boardmap.load(boardmap.BOARDS[0]).reg("intro", "STATUS")
 
 
@@ -76,7 +76,7 @@ class Gateway:
 
     def preamble(self, wait: Optional[Callable[[float], None]] = None) -> None:
         """Send the autobaud preamble at the port's rate, then stay quiet
-        until the firmware listens (SPEC section 2). `wait(seconds)` passes
+        until the firmware listens (docs/protocol.md, "Autobaud"). `wait(seconds)` passes
         that time: a simulator's simulated clock (SimBoard.wait_s); by
         default time.sleep, for a real board. Empty lines to a firmware of
         a fixed rate (no reply)."""
@@ -133,7 +133,7 @@ class Gateway:
         self.send(data)
         return [self.read_reply() for _ in lines]
 
-    # --- batches: many requests in flight (SPEC section 2, flow) -----------------
+    # --- batches: many requests in flight (docs/protocol.md, "Flow") -----------------
     def run(self, lines: Sequence[str]) -> List[str]:
         """Send every request, pipelined, and return their reply texts in
         order (`ERROR xx` replies included, as request() does).

@@ -29,7 +29,7 @@ F_CPU = 7372800
 #: The clock asked for at reset (100 kHz; the TWI makes 99.632 kHz).
 DEFAULT_CLOCK_KHZ = 0x64
 
-#: The serial line's rates (SPEC section 2); the Makefile's BAUD_RATES is
+#: The serial line's rates (docs/protocol.md, "The line"); the Makefile's BAUD_RATES is
 #: the source (a host test keeps the two equal).
 BAUD_RATES = (2400, 4800, 9600, 14400, 19200, 28800, 38400, 57600, 76800, 115200)
 DEFAULT_BAUD = 115200

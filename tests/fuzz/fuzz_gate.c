@@ -1,7 +1,7 @@
 /*
  * The serial gateway under fuzz: bytes into sg_parse_char() as the UART
  * delivers them, requests into sg_exec(), every reply checked against what
- * SPEC section 2 and docs/protocol.md promise:
+ * docs/protocol.md promises:
  *  - replies come only when a line ends (or for lost characters), as whole
  *    lines of at most 127 characters + CR LF;
  *  - each reply has the form its request asks for (V1.1, X, Lxx, Cxxxx,

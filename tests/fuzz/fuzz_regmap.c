@@ -7,7 +7,7 @@
  *   op % 5 == 2  read   [n][max]           (n bytes, max per driver answer)
  *   op % 5 == 3  check  [len][data...]     (regmap_check on every prefix)
  *   op % 5 == 4  inputs [what][value]      (pin levels, ADC values, SPI bytes)
- * Checked (SPEC section 3, regmap.h, docs/registers.md):
+ * Checked (regmap.h, docs/registers.md):
  *  - select is true exactly for mapped registers; after an unmapped one
  *    writes and reads are refused and the status says 08;
  *  - the status register gives the last write's result; a read sets it to

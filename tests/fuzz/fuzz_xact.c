@@ -9,7 +9,7 @@
  *   ones (tests/unit/xact_model.c): the gateway's, a slave's byte by byte,
  *   and the whole slave under a model of the AVR TWI. All three must give
  *   the same acknowledges, bytes and status register (the TWI sending FF
- *   where the gateway refuses a read, as SPEC section 4 says).
+ *   where the gateway refuses a read, as docs/registers.md, "On a slave board", says).
  *
  * bit 0 set: TWI events. Each byte is a master's action (START+SLA+W, a
  *   data byte, STOP, START+SLA+R, a read with ACK, a read with NACK, a bus

@@ -4,7 +4,7 @@ Gateway.run tests without a simulator.
 `FakeLine(answer)`: each request line the host writes is answered by
 `answer(line)` (a reply text), when the host reads. It records every
 request as sent, and the most request characters (terminators included)
-that were ever unanswered: SPEC's flow rule wants that below 256. Noise:
+that were ever unanswered: the flow rule (docs/protocol.md) wants that below 256. Noise:
 `extra[k]` lines come before the reply to request k, `garble[k]` replaces it.
 """
 

@@ -34,9 +34,69 @@ def test_committed_map_is_what_the_c_gives(board, generated):
 
 
 def test_generated_docs_are_current():
+    """Both languages: docs/board-*.md and docs/ru/board-*.md."""
     r = subprocess.run([sys.executable, str(ROOT / "tools" / "docgen.py"), "--check"],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
+
+
+@pytest.fixture
+def docgen(monkeypatch):
+    """tools/docgen.py as a module (its Russian texts in docgen.ru)."""
+    monkeypatch.syspath_prepend(str(ROOT / "tools"))
+    import docgen as module
+    return module
+
+
+def test_docgen_writes_both_languages(docgen):
+    names = sorted(str(p.relative_to(ROOT)) for p in docgen.pages())
+    assert names == ["docs/board-m128s.md", "docs/board-m32d.md",
+                     "docs/ru/board-m128s.md", "docs/ru/board-m32d.md",
+                     "docs/ru/protocol.md"]
+    ru = docgen.pages(("ru",))[ROOT / "docs" / "ru" / "board-m32d.md"]
+    assert "## Значения регистра статуса" in ru
+    for c in boardmap.STATUS.values():
+        assert "| `%02X` | %s | %s |" % (c.code, c.name, docgen.ru.STATUS[c.name]) in ru
+
+
+def test_docgen_fills_the_error_table_of_the_russian_protocol_page(docgen, tmp_path):
+    text = (ROOT / "docs" / "ru" / "protocol.md").read_text()
+    assert docgen.fill_blocks(text, {"errors": docgen.errors_table_ru}) == text
+    stale = text.replace("| `ERROR 05` | NO_P |", "| `ERROR 05` | OLD |")
+    assert stale != text
+    assert docgen.fill_blocks(stale, {"errors": docgen.errors_table_ru}) == text
+    for c in boardmap.ERRORS.values():
+        assert "| `ERROR %02X` | %s | %s |" % (c.code, c.name, docgen.ru.ERRORS[c.name]) in text
+    with pytest.raises(docgen.MissingText, match="no block <!-- docgen:errors -->"):
+        docgen.fill_blocks("# no table here\n", {"errors": docgen.errors_table_ru})
+
+
+def test_docgen_refuses_a_status_without_russian(docgen, monkeypatch, capsys):
+    """A new status code in the map stops docgen until it has a Russian text."""
+    codes = dict(boardmap.STATUS)
+    codes[0x09] = boardmap.Code(0x09, "NEW_REASON", "something new")
+    monkeypatch.setattr(boardmap, "STATUS", codes)
+    monkeypatch.setattr(sys, "argv", ["docgen.py", "--check"])
+    assert docgen.main() == 1
+    err = capsys.readouterr().err
+    assert err == ("docgen: m32d: no Russian text for status NEW_REASON "
+                   "(add it to tools/docgen_ru.py)\n")
+
+
+@pytest.mark.parametrize("table, key, label", [
+    ("ERRORS", "NO_P", "error NO_P"),
+    ("DRIVERS", "motor", "driver motor"),
+    ("REGISTERS", ("servo", "SP"), "register servo/SP"),
+    ("PIN_FUNCTIONS", "MOTOR_PWM", "pin function MOTOR_PWM"),
+    ("RESET_CAUSES", "jtag", "reset cause jtag"),
+])
+def test_docgen_names_each_missing_russian_text(docgen, monkeypatch, table, key, label):
+    texts = dict(getattr(docgen.ru, table))
+    del texts[key]
+    monkeypatch.setattr(docgen.ru, table, texts)
+    assert docgen.missing_ru(boardmap.load("m32d")) == [label]
+    with pytest.raises(docgen.MissingText, match="no Russian text for %s " % label):
+        docgen.page_ru("m32d")
 
 
 def test_mapgen_refuses_a_driver_whose_names_do_not_match_its_registers(tmp_path):

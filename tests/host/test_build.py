@@ -1,4 +1,5 @@
-"""The build's own checks: a slave's bus address (SPEC section 4), the mode."""
+"""The build's own checks: a slave's bus address (docs/registers.md, "On a
+slave board"), the mode."""
 
 import subprocess
 from pathlib import Path

@@ -167,6 +167,16 @@ def test_a_users_tests_run_with_the_plugin(installed, tmp_path):
     assert "--orfa-board={m32d,m128s}" in r.stdout
 
 
+def test_plot_without_matplotlib_names_the_extra(installed, tmp_path):
+    # the venv has only pyserial and pytest: orfa plot says what to install
+    # before it starts a board
+    r = run([installed.bin / "orfa", "--sim", "m32d", "plot", "--do", "servo 3 1500",
+             "-o", tmp_path / "x.png"], cwd=tmp_path)
+    assert (r.returncode, r.stdout) == (2, "")
+    assert r.stderr == "orfa: orfa plot needs matplotlib: pip install 'orfa[plot]'\n"
+    assert not (tmp_path / "x.png").exists()
+
+
 def test_missing_simulator_is_one_line(installed, tmp_path):
     nowhere = tmp_path / "nowhere" / "orfa-sim"
     r = run([installed.bin / "orfa", "sim", "--board", "m32d"], cwd=tmp_path,

@@ -1,5 +1,5 @@
 """The soak's reference model (tests/sim/spec_model.py) against the examples
-of SPEC.md, docs/protocol.md and docs/registers.md."""
+of docs/protocol.md and docs/registers.md."""
 
 import sys
 from pathlib import Path

@@ -324,8 +324,8 @@ class DrvBench(Bench):
     def wr_refused(self, reg: int, data: bytes, status: int) -> None:
         """A register write the driver must reject with `status`: the gateway
         replies ERROR 07 for its own drivers. A slave acknowledges a byte
-        before it is seen (SPEC section 4): a byte that makes the write
-        invalid is refused with the byte after it (ERROR 07), and one that
+        before it is seen (docs/registers.md, "On a slave board"): a byte that
+        makes the write invalid is refused with the byte after it (ERROR 07), and one that
         is the last, or a write found wrong only when the frame ends, is
         acknowledged in full (SW..P); the status register tells either way
         (tests/sim/test_robot.py pins down which is which)."""
@@ -342,7 +342,8 @@ class DrvBench(Bench):
     def unreadable(self, reg: int, count: int = 1) -> None:
         """A register that cannot be read: the gateway refuses the read
         (ERROR 06); a slave acknowledges its read address anyway and sends
-        FF (SPEC section 4). The status register says 05 either way."""
+        FF (docs/registers.md, "On a slave board"). The status register says 05
+        either way."""
         reply = self.ask(self.req("S AA %02X S AB %02X P" % (reg, count)))
         if self.slave:
             assert reply == b"SWASR" + b"FF" * count + b"P\r\n", reply

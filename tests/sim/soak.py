@@ -3,8 +3,8 @@ every reply compared with the reference model (spec_model.py).
 
 The robot: an M32-D gateway (local address AA), a 24C02 EEPROM at A0 and an
 M128-S slave board at 0x10 on its bus (the test robot's build, `make robot`).
-Requests go out pipelined within SPEC's flow rule: fewer than 256 characters
-of requests unanswered. The first reply that differs from the model's stops
+Requests go out pipelined within the flow rule (docs/protocol.md, "Flow"):
+fewer than 256 characters of requests unanswered. The first reply that differs from the model's stops
 the run with the seed, the request's index, the request, expected and got.
 
 Used by tests/sim/test_soak.py (a short run in `make test`) and tools/soak.py
@@ -26,7 +26,8 @@ from orfa.sim import REPO_ROOT, SimBoard, firmware_path, slave_firmware_path
 
 from spec_model import F_CPU, BoardModel, Generator, GatewayModel, Record
 
-#: SPEC section 2, Flow: a host keeps fewer than 256 characters of requests unanswered.
+#: docs/protocol.md, "Flow": a host keeps fewer than 256 characters of requests
+#: unanswered.
 FLOW_LIMIT = 256
 #: Wall seconds without a byte from the board, while replies are due, before giving up.
 STALL_TIMEOUT = 30.0

@@ -1,4 +1,4 @@
-"""A reference model of SPEC.md for the differential soak (tests/sim/soak.py).
+"""A reference model of the protocol for the differential soak (tests/sim/soak.py).
 
 Given a request line, it predicts the exact reply bytes of an ORFA gateway
 (local address AA after reset) with, on its simulated I2C bus, a 256-byte
@@ -6,9 +6,8 @@ Given a request line, it predicts the exact reply bytes of an ORFA gateway
 auto-increment and wrap at 256, writes wrap inside their 8-byte page) and one
 ORFA slave board; every other address is absent (ERROR 06).
 
-It is written from SPEC.md sections 2-4, docs/protocol.md and
-docs/registers.md (the tables of what a slave board answers), not from the
-firmware: where the two disagree the soak stops and prints both.
+It is written from docs/protocol.md and docs/registers.md (the tables of what a
+slave board answers), not from the firmware: where the two disagree the soak stops and prints both.
 
 Pure Python, no I/O. The board facts (driver list, UIDs, register starts)
 come from introspecting the running boards once (soak.py), checked against
@@ -41,7 +40,7 @@ HEXDIGITS = set("0123456789abcdefABCDEF")
 OK, BAD_LENGTH, BAD_VALUE, PIN_BUSY, NOT_WRITABLE, NOT_READABLE, READ_WRAPPED, \
     NOT_BOUND, NO_REGISTER = range(9)
 
-# Protocol error codes (SPEC section 2).
+# Protocol error codes (docs/protocol.md, "Errors").
 E_COMMAND, E_HEX, E_DATA, E_NO_P, E_ADDR_NACK, E_DATA_NACK = 2, 3, 4, 5, 6, 7
 
 UID_INTRO, UID_SPI, UID_ADC, UID_MOTOR = 0x0000, 0x0001, 0x0040, 0x0060
@@ -79,7 +78,7 @@ def twi_khz(khz: int) -> int:
     return F_CPU // ((16 + twbr * (2 << (2 * twps))) * 1000)
 
 
-# --- the parser (SPEC section 2, docs/protocol.md) ------------------------------
+# --- the parser (docs/protocol.md) ----------------------------------------------
 
 @dataclass
 class Request:
@@ -103,8 +102,8 @@ def parse(line: str):
     for n, ch in enumerate(line, 1):
         if n > LINE_MAX:
             if state == "begin":
-                # only spaces so far and a command after column 128: SPEC
-                # does not say which rule comes first
+                # only spaces so far and a command after column 128: the
+                # protocol does not say which rule comes first
                 raise OutOfScope("command after 128 leading spaces")
             return E_DATA
         is_hex = ch in HEXDIGITS
@@ -182,7 +181,7 @@ def parse(line: str):
     return Request(cmd, bytes(args), [(a, bytes(d), c) for a, d, c in frames])
 
 
-# --- one board's register map (SPEC section 3, docs/registers.md) ---------------
+# --- one board's register map (docs/registers.md) ---------------------------------
 
 @dataclass
 class Record:
@@ -198,7 +197,7 @@ class Record:
 
 
 class BoardModel:
-    """The register map of one ORFA board as SPEC section 3 has it."""
+    """The register map of one ORFA board as docs/registers.md has it."""
 
     def __init__(self, board: str, records: Sequence[Record]):
         self.board = board
@@ -435,7 +434,7 @@ class BoardModel:
             out += got
         return out
 
-    # --- frames: a slave board on the bus (SPEC section 4) ---------------------------
+    # --- frames: a slave board on the bus (docs/registers.md) ---------------------------
     SLAVE_BUF = 64
 
     def slave_write(self, data: bytes) -> Optional[int]:

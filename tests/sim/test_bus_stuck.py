@@ -11,7 +11,8 @@ from conftest import DRV_LAYOUT, EEPROM, F_CPU, require_builds, require_slave, r
 from orfa.sim import BOARDS, SimBoard
 
 MS = F_CPU // 1000
-#: SPEC 5: an ERROR within 10 ms of the bus getting stuck ...
+#: docs/protocol.md, "A stuck or missing device": an ERROR within 10 ms of the
+#: bus getting stuck ...
 ERROR_WITHIN = 10 * MS
 #: ... after a wait longer than the longest SCL stretch of an ORFA slave
 #: (8.9 ms, tests/sim/test_robot.py): more than 34 ticks of 2048 cycles
@@ -177,7 +178,7 @@ def test_stuck_bus_does_not_reset_the_board(sb):
     fixture checks the trace for `reset`)."""
     ctl = sb.sim.control
     ctl.i2c_stuck(5)
-    for _ in range(3):          # windows of < 256 characters (SPEC 2, flow)
+    for _ in range(3):          # windows of < 256 characters (docs/protocol.md, "Flow")
         sb.gw.send(("%s\n" % READ).encode() * 10)
         assert sb.read_lines(10) == b"ERROR 06\r\n" * 10
     assert sb.ask("X") == b"X\r\n"

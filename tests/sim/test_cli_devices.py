@@ -161,7 +161,7 @@ def test_adc_table_from_simulated_millivolts(orfa, robot):
     assert orfa("adc", "--channels", "6,7") == (
         0, ADC_TABLE.format(245, "1.196", 818, "3.994"), "")
     robot.control.adc(6, 2500)
-    robot.control.wait(73728)                 # 10 ms: SPEC's promise
+    robot.control.wait(73728)                 # 10 ms: the ADC's promise
     assert orfa("adc") == (0, ADC_TABLE.format(511, "2.495", 818, "3.994"), "")
     status, out, err = orfa("adc", "--watch", "0", "--count", "3")
     assert (status, err) == (0, "")

@@ -1,5 +1,5 @@
-"""docs/cli.md's sample runs that start their own board (`$ orfa --sim ...`)
-replayed: what the page shows is what the command prints."""
+"""docs/cli.md's and docs/ru/cli.md's sample runs that start their own board
+(`$ orfa --sim ...`) replayed: what the page shows is what the command prints."""
 
 import os
 import re
@@ -13,13 +13,13 @@ import pytest
 from conftest import require_builds
 
 ROOT = Path(__file__).resolve().parents[2]
-PAGE = ROOT / "docs" / "cli.md"
+PAGES = ("docs/cli.md", "docs/ru/cli.md")
 
 
-def sample_runs():
+def sample_runs(page):
     """[(command line, expected output)] of every indented `$ orfa --sim` run."""
     runs = []
-    lines = PAGE.read_text().splitlines()
+    lines = (ROOT / page).read_text().splitlines()
     for i, line in enumerate(lines):
         m = re.match(r"    \$ (orfa --sim .*)$", line)
         if m is None:
@@ -33,15 +33,17 @@ def sample_runs():
     return runs
 
 
-RUNS = sample_runs()
+RUNS = [(page, c, e) for page in PAGES for c, e in sample_runs(page)]
 
 
-def test_the_page_has_samples():
-    assert len(RUNS) >= 8
+@pytest.mark.parametrize("page", PAGES)
+def test_the_page_has_samples(page):
+    assert len(sample_runs(page)) >= 8
 
 
-@pytest.mark.parametrize("command, expected", RUNS, ids=[c for c, _ in RUNS])
-def test_sample_run(command, expected):
+@pytest.mark.parametrize("page, command, expected", RUNS,
+                         ids=["%s: %s" % (p, c) for p, c, _ in RUNS])
+def test_sample_run(page, command, expected):
     require_builds()
     argv = shlex.split(command)[1:]
     result = subprocess.run([sys.executable, "-m", "orfa"] + argv, capture_output=True,

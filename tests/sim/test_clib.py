@@ -1,7 +1,8 @@
 """The manual's C API (host/c, docs/c-library.md) through its example:
 `make -C examples` builds examples/get_drivers, which is run on the pty of a
 simulated board and robot, and on a pseudo-terminal where a reference model
-of SPEC (spec_model.py) plays a gateway whose board has 10 and more drivers.
+of the protocol (spec_model.py) plays a gateway whose board has 10 and more
+drivers.
 What it prints is compared with the board maps (orfa.boardmap, generated
 from the C definitions the firmware is built from)."""
 
@@ -113,9 +114,10 @@ def test_bad_address(get_drivers, address):
 # --- a gateway with many drivers: the model on a pseudo-terminal ------------------
 
 class FakeGateway:
-    """SPEC's model answering on the master side of a pty: it answers only
-    when the host has gone quiet (QUIET s), so a host that sends more than
-    the gateway's receive ring holds is caught (`most_unanswered`)."""
+    """The protocol's reference model answering on the master side of a pty:
+    it answers only when the host has gone quiet (QUIET s), so a host that
+    sends more than the gateway's receive ring holds is caught
+    (`most_unanswered`)."""
 
     QUIET = 0.05
 
@@ -187,7 +189,8 @@ def test_many_drivers(get_drivers, ndrivers):
     for req, reply in zip(want[1:], fake.replies[1:]):
         if req.endswith("3CP"):
             assert len(reply) == 127 + 2, reply
-    # SPEC's flow rule: never more requests unanswered than the ring holds
+    # the flow rule (docs/protocol.md): never more requests unanswered than the
+    # ring holds
     assert fake.most_unanswered <= 252, fake.most_unanswered
     if ndrivers == 200:
         # 21 requests of 14 characters: the library had to wait for replies

@@ -1,4 +1,4 @@
-"""SPEC section 2, the simple requests: V X L C, case, spaces, line ends."""
+"""docs/protocol.md, the simple requests: V X L C, case, spaces, line ends."""
 
 import pytest
 

@@ -4,7 +4,8 @@ the voltages the simulator puts on the analog inputs."""
 import pytest
 
 BAD_LENGTH, BAD_VALUE, PIN_BUSY, NOT_WRITABLE = 0x01, 0x02, 0x03, 0x04
-VALID = 73728                      # 10 ms: values valid by then (SPEC)
+#: 10 ms: values valid by then (docs/registers.md, "ADC").
+VALID = 73728
 INPUTS = [0, 250, 1000, 1234, 2000, 2500, 3300, 4999]        # mV on inputs 0-7
 
 

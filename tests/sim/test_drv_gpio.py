@@ -98,8 +98,8 @@ def test_masked_writes(drv):
 
 
 def test_manual_f3_example(drv):
-    """SPEC: on a 2-port board write F3 to R+3 (the mode register of port F):
-    lines 2 and 3 inputs, the others outputs. On the M32-D the same on port A
+    """The manual's example: on a 2-port board write F3 to R+3 (the mode
+    register of port F): lines 2 and 3 inputs, the others outputs. On the M32-D the same on port A
     (mode register R+4)."""
     reg = drv.lay["gpio_val"] + (3 if drv.board == "m128s" else 4)
     port = "F" if drv.board == "m128s" else "A"

@@ -2,8 +2,8 @@
 
 The simulator of this module is never written to (only reads and writes the
 drivers refuse), so every test sees the board as it came out of reset
-(SPEC section 1: servos send no pulses, motors are stopped, all GPIO pins are
-inputs; docs/registers.md for each driver's reset state).
+(docs/registers.md, "Conventions": servos send no pulses, motors are stopped,
+all GPIO pins are inputs; docs/registers.md for each driver's reset state).
 """
 
 import pytest

@@ -1,6 +1,6 @@
-"""Everything at once (SPEC section 5 with the drivers busy): servos pulsing,
-the ADC converting, the motors running (M32-D), while lines of garbage and
-valid requests stream in at line rate. The board answers every line with one
+"""Everything at once (docs/registers.md, "Reliability", with the drivers
+busy): servos pulsing, the ADC converting, the motors running (M32-D), while
+lines of garbage and valid requests stream in at line rate. The board answers every line with one
 reply, never resets, and afterwards every driver is exactly where the valid
 requests left it: widths read back and measured on the pins, ADC values of
 the injected voltages, motor duty.

@@ -7,7 +7,8 @@ AREA = 0xA0               # this module's bytes of the simulated EEPROM: 0xA0-0x
 
 def test_pipelined_requests_in_one_write(board):
     """240 requests in one write; each reply is no longer than its request, so
-    the host never has 256 characters of requests unanswered (SPEC: Flow)."""
+    the host never has 256 characters of requests unanswered (docs/protocol.md,
+    "Flow")."""
     rng = random.Random(1)
     n = board.driver_count()
     rec1 = board.record(1).hex().upper().encode()
@@ -112,7 +113,8 @@ def test_idle_line_after_an_overflow_of_empty_lines(board):
 
 
 def test_long_lines_of_spaces_are_empty(board):
-    """SPEC 2: a line of nothing but spaces is empty, whatever its length."""
+    """docs/protocol.md, "The line": a line of nothing but spaces is empty,
+    whatever its length."""
     board.gw.send(b" " * 129 + b"\r" + b" " * 300 + b"\n" + b" " * 1000 + b"\r\n")
     board.assert_silent()
     assert board.ask(" " * 200 + "V") == b"ERROR 04\r\n"   # a request over 128

@@ -1,5 +1,5 @@
-"""The gateway's own register map at the local address (SPEC section 3,
-docs/registers.md): introspection and the status register."""
+"""The gateway's own register map at the local address (docs/registers.md):
+introspection and the status register."""
 
 from orfa import protocol as p
 
@@ -41,7 +41,7 @@ def test_auto_increment_over_all_records(board):
 
 
 def test_count_read_moves_nothing(board):
-    """SPEC 3: reading the count moves nothing; every later read frame (and
+    """docs/registers.md: reading the count moves nothing; every later read frame (and
     every further byte of a longer one) gives the count again, as ORFA 0.7.5
     does, until another number is written."""
     n = board.driver_count()

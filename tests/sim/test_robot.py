@@ -1,4 +1,4 @@
-"""A robot on one simulated I2C bus (SPEC section 4, docs/registers.md "On a
+"""A robot on one simulated I2C bus (docs/registers.md "On a
 slave board"): an M32-D gateway on the PC's serial port, an M128-S slave at
 0x10, an M32-D slave at 0x12, a 24C02 EEPROM at 0xA0 and an SRF08 ranger at
 0xE0. Everything goes through the gateway's serial port as a PC would; the
@@ -78,7 +78,7 @@ def test_slave_records_are_the_boards(rb):
                                            b"000101010602" b"004001010802" b"003002000A02")
 
 
-# --- SPEC section 4: what the slave can and cannot refuse ----------------------
+# --- on a slave board: what the slave can and cannot refuse ----------------------
 
 @pytest.mark.parametrize("addr", [M128S, M32D])
 def test_unmapped_register(rb, addr):
@@ -114,7 +114,7 @@ def test_status_register_refuses_data(rb, addr):
 
 @pytest.mark.parametrize("addr", [M128S, M32D])
 def test_data_byte_that_makes_the_write_invalid(rb, addr):
-    """SPEC 4: the byte after it is not acknowledged (ERROR 07); a frame that
+    """On a slave board: the byte after it is not acknowledged (ERROR 07); a frame that
     ends with it is acknowledged in full; the status tells either way and
     nothing is applied."""
     gw, boards = rb
@@ -246,7 +246,8 @@ def test_pipelined_requests_to_slaves_all_answered_in_order(rb):
         else:
             reqs.append(b"V")
             want.append(b"V1.1\r\n")
-    # in windows the size SPEC's flow rule allows (< 256 characters pending)
+    # in windows the size the flow rule (docs/protocol.md) allows (< 256
+    # characters pending)
     got = []
     for i in range(0, len(reqs), 8):
         chunk = reqs[i:i + 8]

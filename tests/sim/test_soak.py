@@ -1,6 +1,6 @@
 """The differential soak, short: seeded random requests (valid and invalid;
-local, EEPROM, slave and absent addresses) pipelined within SPEC's flow rule
-against an M32-D gateway with an EEPROM and an M128-S slave; every reply must
+local, EEPROM, slave and absent addresses) pipelined within the flow rule
+(docs/protocol.md, "Flow") against an M32-D gateway with an EEPROM and an M128-S slave; every reply must
 equal the reference model's (spec_model.py). The long run is `make soak`
 (tools/soak.py); docs/testing.md has its figures."""
 

@@ -1,5 +1,5 @@
 """The watchdog, the reset causes and the link-loss failsafe, at the pins
-(SPEC section 5, docs/registers.md "sys", docs/simulator.md "Faults and
+(docs/registers.md "Reliability" and "sys", docs/simulator.md "Faults and
 resets").
 
 Each test starts fresh simulators (they hang and reset boards, which the

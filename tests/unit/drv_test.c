@@ -226,7 +226,7 @@ static void test_intro(void)
 	to_hex(hex, want, n);
 	WRITE(0x00, "01", REG_OK);
 	READ(0x00, (uint8_t)n, hex);
-	/* Reading the count moves nothing (SPEC 3, as ORFA 0.7.5): every read
+	/* Reading the count moves nothing (docs/registers.md, as ORFA 0.7.5): every read
 	 * frame, and every byte of a longer one, gives the count again. */
 	char buf[220];
 	WRITE(0x00, "00", REG_OK);

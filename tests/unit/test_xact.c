@@ -3,8 +3,8 @@
  * byte-at-a-time frames as a TWI slave makes them (no read length known,
  * a 64-byte buffer) must give exactly what the gateway's frames give (the
  * read length known, the request's own bytes as the buffer), for random
- * frame sequences; and the refusals SPEC section 4 describes land where it
- * says.
+ * frame sequences; and the refusals docs/registers.md ("On a slave board")
+ * describes land where it says.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -162,7 +162,8 @@ static void test_refusals(void)
 	CHECK_EQ(xact_frame_end(), REG_BAD_LENGTH);
 	READ(B.servo_sp, 4, "00 00 00 00");
 	/* A data byte that makes the write invalid (a servo channel that
-	 * does not exist): refused at once, the rest too (SPEC section 4). */
+	 * does not exist): refused at once, the rest too (docs/registers.md, "On a
+	 * slave board"). */
 	xact_write_requested(buf, sizeof buf);
 	CHECK(xact_write_received(B.servo_sp));
 	CHECK(!xact_write_received(B.servo_channels));

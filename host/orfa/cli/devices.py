@@ -201,7 +201,8 @@ def _duty(text: str) -> int:
 
 # --- adc --------------------------------------------------------------------------
 
-#: SPEC: an enabled channel's value is valid within 10 ms of its configuration.
+#: docs/registers.md, "ADC": an enabled channel's value is valid within 10 ms
+#: of its configuration.
 ADC_SETTLE_S = 0.010
 
 

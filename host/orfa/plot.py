@@ -1,0 +1,120 @@
+"""Draw waveforms (orfa.waves.Wave) as a PNG with matplotlib: one row per
+signal, the time axis in microseconds, each row annotated with what
+orfa.waves measures (every pulse's width when they fit, and a summary line:
+widths, period, duty).
+
+matplotlib is the extra `orfa[plot]`; this module imports it only when it
+draws, and says which package is missing otherwise.
+"""
+
+from __future__ import annotations
+
+from typing import List, NamedTuple, Optional, Sequence
+
+from . import waves
+
+MAX_PULSE_LABELS = 8          # a row with more complete pulses gets only its summary
+ROW_HEIGHT_IN = 0.62
+WIDTH_IN = 12.0
+
+
+class Row(NamedTuple):
+    wave: waves.Wave
+    label: str                # the y axis text: name and what the pin does
+
+
+class Annotation(NamedTuple):
+    signal: str
+    kind: str                 # "pulse" (one pulse's width) or "summary"
+    text: str
+    cycles: Optional[int]     # the measured width (pulse) or None
+
+
+class PlotUnavailable(RuntimeError):
+    pass
+
+
+def annotations(rows: Sequence[Row], f_cpu: int) -> List[Annotation]:
+    """What the plot writes next to each row (also what the tests check)."""
+    out = []
+    for row in rows:
+        name = row.wave.name
+        ps = waves.pulses(row.wave)
+        if 0 < len(ps) <= MAX_PULSE_LABELS:
+            for rise, fall in ps:
+                out.append(Annotation(name, "pulse", waves.show_us(fall - rise, f_cpu),
+                                      fall - rise))
+        out.append(Annotation(name, "summary",
+                              waves.describe(waves.summary(row.wave), f_cpu), None))
+    return out
+
+
+def require() -> None:
+    """PlotUnavailable (saying what to install) when matplotlib is missing."""
+    _matplotlib()
+
+
+def _matplotlib():
+    try:
+        import matplotlib
+    except ImportError:
+        raise PlotUnavailable("orfa plot needs matplotlib: pip install 'orfa[plot]'") from None
+    matplotlib.use("Agg")                 # files only, no display needed
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _micro(text: str) -> str:
+    return text.replace(" us", " \u00b5s")
+
+
+def _steps(wave: waves.Wave, f_cpu: int):
+    xs = [waves.us(wave.start, f_cpu)]
+    ys = [wave.level]
+    for cycle, level in wave.edges:
+        xs += [waves.us(cycle, f_cpu)] * 2
+        ys += [ys[-1], level]
+    xs.append(waves.us(wave.end, f_cpu))
+    ys.append(ys[-1])
+    return xs, ys
+
+
+def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[Annotation]:
+    """Draw rows into the PNG (or SVG/PDF by out's suffix) at out; returns
+    the annotations written on it."""
+    plt = _matplotlib()
+    notes = annotations(rows, f_cpu)
+    n = max(1, len(rows))
+    fig, axes = plt.subplots(n, 1, sharex=True, squeeze=False,
+                             figsize=(WIDTH_IN, 1.1 + ROW_HEIGHT_IN * n))
+    axes = [a[0] for a in axes]
+    start = waves.us(rows[0].wave.start, f_cpu) if rows else 0.0
+    end = waves.us(rows[0].wave.end, f_cpu) if rows else 1.0
+    for ax, row in zip(axes, rows):
+        xs, ys = _steps(row.wave, f_cpu)
+        ax.plot(xs, ys, color="tab:blue", linewidth=1.0, drawstyle="default")
+        ax.fill_between(xs, 0, ys, color="tab:blue", alpha=0.15, linewidth=0)
+        ax.set_ylim(-0.25, 1.75)
+        ax.set_yticks([])
+        ax.set_ylabel(row.label, rotation=0, ha="right", va="center", fontsize=9)
+        for side in ("top", "right", "left"):
+            ax.spines[side].set_visible(False)
+        ax.grid(axis="x", color="0.85", linewidth=0.6)
+        mine = [a for a in notes if a.signal == row.wave.name]
+        pulses = waves.pulses(row.wave)
+        for (rise, fall), note in zip(pulses, [a for a in mine if a.kind == "pulse"]):
+            ax.annotate(_micro(note.text), xy=(waves.us((rise + fall) / 2, f_cpu), 1.05),
+                        ha="center", va="bottom", fontsize=7.5, color="tab:red")
+        summary = [a.text for a in mine if a.kind == "summary"]
+        ax.text(1.01, 0.35, _micro(summary[0]).replace(", ", "\n", 1) if summary else "",
+                transform=ax.transAxes, ha="left", va="center", fontsize=8, color="0.2")
+    axes[-1].set_xlim(start, end)
+    axes[-1].ticklabel_format(axis="x", useOffset=False, style="plain")
+    axes[-1].set_xlabel("time (\u00b5s, simulated, %.4g MHz CPU clock)" % (f_cpu / 1e6))
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.subplots_adjust(right=0.76)        # the measurements, right of the rows
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return notes

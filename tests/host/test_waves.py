@@ -1,0 +1,197 @@
+"""orfa.vcd, orfa.waves, orfa.plot and the `orfa plot` command on VCD text
+written here (the simulator's own VCDs: tests/sim/test_plot.py)."""
+
+import argparse
+import re
+import struct
+
+import pytest
+
+from orfa import boardmap, plot, vcd, waves
+from orfa.cli import main
+from orfa.cli import plot as cli_plot
+
+F = 7372800
+PS = 1e12 / F
+
+
+def ps(cycle):
+    return int(round(cycle * PS))
+
+
+M32D_PINS = tuple("%s%d" % (p, b) for p in "ABCD" for b in range(8))
+
+
+def make_vcd(changes, names=M32D_PINS + ("servo3", "i2c"), slave=()):
+    """A VCD as the simulator writes it: changes {name: [(cycle, level)]}."""
+    ids = {}
+    out = ["$comment orfa-sim, %d Hz: one CPU cycle is %.3f ps $end" % (F, PS),
+           "$timescale 1ps $end", "$scope module board $end"]
+    for i, n in enumerate(names):
+        ids[n] = chr(33 + i) + "!"
+        out.append("$var wire 1 %s %s $end" % (ids[n], n))
+    out.append("$upscope $end")
+    if slave:
+        out.append("$scope module board_10 $end")
+        for i, n in enumerate(slave):
+            ids[n] = chr(33 + i) + "#"
+            out.append("$var wire 1 %s %s $end" % (ids[n], n))
+        out.append("$upscope $end")
+    out += ["$enddefinitions $end", "#0", "$dumpvars"]
+    out += ["0%s" % ids[n] for n in list(names) + list(slave)]
+    out.append("$end")
+    events = sorted((c, n, lv) for n, es in changes.items() for c, lv in es)
+    last = None
+    for c, n, lv in events:
+        if c != last:
+            out.append("#%d" % ps(c))
+            last = c
+        out.append("%d%s" % (lv, ids[n]))
+    return "\n".join(out) + "\n"
+
+
+SERVO = [(1000, 1), (12059, 0), (148456, 1), (159517, 0), (295912, 1), (306971, 0)]
+
+
+def test_vcd_cycles_are_exact():
+    t = vcd.parse(make_vcd({"servo3": SERVO}))
+    assert t.f_cpu == F
+    assert t.names() == list(M32D_PINS) + ["servo3", "i2c"]
+    assert t.edges("servo3") == SERVO
+    assert t.initial["servo3"] == 0 and t.end == 306971
+    assert t.level_at("servo3", 1001) == 1 and t.level_at("servo3", 1000) == 0
+
+
+def test_vcd_slave_scope_keeps_its_prefixed_names():
+    t = vcd.parse(make_vcd({"10/servo3": [(5, 1)]}, slave=("10/servo3",)))
+    assert t.scopes["board_10"] == ["10/servo3"]
+    assert t.edges("10/servo3") == [(5, 1)]
+
+
+@pytest.mark.parametrize("text, message", [
+    ("", "no $enddefinitions"),
+    ("$timescale 1ps $end\n$enddefinitions $end\n", "no CPU clock"),
+    ("$comment 8000000 Hz $end\n$timescale 3ps $end\n", "timescale"),
+    ("$comment 8000000 Hz $end\n$timescale 1ps $end\n$enddefinitions $end\n#0\n1?\n",
+     "unknown id"),
+    ("$comment 8000000 Hz $end\n$timescale 1ps $end\n$enddefinitions $end\n#x\n", "time"),
+])
+def test_vcd_errors_name_the_place(text, message):
+    with pytest.raises(vcd.VcdError, match=re.escape(message)):
+        vcd.parse(text, where="t.vcd")
+
+
+def test_window_and_pulses():
+    w = waves.window("servo3", 0, SERVO, 100000, 300000)
+    assert w.level == 0 and w.edges == ((148456, 1), (159517, 0), (295912, 1))
+    assert waves.pulses(w) == [(148456, 159517)]
+    w = waves.window("servo3", 0, SERVO, 150000, 300000)
+    assert w.level == 1                          # inside a pulse: it began before
+    assert waves.pulses(w) == []                 # no whole high pulse in the window
+    assert waves.high_time(w) == (159517 - 150000) + (300000 - 295912)
+    s = waves.summary(waves.window("servo3", 0, SERVO, 0, 400000))
+    assert (s.pulses, s.width_min, s.width_max) == (3, 11059, 11061)
+    assert s.period == (295912 - 1000) // 2 and s.polarity == 1
+    assert s.duty == pytest.approx((11059 + 11061) / (295912 - 1000))
+    assert waves.describe(s, F) == \
+        "high 1500.0 us-1500.2 us, period 20.00 ms (50.0 Hz), duty 7.5%"
+
+
+def test_a_line_that_idles_high_has_low_pulses():
+    cs = [(100, 1), (1000, 0), (1737, 1)]        # a chip select: high, 100 ns low, high
+    s = waves.summary(waves.window("B3", 0, cs, 500, 5000))
+    assert s.polarity == 0 and (s.width_min, s.width_max) == (737, 737)
+    assert waves.describe(s, F) == "low 99.96 us"
+    assert waves.describe(waves.summary(waves.window("B3", 1, [], 0, 9)), F) == "steady 1"
+
+
+@pytest.mark.parametrize("text, us", [("1500", 1500), ("1500us", 1500), ("1.5ms", 1500),
+                                      ("0.02s", 20000), (".5ms", 500)])
+def test_times(text, us):
+    assert cli_plot.parse_time(text) == us
+
+
+@pytest.mark.parametrize("text", ["", "1.5 min", "-3", "ms"])
+def test_bad_times(text):
+    with pytest.raises(argparse.ArgumentTypeError):
+        cli_plot.parse_time(text)
+
+
+def test_labels_come_from_the_board_map():
+    m32 = cli_plot.Namer(["A3", "D5", "servo3", "i2c"] + ["%s%d" % (p, b) for p in "ABCD"
+                                                          for b in range(8)])
+    assert m32.maps[""].board == "m32d"
+    assert m32.label("A3") == "A3\nservo 3"
+    motor = [p for p in boardmap.load("m32d").pins if p.function == "MOTOR_PWM"][0]
+    pin = "%s%d" % (motor.port, motor.bit)
+    assert "motor %d PWM" % (motor.index + 1) in m32.label(pin)
+    assert m32.label("servo3") == "servo3\npin A3"
+    assert m32.label("i2c") == "i2c\nbus busy"
+    assert m32.rank("servo3") is None            # its pin's row is the servo's
+    m128 = cli_plot.Namer(["servo3"] + ["%s%d" % (p, b) for p in "ABCDEFG" for b in range(8)])
+    assert m128.maps[""].board == "m128s"
+    assert m128.rank("servo3") == 0
+    clk = [p for p in boardmap.load("m128s").pins if p.function == "SERVO_CLK"][0]
+    assert m128.rank("%s%d" % (clk.port, clk.bit)) is None
+
+
+def test_select_by_pattern_keeps_the_order_and_refuses_unknown_names():
+    names = ["A3", "B3", "servo3", "servo4", "i2c"]
+    namer = cli_plot.Namer(names, {"": "m32d"})
+    assert cli_plot.select(namer, names, [], ["i2c", "servo*"]) == (["i2c", "servo3", "servo4"], 0)
+    with pytest.raises(Exception, match="no signal 'servo99'"):
+        cli_plot.select(namer, names, [], ["servo99"])
+
+
+def test_annotations_are_the_measured_widths():
+    w = waves.window("servo3", 0, SERVO, 0, 400000)
+    notes = plot.annotations([plot.Row(w, "servo3")], F)
+    assert [(a.kind, a.text, a.cycles) for a in notes] == [
+        ("pulse", "1500.0 us", 11059), ("pulse", "1500.2 us", 11061),
+        ("pulse", "1500.0 us", 11059),
+        ("summary", "high 1500.0 us-1500.2 us, period 20.00 ms (50.0 Hz), duty 7.5%", None)]
+
+
+def png_size(path):
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    return struct.unpack(">II", data[16:24])
+
+
+def test_command_on_a_file(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    src = tmp_path / "t.vcd"
+    src.write_text(make_vcd({"servo3": SERVO, "A3": SERVO, "i2c": [(50000, 1), (57000, 0)]}))
+    out = tmp_path / "t.png"
+    assert main(["plot", str(src), "-o", str(out)]) == 0
+    assert capsys.readouterr().out == (
+        "A3         high 1500.0 us-1500.2 us, period 20.00 ms (50.0 Hz), duty 7.5%\n"
+        "i2c        high 949.4 us\n")
+    width, height = png_size(out)
+    assert width > 1000 and height > 150
+    assert main(["plot", str(src), "--signals", "servo3", "--from", "0", "--to", "15ms",
+                 "-o", str(out), "-v"]) == 0
+    assert capsys.readouterr().out == ("servo3     1500.0 us\n"
+                                       "servo3     high 1500.0 us\n")
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["plot", "-o", "x.png"], "orfa: give a VCD file"),
+    (["plot", "nowhere.vcd", "-o", "x.png"], "orfa: cannot read nowhere.vcd: No such file"),
+    (["plot", "{vcd}", "--signals", "servo99", "-o", "x.png"], "orfa: no signal 'servo99'"),
+    (["plot", "{vcd}", "--from", "2ms", "--to", "1ms", "-o", "x.png"],
+     "orfa: --to must be after --from"),
+    (["plot", "{vcd}", "--do", "servo 3 1500", "-o", "x.png"], "orfa: --do runs commands"),
+    (["plot", "{bad}", "-o", "x.png"], "orfa: {bad}: no $enddefinitions"),
+    (["plot", "--control", "{tmp}/none.sock", "-o", "x.png"], "orfa: cannot connect to"),
+])
+def test_command_errors_are_one_line(tmp_path, capsys, argv, message):
+    good, bad = tmp_path / "t.vcd", tmp_path / "bad.vcd"
+    good.write_text(make_vcd({"servo3": SERVO}))
+    bad.write_text("hello\n")
+    fill = dict(vcd=good, bad=bad, tmp=tmp_path)
+    argv = [a.format(**fill) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(message.format(**fill)) and err.count("\n") == 1
+    assert not (tmp_path / "x.png").exists()
