@@ -13,6 +13,7 @@
 #   make fuzz           the long run: 10^7 executions per harness (docs/fuzzing.md)
 #   make test           install what is missing, build everything, run all tests
 #   make bench          cycle-exact benchmark table
+#   make doc-images     the pictures in docs/img/, made by the tests that draw them
 #   make soak           the long differential soak (SOAK_REQUESTS, SOAK_SEED)
 #   make demo           a simulated M32-D gateway to talk to
 #   make demo-robot     the same with two slave boards on its I2C bus
@@ -102,7 +103,7 @@ $(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 
-.PHONY: map map-board print-baud-rates firmware flash fuses all-boards robot size sim unit fuzz fuzz-short test bench soak demo demo-robot clean setup
+.PHONY: map map-board print-baud-rates firmware flash fuses all-boards robot size sim unit fuzz fuzz-short test bench soak demo demo-robot doc-images clean setup
 .DEFAULT_GOAL := firmware
 
 firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
@@ -228,6 +229,13 @@ test: setup
 	@$(MAKE) --no-print-directory unit
 	@$(MAKE) --no-print-directory fuzz-short
 	python3 -m pytest -q tests
+
+# The pictures in docs/img/: each test file here saves its images in
+# $ORFA_SHOTS (default build/shots/); add a file to draw one more.
+DOC_IMAGE_TESTS := tests/sim/test_dash.py tests/sim/test_plot.py
+doc-images:
+	@$(MAKE) --no-print-directory all-boards robot sim
+	ORFA_SHOTS=docs/img python3 -m pytest -q $(DOC_IMAGE_TESTS)
 
 bench: setup
 	@$(MAKE) --no-print-directory all-boards robot sim

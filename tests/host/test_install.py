@@ -249,3 +249,16 @@ def test_issue_commands_run_from_the_venv(installed, tmp_path):
         [(d.uid, d.name) for d in boardmap.load("m32d").drivers]
     r = run([orfa, "--sim", "m32d", "servo", "3", "1500"], cwd=tmp_path)
     assert r.returncode == 0 and r.stderr == "", r.stderr
+
+
+def test_dash_page_is_in_the_package_and_flask_is_asked_for(installed, tmp_path):
+    """The dashboard's page ships with the package; the venv has no Flask
+    (the extra orfa[dash] was not asked for), so `orfa dash` says which
+    extra to install."""
+    static = installed.site / "orfa" / "dash" / "static"
+    for name in ("index.html", "dash.js", "dash.css"):
+        assert filecmp.cmp(str(static / name),
+                           str(ROOT / "host" / "orfa" / "dash" / "static" / name), shallow=False)
+    r = run([installed.bin / "orfa", "dash", "--sim", "m32d"], cwd=tmp_path)
+    assert (r.returncode, r.stdout, r.stderr) == (
+        2, "", "orfa: orfa dash needs Flask: pip install 'orfa[dash]'\n")

@@ -2,7 +2,7 @@
 
 One module per group of commands: bus (version, scan, read, write, transfer,
 request), devices (drivers and the driver clients), console, simulate (sim),
-plot;
+plot, dash (the live web page);
 `flash` comes from orfa.flash when it is there. Exit status: 0 ok, 1 an
 ERROR reply or a device, bus or serial failure, 2 a usage error (bad
 arguments, a port that cannot be opened), 130 Ctrl-C.
@@ -22,7 +22,7 @@ import serial
 from .. import __version__
 from .. import protocol as p
 from ..sim import BOARDS
-from . import bus, console, devices, plot, simulate
+from . import bus, console, dash, devices, plot, simulate
 from .common import ADDRESS_RULE, PORT_ENV, UsageError, add_sim_devices, env_port, explain, number
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
@@ -78,6 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
     console.add_parsers(sub, common)
     simulate.add_parsers(sub, common)
     plot.add_parsers(sub, common)
+    dash.add_parsers(sub, common)
     if importlib.util.find_spec("orfa.flash") is not None:
         importlib.import_module("orfa.flash").add_parser(sub)
     return parser
