@@ -121,3 +121,13 @@ def register_error(status: int, addr: int, register: str, action: str,
         return err
     cls = REGISTER_ERRORS.get(st, RegisterError)
     return cls(st, addr, register, action, code=code)
+
+
+def explain(exc: BaseException) -> str:
+    """One line for an error: a bare `ERROR xx` gets the code's meaning
+    (from the board map, as the firmware's error enum gives it)."""
+    text = str(exc) or type(exc).__name__
+    code = getattr(exc, "code", None)
+    if code is not None and text == "ERROR %02X" % code and code in _map.ERRORS:
+        text += ": %s" % _map.ERRORS[code].text
+    return text

@@ -17,6 +17,9 @@ from . import flow
 from . import protocol as p
 from .errors import SerialError
 
+#: i2cdetect's default range of 7-bit addresses (the others are reserved)
+SCAN_FIRST, SCAN_LAST = 0x08, 0x77
+
 
 def open_port(url: str, baudrate: int, timeout: float) -> serial.SerialBase:
     """serial.serial_for_url, its errors as one-line SerialErrors."""
@@ -313,6 +316,19 @@ class Gateway:
         addr = p.parse_local_address(self.request(p.format_local_address(new)))
         self.local = addr
         return addr
+
+    def scan(self, first: int = SCAN_FIRST, last: int = SCAN_LAST) -> List[int]:
+        """The 7-bit addresses first..last that acknowledge a probe
+        (`S<addr> P`, pipelined), as i2cdetect finds them."""
+        addrs = list(range(first, last + 1))
+        replies = self.run(["S%02XP" % (a << 1) for a in addrs])
+        found = []
+        for a, reply in zip(addrs, replies):
+            if reply == "SWP":
+                found.append(a)
+            elif reply != "ERROR 06":
+                raise p.ProtocolError("probe of 7-bit 0x%02X answered %r" % (a, reply))
+        return found
 
     def clock(self, khz: Optional[int] = None) -> int:
         return p.parse_clock(self.request(p.format_clock(khz)))

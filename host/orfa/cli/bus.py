@@ -10,13 +10,13 @@ from typing import List, Sequence
 
 from .. import protocol as p
 from ..board import Board
+from ..gateway import SCAN_FIRST, SCAN_LAST
 from .common import (ADDRESS_RULE, UsageError, address, byte, connect, explain,
                      hex_bytes, number, show_address)
 from .names import board_of
 
 #: What scan probes by default: i2cdetect's range (0x00-0x07 and 0x78-0x7F
 #: are reserved by the I2C specification).
-SCAN_FIRST, SCAN_LAST = 0x08, 0x77
 
 
 # --- version ------------------------------------------------------------------
@@ -50,24 +50,11 @@ def scan_grid(found: Sequence[int], first: int, last: int) -> str:
     return "\n".join(lines)
 
 
-def scan(gw, first: int = SCAN_FIRST, last: int = SCAN_LAST) -> List[int]:
-    """The 7-bit addresses first..last that acknowledge a probe (`S<addr> P`)."""
-    addrs = list(range(first, last + 1))
-    replies = gw.run(["S%02XP" % (a << 1) for a in addrs])     # pipelined
-    found = []
-    for a, reply in zip(addrs, replies):
-        if reply == "SWP":
-            found.append(a)
-        elif reply != "ERROR 06":
-            raise p.ProtocolError("probe of 7-bit 0x%02X answered %r" % (a, reply))
-    return found
-
-
 def cmd_scan(args) -> int:
     first, last = (0x00, 0x7F) if args.all else (SCAN_FIRST, SCAN_LAST)
     with connect(args) as gw:
         local = gw.local_address()
-        found = scan(gw, first, last)
+        found = gw.scan(first, last)
     print(scan_grid(found, first, last))
     own = " (%s: the gateway itself)" % show_address(args, local) \
         if local >> 1 in found else ""

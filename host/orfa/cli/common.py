@@ -8,8 +8,8 @@ import contextlib
 import os
 from typing import Iterator, List, Optional
 
-from .. import boardmap
 from .. import protocol as p
+from ..errors import explain  # noqa: F401 (the commands' one-line errors)
 from ..gateway import Gateway, os_reason
 from ..sim import BOARDS, SimBoard, SimError
 
@@ -61,16 +61,6 @@ def show_address(args, addr8: int) -> str:
     if getattr(args, "seven_bit", False):
         return "0x%02X" % (addr8 >> 1)
     return "0x%02X" % addr8
-
-
-def explain(exc: BaseException) -> str:
-    """One line for an error: a bare `ERROR xx` gets the code's meaning
-    (from the board map, as the firmware's error enum gives it)."""
-    text = str(exc) or type(exc).__name__
-    code = getattr(exc, "code", None)
-    if code is not None and text == "ERROR %02X" % code and code in boardmap.ERRORS:
-        text += ": %s" % boardmap.ERRORS[code].text
-    return text
 
 
 def open_gateway(url: str, args) -> Gateway:

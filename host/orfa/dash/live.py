@@ -18,8 +18,7 @@ from typing import Callable, Dict, List, Optional, Sequence
 
 from .. import protocol as p
 from ..board import Board
-from ..cli.bus import scan
-from ..cli.common import explain
+from ..errors import explain
 from ..gateway import Gateway
 from . import snapshot
 
@@ -81,7 +80,7 @@ class Dashboard:
                                   % " ".join("%04X" % r.uid for r in own.drivers))
             found = [own]
             named = self.slaves is not None
-            addrs = self.slaves if named else [a << 1 for a in scan(gw)]
+            addrs = self.slaves if named else [a << 1 for a in gw.scan()]
             for addr in addrs:
                 if addr == local:
                     continue
