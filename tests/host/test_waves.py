@@ -139,6 +139,7 @@ def test_select_by_pattern_keeps_the_order_and_refuses_unknown_names():
     names = ["A3", "B3", "servo3", "servo4", "i2c"]
     namer = cli_plot.Namer(names, {"": "m32d"})
     assert cli_plot.select(namer, names, [], ["i2c", "servo*"]) == (["i2c", "servo3", "servo4"], 0)
+    assert cli_plot.select(namer, names, [], ["a3", "SERVO4"]) == (["A3", "servo4"], 0)
     with pytest.raises(Exception, match="no signal 'servo99'"):
         cli_plot.select(namer, names, [], ["servo99"])
 

@@ -6,8 +6,8 @@ live simulated board through its control socket (`orfa plot --sim BOARD`,
 from __future__ import annotations
 
 import argparse
-import os
 import fnmatch
+import os
 import re
 import shlex
 import sys
@@ -134,7 +134,8 @@ def select(namer: Namer, names: Sequence[str], changing: Sequence[str],
     if patterns:
         chosen: List[str] = []
         for pat in patterns:
-            hits = [n for n in names if fnmatch.fnmatchcase(n, pat)]
+            # names are case-insensitive, as the simulator takes them
+            hits = [n for n in names if fnmatch.fnmatchcase(n.lower(), pat.lower())]
             if not hits:
                 raise UsageError("no signal %r (signals: %s)" % (pat, _some(names)))
             chosen += [h for h in hits if h not in chosen]
