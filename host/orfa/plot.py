@@ -92,7 +92,7 @@ def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[A
     end = waves.us(rows[0].wave.end, f_cpu) if rows else 1.0
     for ax, row in zip(axes, rows):
         xs, ys = _steps(row.wave, f_cpu)
-        ax.plot(xs, ys, color="tab:blue", linewidth=1.0, drawstyle="default")
+        ax.plot(xs, ys, color="tab:blue", linewidth=1.0)
         ax.fill_between(xs, 0, ys, color="tab:blue", alpha=0.15, linewidth=0)
         ax.set_ylim(-0.25, 1.75)
         ax.set_yticks([])

@@ -54,15 +54,6 @@ class Trace:
     def edges(self, name: str) -> List[Edge]:
         return self.changes[name]
 
-    def level_at(self, name: str, cycle: int) -> int:
-        """The level just before `cycle` (the initial one before any edge)."""
-        level = self.initial[name]
-        for c, lv in self.changes[name]:
-            if c >= cycle:
-                break
-            level = lv
-        return level
-
 
 def _tokens(lines: Iterable[str]) -> Iterator[Tuple[int, str]]:
     for number, line in enumerate(lines, 1):
@@ -131,7 +122,7 @@ def parse(text: str, where: str = "VCD") -> Trace:
             block(line)
     else:
         raise VcdError("%s: no $enddefinitions: not a VCD" % where)
-    if f_cpu is None:
+    if not f_cpu:
         raise VcdError("%s: no CPU clock in its comment: not the simulator's VCD" % where)
     if ps_per_unit is None:
         raise VcdError("%s: no $timescale" % where)

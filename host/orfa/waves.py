@@ -28,6 +28,7 @@ class Summary(NamedTuple):
     duty: Optional[float]           # high time / time over the complete periods
     level: int                      # the level at the end of the window
     polarity: int                   # 1: high pulses, 0: low ones (idles high)
+    last_edge: Optional[Edge]       # the window's last edge (cycle, level), if any
 
 
 def window(name: str, initial: int, edges: Sequence[Edge], start: int, end: int) -> Wave:
@@ -86,6 +87,9 @@ def pulses(wave: Wave, level: Optional[int] = None) -> List[Tuple[int, int]]:
 def summary(wave: Wave) -> Summary:
     pol = polarity(wave)
     widths = [end - begin for begin, end in pulses(wave, pol)]
+    if not widths and pulses(wave, pol ^ 1):
+        pol ^= 1                    # the only whole pulse is the long one
+        widths = [end - begin for begin, end in pulses(wave, pol)]
     rises = [c for c, lv in wave.edges if lv == 1]
     period = duty = None
     if len(rises) >= 2:
@@ -95,7 +99,8 @@ def summary(wave: Wave) -> Summary:
         duty = high / span if span else None
     level = wave.edges[-1][1] if wave.edges else wave.level
     return Summary(len(widths), min(widths) if widths else None,
-                   max(widths) if widths else None, period, duty, level, pol)
+                   max(widths) if widths else None, period, duty, level, pol,
+                   wave.edges[-1] if wave.edges else None)
 
 
 def us(cycles: float, f_cpu: int) -> float:
@@ -116,7 +121,11 @@ def show_us(cycles: float, f_cpu: int) -> str:
 def describe(s: Summary, f_cpu: int) -> str:
     """One line: the measured widths, period (or frequency) and duty."""
     if s.pulses == 0 and s.period is None:
-        return "steady %d" % s.level
+        if s.last_edge is None:
+            return "steady %d" % s.level
+        # one edge, or a pulse that the window cuts: when it last changed
+        cycle, level = s.last_edge
+        return "%s at %.2f us" % ("rises" if level else "falls", us(cycle, f_cpu))
     parts = []
     kind = "high" if s.polarity else "low"
     if s.width_min is not None:

@@ -59,7 +59,6 @@ def test_vcd_cycles_are_exact():
     assert t.names() == list(M32D_PINS) + ["servo3", "i2c"]
     assert t.edges("servo3") == SERVO
     assert t.initial["servo3"] == 0 and t.end == 306971
-    assert t.level_at("servo3", 1001) == 1 and t.level_at("servo3", 1000) == 0
 
 
 def test_vcd_slave_scope_keeps_its_prefixed_names():
@@ -103,6 +102,33 @@ def test_a_line_that_idles_high_has_low_pulses():
     assert s.polarity == 0 and (s.width_min, s.width_max) == (737, 737)
     assert waves.describe(s, F) == "low 99.96 us"
     assert waves.describe(waves.summary(waves.window("B3", 1, [], 0, 9)), F) == "steady 1"
+
+
+def test_a_line_that_only_rises_or_falls_says_when():
+    rise = waves.summary(waves.window("B0", 0, [(73728, 1)], 0, 100000))
+    assert waves.describe(rise, F) == "rises at 10000.00 us"
+    fall = waves.summary(waves.window("B0", 1, [(737, 0)], 0, 100000))
+    assert waves.describe(fall, F) == "falls at 99.96 us"
+    # a whole period, rise to rise, around one whole high pulse
+    odd = waves.summary(waves.window("B0", 0, [(100, 1), (200, 0), (300, 1)], 0, 310))
+    assert waves.describe(odd, F) == "high 13.56 us, period 27.13 us (36.9 kHz), duty 50.0%"
+    # mostly high, but the one whole pulse is high: that is what it measures
+    long = waves.summary(waves.window("B0", 0, [(100, 1), (900, 0)], 0, 1000))
+    assert (long.polarity, long.width_min) == (1, 800)
+
+
+def test_a_zero_clock_is_no_vcd():
+    with pytest.raises(vcd.VcdError, match="no CPU clock"):
+        vcd.parse("$comment orfa-sim, 0 Hz $end\n$timescale 1ps $end\n$enddefinitions $end\n")
+
+
+def test_an_edge_at_the_files_last_time_is_drawn(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    src = tmp_path / "t.vcd"
+    src.write_text(make_vcd({"B0": [(73728, 1)]}).replace("#%d\n" % ps(73728), "#%d\n" % ps(73728)))
+    assert vcd.parse(src.read_text()).end == 73728
+    assert main(["plot", str(src), "--signals", "B0", "-o", str(tmp_path / "t.png")]) == 0
+    assert capsys.readouterr().out == "B0         rises at 10000.00 us\n"
 
 
 @pytest.mark.parametrize("text, us", [("1500", 1500), ("1500us", 1500), ("1.5ms", 1500),
@@ -185,6 +211,8 @@ def test_command_on_a_file(tmp_path, capsys):
     (["plot", "{vcd}", "--do", "servo 3 1500", "-o", "x.png"], "orfa: --do runs commands"),
     (["plot", "{bad}", "-o", "x.png"], "orfa: {bad}: no $enddefinitions"),
     (["plot", "--control", "{tmp}/none.sock", "-o", "x.png"], "orfa: cannot connect to"),
+    (["plot", "--sim", "m32d", "--control", "{tmp}/none.sock", "-o", "x.png"],
+     "orfa: give --sim (a board of its own) or --control (a running one), not both"),
 ])
 def test_command_errors_are_one_line(tmp_path, capsys, argv, message):
     good, bad = tmp_path / "t.vcd", tmp_path / "bad.vcd"

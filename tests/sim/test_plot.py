@@ -111,11 +111,12 @@ def test_i2c_signal_spans_start_to_stop(tmp_path):
     # the command draws them with the serial line that asked for them
     SHOTS.mkdir(parents=True, exist_ok=True)
     out = SHOTS / "plot-bus.png"
-    r = orfa("plot", sim_vcd, "--from", "%.3f" % waves.us(busy[0][0] - 30000, 7372800),
-             "--to", "%.3f" % waves.us(busy[-1][0] + 3000, 7372800), "-v", "-o", out)
+    f_cpu = trace.f_cpu
+    r = orfa("plot", sim_vcd, "--from", "%.3f" % waves.us(busy[0][0] - 30000, f_cpu),
+             "--to", "%.3f" % waves.us(busy[-1][0] + 3000, f_cpu), "-v", "-o", out)
     assert r.returncode == 0, r.stderr
     got = rows(r.stdout)
-    widths = [round(v * 7.3728) for t in got["i2c"][:-1] for v in us_values(t)]
+    widths = [round(v * f_cpu / 1e6) for t in got["i2c"][:-1] for v in us_values(t)]
     assert [abs(w - (stop - start)) <= 1 for w, ((start, _), (stop, _)) in
             zip(widths, [busy[0:2], busy[2:4]])] == [True, True]
     assert "D0" in got or "D2" in got            # the UART line's bytes (RX pin)
@@ -149,10 +150,15 @@ def test_live_board_through_its_control_socket(tmp_path):
     sim = SimBoard("m128s", control=True, trace=False).start()
     try:
         out = tmp_path / "live.png"
+        rx = [p for p in boardmap.load("m128s").pins if p.function == "UART_RX"][0]
+        rx = "%s%d" % (rx.port, rx.bit)
         r = orfa("plot", "--control", sim.control_path, "--port", sim.port,
-                 "--do", "servo 20 1200", "--signals", "servo20", "--for", "45ms", "-v",
+                 "--do", "servo 20 1200", "--signals", "servo20", rx, "--for", "45ms", "-v",
                  "-o", out)
         assert r.returncode == 0, r.stderr
+        # the recording starts when the command has had its reply: the
+        # request's bytes on the receive line are before it
+        assert rows(r.stdout)[rx] == ["steady 1"]
         got = rows(r.stdout)["servo20"]
         widths = [v for t in got[:-1] for v in us_values(t)]
         assert len(widths) >= 2 and all(abs(v - 1200) <= 0.5 for v in widths)

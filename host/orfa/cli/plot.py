@@ -163,7 +163,7 @@ def _from_file(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]
         raise UsageError(str(exc)) from None
     f = trace.f_cpu
     start = _cycles(args.start, f) if args.start is not None else 0
-    end = _cycles(args.stop, f) if args.stop is not None else max(trace.end, start + 1)
+    end = _cycles(args.stop, f) if args.stop is not None else max(trace.end + 1, start + 1)
     if end <= start:
         raise UsageError("--to must be after --from")
     names = trace.names()
@@ -186,24 +186,21 @@ def _run_commands(port: str, args) -> None:
             raise UsageError("--do %r failed (exit %d)" % (line, rc))
 
 
-RING = 1024                      # the simulator keeps at least the last 1024 edges per signal
+RING = 1024                      # the simulator keeps at least the last 1024 edges of a signal
 CHUNK_US = 1000                  # read them every simulated millisecond
 
 
-def _record(ctl: SimControl, f_cpu: int, args, commands
-            ) -> Tuple[Dict[str, waves.Wave], List[str], int]:
-    """Run the --do commands, let --for of simulated time pass, a
-    millisecond at a time, and take
-    every signal's edges as they come (so the simulator's ring of edges does
-    not overflow: that takes a signal changing more than once a microsecond)."""
+def _record(ctl: SimControl, f_cpu: int, args) -> Tuple[Dict[str, waves.Wave], List[str], int]:
+    """From now (after the --do commands), let --for of simulated time pass a
+    millisecond at a time and take every signal's edges as they come, so
+    the simulator's ring of the last 1024 edges holds them until they are
+    read. The board runs on while this program reads, so a fast signal (a
+    motor's PWM) can lose edges when the program is held up: it says which."""
     names = ctl.signals()
     first = ctl.requests(["time"] + ["level %s" % n for n in names])     # one cycle
-    t0 = int(first[0])
+    zero = since = int(first[0])
     levels = dict(zip(names, (int(r) for r in first[1:])))
     edges: Dict[str, List[Tuple[int, int]]] = {n: [] for n in names}
-    commands()
-    since = t0
-    zero = ctl.time()
     end = zero + _cycles(args.span, f_cpu)
     lost = []
     while since < end:
@@ -218,15 +215,19 @@ def _record(ctl: SimControl, f_cpu: int, args, commands
             edges[n] += [e for e in got if e[0] < now]
         since = now
     if lost:
-        print("orfa: plot: %s changed too fast to record every edge live; write a VCD"
-              " (orfa sim --vcd) for those" % " ".join(lost), file=sys.stderr)
-    found = {n: waves.window(n, levels[n], edges[n], t0, since) for n in names}
+        print("orfa: plot: edges of %s were dropped before they could be read (the"
+              " simulator keeps %d a signal); plot those from a VCD (orfa sim --vcd)"
+              % (" ".join(lost), RING), file=sys.stderr)
+    found = {n: waves.window(n, levels[n], edges[n], zero, since) for n in names}
     return found, names, zero
 
 
-def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]:
+def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str, int]:
     if args.trace:
         raise UsageError("give a VCD file or --sim/--control, not both")
+    if args.sim is not None and args.control is not None:
+        raise UsageError("give --sim (a board of its own) or --control (a running one),"
+                         " not both")
     if args.sim is not None:
         # a board of our own: its VCD has every edge, however far the
         # simulator runs ahead of this program while it reads
@@ -257,8 +258,8 @@ def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]:
         names = ctl.signals()
         namer = Namer(names, {"": args.board} if args.board else None)
         main_map = namer.maps.get("") or boardmap.load("m32d")
-        found, names, zero = _record(ctl, main_map.f_cpu, args,
-                                   lambda: _run_commands(args.port, args))
+        _run_commands(args.port, args)
+        found, names, zero = _record(ctl, main_map.f_cpu, args)
     return found, names, namer, main_map.f_cpu, "simulator at %s" % args.control, zero
 
 
