@@ -15,7 +15,7 @@ from orfa.dash.live import ControlError, Dashboard, NotFound, Refused
 from test_api_requests import board_answers
 
 flask = pytest.importorskip("flask", reason="orfa dash needs Flask (pip install 'orfa[dash]')")
-from orfa.dash.web import create_app  # noqa: E402
+from orfa.dash.web import _hosts, create_app  # noqa: E402
 
 M32D = boardmap.load("m32d")
 LOCAL = "%02X" % M32D.local_address
@@ -118,6 +118,17 @@ def test_subscribers_get_the_latest_snapshot_then_none_at_close(dash):
     assert q.empty()
 
 
+def test_a_signal_to_stop_is_no_board_error(dash, monkeypatch):
+    # orfa dash stops on SIGTERM with a BaseException (as Ctrl-C's
+    # KeyboardInterrupt is): the poller must let it through, not show it
+    def interrupted(board):
+        raise KeyboardInterrupt
+    monkeypatch.setattr("orfa.dash.snapshot.read", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        dash.poll()
+    assert dash.latest() is None
+
+
 def test_the_interval_must_be_positive():
     with pytest.raises(ValueError, match="above 0 s"):
         Dashboard(None, interval=0)
@@ -157,8 +168,30 @@ SNAP = {"seq": 7, "time": 1.5, "interval": 0.2, "port": "fake://", "others": [],
         "boards": [{"addr": "AA", "servo": [{"ch": 0, "us": 1500, "deg": 0.0}]}]}
 
 
-def client(**kw):
-    return create_app(StubDash(**kw)).test_client()
+def client(listen=None, **kw):
+    app = create_app(StubDash(**kw))
+    if listen is not None:
+        app.config["ORFA_HOSTS"] = _hosts(listen)       # as Server sets it
+    return app.test_client()
+
+
+@pytest.mark.parametrize("listen, host, status", [
+    ("127.0.0.1", "127.0.0.1:8000", 200), ("127.0.0.1", "localhost:8000", 200),
+    ("127.0.0.1", "[::1]:8000", 200), ("127.0.0.1", "LOCALHOST", 200),
+    ("127.0.0.1", "evil.example:8000", 403), ("127.0.0.1", "127.0.0.1.evil.example", 403),
+    ("robot.lan", "robot.lan:8000", 200), ("robot.lan", "evil.example", 403),
+    ("0.0.0.0", "evil.example:8000", 200),        # every interface: any name
+])
+def test_only_the_served_names_are_answered(listen, host, status):
+    # a page of another site whose name was rebound to 127.0.0.1 sends its
+    # own name as Host: it gets neither the values nor the controls
+    c = client(listen, snap=SNAP, outcome={"ok": 1})
+    r = c.get("/api/snapshot", headers={"Host": host})
+    assert r.status_code == status
+    r = c.post("/api/AA/servo", json={"channel": 3, "us": 1700}, headers={"Host": host})
+    assert r.status_code == status
+    if status == 403:
+        assert r.get_json()["error"].startswith("%s is not a name this dashboard" % host)
 
 
 def test_the_page_and_its_files_are_served():

@@ -5,6 +5,7 @@ SIGTERM (exit 0) and Ctrl-C (exit 130)."""
 import json
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -150,3 +151,17 @@ def test_a_port_that_does_not_open():
                        env=dict(os.environ, PYTHONPATH=str(ROOT / "host")))
     assert (r.returncode, r.stdout) == (2, "")
     assert r.stderr == "orfa: cannot open /dev/orfa-none: No such file or directory\n"
+
+
+def test_a_busy_listen_address_is_one_line():
+    require_builds(["m32d"])
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen(1)
+        port = taken.getsockname()[1]
+        r = subprocess.run([sys.executable, "-m", "orfa", "dash", "--sim", "m32d", "--no-scan",
+                            "--listen", "127.0.0.1:%d" % port],
+                           capture_output=True, text=True, cwd=ROOT, timeout=TIMEOUT,
+                           env=dict(os.environ, PYTHONPATH=str(ROOT / "host")))
+    assert (r.returncode, r.stdout) == (2, "")
+    assert r.stderr == "orfa: cannot listen on 127.0.0.1:%d: Address already in use\n" % port

@@ -47,9 +47,11 @@ def seconds(text: str) -> float:
     return value
 
 
-class _Stop(Exception):
+class _Stop(BaseException):
     """A signal to stop serving (werkzeug's serve_forever swallows
-    KeyboardInterrupt, so Ctrl-C comes as this too): the exit status."""
+    KeyboardInterrupt, so Ctrl-C comes as this too): the exit status. A
+    BaseException, as KeyboardInterrupt is, so that no `except Exception`
+    (the poller's, socketserver's) takes it for an error."""
 
     def __init__(self, status: int):
         super().__init__(status)
@@ -73,29 +75,33 @@ def cmd_dash(args) -> int:
     slaves = [] if args.no_scan else None
     if args.boards is not None:
         slaves = [address(args, a, "--boards") for a in args.boards]
-    with connect(args) as gw:
-        dash = Dashboard(gw, interval=args.interval, slaves=slaves)
-        dash.discover()
-        try:
-            server = Server(dash, host, port)
-        except OSError as exc:
-            raise UsageError("cannot listen on %s:%d: %s"
-                             % (host, port, exc.strerror or exc)) from None
-        # the requests' log lines would bury the terminal
-        logging.getLogger("werkzeug").setLevel(logging.ERROR)
-        previous = {sig: signal.signal(sig, _stop_with(status))
-                    for sig, status in ((signal.SIGTERM, 0), (signal.SIGINT, 130))}
-        try:
-            dash.start()
-            print(server.url, flush=True)
-            server.serve_forever()
-        except _Stop as stop:
-            return stop.status
-        finally:
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
-            dash.close()
-            server.httpd.server_close()
+    # from here on SIGTERM and Ctrl-C stop the command cleanly, the
+    # simulated board of --sim too (while the boards are being found as well)
+    previous = {sig: signal.signal(sig, _stop_with(status))
+                for sig, status in ((signal.SIGTERM, 0), (signal.SIGINT, 130))}
+    try:
+        with connect(args) as gw:
+            dash = Dashboard(gw, interval=args.interval, slaves=slaves)
+            dash.discover()
+            try:
+                server = Server(dash, host, port)
+            except OSError as exc:
+                raise UsageError("cannot listen on %s:%d: %s"
+                                 % (host, port, exc.strerror or exc)) from None
+            # the requests' log lines would bury the terminal
+            logging.getLogger("werkzeug").setLevel(logging.ERROR)
+            try:
+                dash.start()
+                print(server.url, flush=True)
+                server.serve_forever()
+            finally:
+                dash.close()
+                server.httpd.server_close()
+    except _Stop as stop:
+        return stop.status
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     return 0
 
 
@@ -105,7 +111,8 @@ def add_parsers(sub, common) -> None:
         description="Serve a local web page of the gateway's board and the ORFA slave"
                     " boards on its bus: servo widths and angles, motor duty and"
                     " direction, ADC volts, GPIO levels and directions, status, reset"
-                    " cause and failsafe, pushed to the page as they change, with"
+                    " cause and failsafe, read every --interval and pushed to the page,"
+                    " with"
                     " controls for servos, motors and GPIO lines. Prints the page's URL,"
                     " serves until Ctrl-C (exit 130) or SIGTERM (exit 0). Needs Flask"
                     " (pip install 'orfa[dash]'). docs/dashboard.md.",

@@ -166,10 +166,10 @@ class Dashboard:
         """A queue that gets each new snapshot (None when the dashboard
         closes); a slow reader skips to the newest."""
         q: "queue.Queue" = queue.Queue(maxsize=1)
-        with self._subs_lock:
+        with self._subs_lock:              # no snapshot published in between
             self._subscribers.append(q)
-        if self._latest is not None:
-            _offer(q, self._latest)
+            if self._latest is not None:
+                _offer(q, self._latest)
         return q
 
     def unsubscribe(self, q: "queue.Queue") -> None:
@@ -178,12 +178,11 @@ class Dashboard:
                 self._subscribers.remove(q)
 
     def _publish(self, snap: Optional[Dict[str, object]]) -> None:
-        if snap is not None:
-            self._latest = snap
-        with self._subs_lock:
-            subs = list(self._subscribers)
-        for q in subs:
-            _offer(q, snap)
+        with self._subs_lock:              # _offer never blocks
+            if snap is not None:
+                self._latest = snap
+            for q in self._subscribers:
+                _offer(q, snap)
 
     def close(self) -> None:
         """Stop the poller and end every stream."""

@@ -17,11 +17,12 @@ from __future__ import annotations
 
 import json
 import queue
+import socket
 import threading
 from typing import Iterator
 
 from flask import Flask, Response, jsonify, request
-from werkzeug.serving import make_server
+from werkzeug.serving import make_server, select_address_family
 
 from .. import protocol as p
 from .live import ControlError, Dashboard, NotFound, Refused, explain
@@ -31,9 +32,34 @@ from .live import ControlError, Dashboard, NotFound, Refused, explain
 KEEPALIVE_S = 10.0
 
 
+def _hosts(listen: str):
+    """The names a browser may use for this server (the Host header): the
+    address it listens on and the loopback names; None (any) when it listens
+    on every interface. A page of another site that rebinds its own name to
+    127.0.0.1 (DNS rebinding) is not among them, so it cannot move a motor."""
+    if listen in ("", "0.0.0.0", "::"):
+        return None
+    return {listen.lower(), "localhost", "127.0.0.1", "::1"}
+
+
+def _host_name(header: str) -> str:
+    """`127.0.0.1:8000` -> `127.0.0.1`; `[::1]:8000` -> `::1`."""
+    if header.startswith("["):
+        return header[1:].partition("]")[0].lower()
+    return header.rpartition(":")[0].lower() if ":" in header else header.lower()
+
+
 def create_app(dash: Dashboard) -> Flask:
     app = Flask(__name__, static_folder="static", static_url_path="/static")
     app.config["ORFA_DASH"] = dash
+
+    @app.before_request
+    def known_host():
+        allowed = app.config.get("ORFA_HOSTS")
+        if allowed is not None and _host_name(request.host) not in allowed:
+            return _error("%s is not a name this dashboard is served under (%s)"
+                          % (request.host, ", ".join(sorted(allowed))), 403)
+        return None
 
     @app.get("/")
     def index():
@@ -121,8 +147,18 @@ class Server:
     def __init__(self, dash: Dashboard, host: str = "127.0.0.1", port: int = 8000):
         self.dash = dash
         self.app = create_app(dash)
-        self.httpd = make_server(host, port, self.app, threaded=True)
-        self.host, self.port = host, self.httpd.server_port
+        # bound here, so a busy port or an unknown host is an OSError for
+        # the caller (werkzeug's own binding prints and exits instead)
+        sock = socket.socket(select_address_family(host, port), socket.SOCK_STREAM)
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            sock.bind((host, port))
+            sock.listen(128)
+            self.httpd = make_server(host, port, self.app, threaded=True, fd=sock.fileno())
+        finally:
+            sock.close()                   # the server holds a duplicate
+        self.app.config["ORFA_HOSTS"] = _hosts(host)
+        self.host, self.port = host, self.httpd.port
         self._thread = None
 
     @property
