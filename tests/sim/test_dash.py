@@ -9,6 +9,11 @@ live values without reloading, its controls must move the simulated pins
 come back as an error that changes nothing, and the page is saved as
 dashboard.png in $ORFA_SHOTS (default build/shots/; `make doc-images` puts
 it in docs/img/).
+
+The tests share one robot, one page and one browser (module fixtures) and
+run in file order, as a person would use the page: the bad width is
+checked against the 1700 us an earlier test set, and the screenshot comes
+last, showing what the others did.
 """
 
 import os
