@@ -8,6 +8,8 @@ ORFA 0.7.5 manual's (драйвер интроспекции, порты ВВ, �
 резисторы ...).
 """
 
+LANGUAGE = "Russian"
+
 #: Status register values, by name (boardmap.STATUS).
 STATUS = {
     "OK": "последняя операция выполнена успешно",
@@ -104,6 +106,7 @@ TEXT = {
               "фьюзы %s.\n"),
     "drivers": "## Драйверы (в порядке интроспекции)\n",
     "drivers_head": "| № | UID | драйвер | версия | регистры |",
+    "gpio_ports": "порты %s",
     "registers": "## Карта регистров\n",
     "registers_head": "| регистр | драйвер | имя | назначение |",
     "limits": ("Пределы: запрос %d символов, ответ %d; длительность импульса серв %d-%d мкс, "
@@ -139,3 +142,7 @@ def plural(n: int, one: str, few: str, many: str) -> str:
 
 def channels(n: int) -> str:
     return plural(n, "канал", "канала", "каналов")
+
+
+def nbytes(n: int) -> str:
+    return plural(n, "байт", "байта", "байт")

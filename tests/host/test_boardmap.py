@@ -49,26 +49,43 @@ def docgen(monkeypatch):
 
 
 def test_docgen_writes_both_languages(docgen):
-    names = sorted(str(p.relative_to(ROOT)) for p in docgen.pages())
+    pages = docgen.pages()
+    names = sorted(str(p.relative_to(ROOT)) for p in pages)
     assert names == ["docs/board-m128s.md", "docs/board-m32d.md",
                      "docs/ru/board-m128s.md", "docs/ru/board-m32d.md",
                      "docs/ru/protocol.md"]
-    ru = docgen.pages(("ru",))[ROOT / "docs" / "ru" / "board-m32d.md"]
+    ru = pages[ROOT / "docs" / "ru" / "board-m32d.md"]
     assert "## Значения регистра статуса" in ru
     for c in boardmap.STATUS.values():
         assert "| `%02X` | %s | %s |" % (c.code, c.name, docgen.ru.STATUS[c.name]) in ru
 
 
+def test_docgen_gives_both_languages_the_same_sections(docgen):
+    """One generator: each page has the same headings and table rows, in its words."""
+    m = boardmap.load("m128s")
+    en, ru = docgen.page("m128s", docgen.en), docgen.page("m128s", docgen.ru)
+    assert en.count("\n## ") == ru.count("\n## ") == 6
+    assert en.count("\n|") == ru.count("\n|")
+    assert en.count("\n* ") == ru.count("\n* ") == len({p.function for p in m.pins})
+    assert "## Reset causes (the sys driver's RESET register)" in en
+    for name, bit in m.reset_causes.items():
+        assert "| `%02X` | %s | %s |" % (bit, name, docgen.en.RESET_CAUSES[name]) in en
+        assert "| `%02X` | %s | %s |" % (bit, name, docgen.ru.RESET_CAUSES[name]) in ru
+    assert "* CLKn: clock input of CD4017 counter n" in en
+    for c in boardmap.ERRORS.values():
+        assert "| `ERROR %02X` | %s | %s |" % (c.code, c.name, c.text) in en
+
+
 def test_docgen_fills_the_error_table_of_the_russian_protocol_page(docgen, tmp_path):
     text = (ROOT / "docs" / "ru" / "protocol.md").read_text()
-    assert docgen.fill_blocks(text, {"errors": docgen.errors_table_ru}) == text
+    assert docgen.fill_errors(text, docgen.ru) == text
     stale = text.replace("| `ERROR 05` | NO_P |", "| `ERROR 05` | OLD |")
     assert stale != text
-    assert docgen.fill_blocks(stale, {"errors": docgen.errors_table_ru}) == text
+    assert docgen.fill_errors(stale, docgen.ru) == text
     for c in boardmap.ERRORS.values():
         assert "| `ERROR %02X` | %s | %s |" % (c.code, c.name, docgen.ru.ERRORS[c.name]) in text
     with pytest.raises(docgen.MissingText, match="no block <!-- docgen:errors -->"):
-        docgen.fill_blocks("# no table here\n", {"errors": docgen.errors_table_ru})
+        docgen.fill_errors("# no table here\n", docgen.ru)
 
 
 def test_docgen_refuses_a_status_without_russian(docgen, monkeypatch, capsys):
@@ -94,9 +111,24 @@ def test_docgen_names_each_missing_russian_text(docgen, monkeypatch, table, key,
     texts = dict(getattr(docgen.ru, table))
     del texts[key]
     monkeypatch.setattr(docgen.ru, table, texts)
-    assert docgen.missing_ru(boardmap.load("m32d")) == [label]
+    assert docgen.missing(docgen.ru, boardmap.load("m32d")) == [label]
     with pytest.raises(docgen.MissingText, match="no Russian text for %s " % label):
-        docgen.page_ru("m32d")
+        docgen.page("m32d", docgen.ru)
+    if table == "ERRORS":
+        with pytest.raises(docgen.MissingText, match="^protocol: no Russian text for error NO_P "):
+            docgen.fill_errors((ROOT / "docs" / "ru" / "protocol.md").read_text(), docgen.ru)
+
+
+def test_docgen_refuses_a_name_without_english(docgen, monkeypatch):
+    """The English word set is checked the same way, naming its own file."""
+    texts = dict(docgen.en.PIN_FUNCTIONS)
+    del texts["SERVO_RST"]
+    monkeypatch.setattr(docgen.en, "PIN_FUNCTIONS", texts)
+    assert docgen.missing(docgen.en, boardmap.load("m32d")) == []
+    with pytest.raises(docgen.MissingText) as e:
+        docgen.page("m128s", docgen.en)
+    assert str(e.value) == ("m128s: no English text for pin function SERVO_RST "
+                            "(add it to tools/docgen_en.py)")
 
 
 def test_mapgen_refuses_a_driver_whose_names_do_not_match_its_registers(tmp_path):
