@@ -5,7 +5,8 @@
  *     examples/get_drivers PORT [ADDRESS]
  *
  * ADDRESS is the board's address in the protocol's 8-bit form, in hex (10 or
- * 0x10); the default AA is the gateway's own. One line per driver:
+ * 0x10); the default AA is the gateway's own. The port runs at 115200 baud,
+ * or at $ORFA_BAUD (a gateway built with BAUD=14400, say). One line per driver:
  *
  *     UID 0x0020  version 1.1  registers 0x02-0x09 (8)
  *
@@ -118,6 +119,7 @@ int main(int argc, char **argv)
 {
 	const char *port;
 	unsigned long address = LOCAL_ADDRESS;
+	long baud;
 	orfa_t *o = NULL;
 	orfa_reply_t reply;
 	unsigned count, max_cnt, min_cnt, requests, i;
@@ -141,7 +143,20 @@ int main(int argc, char **argv)
 			return 2;
 		}
 	}
-	rc = orfa_open(&o, port, 115200);
+	baud = 115200;
+	if (getenv("ORFA_BAUD") != NULL && getenv("ORFA_BAUD")[0] != '\0') {
+		const char *text = getenv("ORFA_BAUD");
+		char *end;
+
+		errno = 0;
+		baud = strtol(text, &end, 10);
+		if (errno != 0 || end == text || *end != '\0' || baud <= 0) {
+			fprintf(stderr, "%s: bad ORFA_BAUD '%s': the gateway's rate in bits per "
+				"second (115200)\n", prog, text);
+			return 2;
+		}
+	}
+	rc = orfa_open(&o, port, baud);
 	if (rc != ORFA_OK) {
 		return fail(port, (unsigned)address, NULL, rc);
 	}

@@ -16,6 +16,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "orfa_speed.h"
 #include "serialgate/sg_rx.h"
 
 /* Characters of requests the gateway holds unanswered without overflowing
@@ -50,6 +51,11 @@ struct orfa {
 	int rx_skip;                    /* dropping the rest of an over-long line */
 };
 
+/* Highest rate asked for by number (a rate without a Bxxx name). */
+#define ORFA_BAUD_MAX 4000000L
+
+/* The Bxxx name of BAUD in *SP, or B0 for a rate set by number after
+ * tcsetattr (14400, 28800, 76800: rates the gateway can be built for). */
 static int speed_of(long baud, speed_t *sp)
 {
 	static const struct {
@@ -67,7 +73,8 @@ static int speed_of(long baud, speed_t *sp)
 			return ORFA_OK;
 		}
 	}
-	return ORFA_E_ARG;
+	*sp = B0;
+	return baud > 0 && baud <= ORFA_BAUD_MAX ? ORFA_OK : ORFA_E_ARG;
 }
 
 int orfa_open(orfa_t **out, const char *path, long baud)
@@ -108,8 +115,23 @@ int orfa_open(orfa_t **out, const char *path, long baud)
 	t.c_cflag |= CS8 | CLOCAL | CREAD;
 	t.c_cc[VMIN] = 1;
 	t.c_cc[VTIME] = 0;
-	if (cfsetispeed(&t, sp) < 0 || cfsetospeed(&t, sp) < 0 ||
-	    tcsetattr(o->fd, TCSANOW, &t) < 0 || tcflush(o->fd, TCIOFLUSH) < 0) {
+	if (sp != B0 && (cfsetispeed(&t, sp) < 0 || cfsetospeed(&t, sp) < 0)) {
+		goto fail;
+	}
+	if (tcsetattr(o->fd, TCSANOW, &t) < 0) {
+		goto fail;
+	}
+	if (sp == B0 && orfa_speed_set(o->fd, baud) < 0) {
+		if (errno == ENOTSUP) {                 /* no rates by number here */
+			tcsetattr(o->fd, TCSANOW, &o->saved);
+			close(o->fd);
+			free(o);
+			errno = EINVAL;
+			return ORFA_E_ARG;
+		}
+		goto fail;
+	}
+	if (tcflush(o->fd, TCIOFLUSH) < 0) {
 		goto fail;
 	}
 	o->timeout_ms = ORFA_TIMEOUT_MS;

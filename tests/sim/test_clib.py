@@ -75,6 +75,30 @@ def test_slave_drivers(get_drivers):
             assert r.stdout == listing(boardmap.load(board).drivers)
 
 
+def test_a_gateway_at_a_rate_termios_has_no_name_for(get_drivers):
+    """BAUD=14400: the library sets the PC's port by number (termios2), the
+    simulator's line runs at what the port says, the example reads the list."""
+    from conftest import build_gateway
+    require_builds(["m32d"])
+    sim = SimBoard("m32d", firmware=build_gateway("m32d", 14400), trace=False).start()
+    try:
+        r = subprocess.run([str(EXAMPLE), sim.port], capture_output=True, text=True,
+                           timeout=PROG_TIMEOUT, env=dict(os.environ, ORFA_BAUD="14400"))
+        assert (r.returncode, r.stderr) == (0, "")
+        assert r.stdout == listing(boardmap.load("m32d").drivers)
+    finally:
+        sim.stop()
+
+
+@pytest.mark.parametrize("value", ["fast", "0", "-9600", "9600x"])
+def test_bad_orfa_baud(get_drivers, value):
+    r = subprocess.run([str(EXAMPLE), "/nonexistent/tty"], capture_output=True, text=True,
+                       timeout=PROG_TIMEOUT, env=dict(os.environ, ORFA_BAUD=value))
+    assert (r.returncode, r.stdout) == (2, "")
+    assert r.stderr == ("get_drivers: bad ORFA_BAUD '%s': the gateway's rate in bits per"
+                        " second (115200)\n" % value)
+
+
 def test_error_reply(get_drivers):
     """No device at 0x42: the gateway's ERROR 06, one line, exit 1."""
     require_builds(["m32d"])

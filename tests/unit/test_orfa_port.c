@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "orfa.h"
+#include "orfa_speed.h"
 
 #include "check.h"
 
@@ -102,10 +103,35 @@ static void test_open(void)
 	CHECK(orfa_open(&o, "/nonexistent/tty", 115200) == ORFA_E_IO && errno == ENOENT,
 	      "missing port: errno %d", errno);
 	CHECK(o == NULL, "no handle");
-	CHECK(orfa_open(&o, slave_path, 14400) == ORFA_E_ARG, "a rate termios has no name for");
 	CHECK(orfa_open(&o, slave_path, 0) == ORFA_E_ARG, "rate 0");
+	CHECK(orfa_open(&o, slave_path, -9600) == ORFA_E_ARG, "a negative rate");
+	CHECK(orfa_open(&o, slave_path, 4000001) == ORFA_E_ARG, "a rate above 4 Mbit/s");
 	CHECK(orfa_open(NULL, slave_path, 115200) == ORFA_E_ARG, "no handle pointer");
 	orfa_close(NULL);
+}
+
+/* The rates a gateway can be built for that termios has no name for go by
+ * number (termios2 on Linux), and a named one after them goes back to a
+ * name: the port's rate is what was asked, read on a descriptor of our own. */
+static void test_rates_by_number(void)
+{
+	static const long rates[] = {14400, 28800, 76800, 115200};
+	int fd = open(slave_path, O_RDWR | O_NOCTTY);
+	size_t i;
+
+	CHECK(fd >= 0, "open %s: %s", slave_path, strerror(errno));
+	for (i = 0; i < sizeof(rates) / sizeof(rates[0]) && fd >= 0; i++) {
+		orfa_t *o = NULL;
+		int rc = orfa_open(&o, slave_path, rates[i]);
+
+		CHECK(rc == ORFA_OK, "open at %ld: %d (%s)", rates[i], rc, strerror(errno));
+		CHECK(orfa_speed_get(fd) == rates[i], "rate %ld: the port says %ld", rates[i],
+		      orfa_speed_get(fd));
+		orfa_close(o);
+	}
+	if (fd >= 0) {
+		close(fd);
+	}
 }
 
 static void test_exchange(orfa_t *o)
@@ -274,6 +300,7 @@ int main(void)
 
 	open_pty();
 	test_open();
+	test_rates_by_number();
 	CHECK(orfa_open(&o, slave_path, 115200) == ORFA_OK, "open %s", slave_path);
 	if (o != NULL) {
 		test_exchange(o);
