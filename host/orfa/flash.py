@@ -84,7 +84,7 @@ def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str) -> Pa
         except OSError as exc:
             raise FlashError("cannot read %s: %s" % (given, exc.strerror)) from None
         if ihex.is_elf(head):
-            return _converted(path, tmpdir)
+            return _converted(path, tmpdir, board_map(board))
         if head[:1] != b":":
             raise FlashError("%s is neither Intel HEX nor an ELF file" % given)
         return path
@@ -94,7 +94,7 @@ def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str) -> Pa
                                or hex_path.stat().st_mtime >= elf.stat().st_mtime):
         return _near(hex_path)
     if elf.is_file():
-        return _converted(elf, tmpdir)
+        return _converted(elf, tmpdir, board_map(board))
     addr = " ADDR=0x10" if mode == "slave" else ""
     raise FlashError("no firmware for %s %s: build it with `make BOARD=%s MODE=%s%s`,"
                      " or give --hex FILE" % (board, mode, board, mode, addr))
@@ -109,13 +109,20 @@ def _near(path: Path) -> Path:
         return path
 
 
-def _converted(elf: Path, tmpdir: str) -> Path:
+def _converted(elf: Path, tmpdir: str, board: boardmap.BoardMap) -> Path:
+    """The ELF as Intel HEX in tmpdir; an ELF whose note names another MCU
+    than the board's is refused (a HEX file says nothing of its MCU)."""
     try:
-        text = ihex.elf_to_ihex(elf.read_bytes())
+        data = elf.read_bytes()
+        text = ihex.elf_to_ihex(data)
     except OSError as exc:
         raise FlashError("cannot read %s: %s" % (elf, exc.strerror)) from None
     except ihex.ElfError as exc:
         raise FlashError("%s: %s" % (elf, exc)) from None
+    device = ihex.elf_device(data)
+    if device is not None and device != board.mcu:
+        raise FlashError("%s was built for the %s, not the %s's %s (--board)"
+                         % (elf, device, board.board, board.mcu))
     out = Path(tmpdir) / (elf.stem + ".hex")
     out.write_text(text)
     return out

@@ -10,8 +10,9 @@ the signature above), so flash is every address below 0x800000.
 
 from __future__ import annotations
 
+import re
 import struct
-from typing import Iterable, List, Tuple
+from typing import Iterable, List, Optional, Tuple
 
 #: avr-gcc's address of the data space in an ELF: flash lies below it.
 AVR_DATA_BASE = 0x800000
@@ -69,6 +70,38 @@ def flash_segments(elf: bytes) -> List[Segment]:
     if not joined:
         raise ElfError("the ELF has nothing to put in flash")
     return joined
+
+
+#: the note avr-gcc and avr-libc put in an ELF: the device it was built for
+DEVICE_NOTE = b".note.gnu.avr.deviceinfo"
+
+
+def elf_device(elf: bytes) -> Optional[str]:
+    """The device an AVR ELF was built for ("atmega32"), from its
+    .note.gnu.avr.deviceinfo section (its descriptor ends with the device's
+    name in a string table); None when the ELF has no such note."""
+    if not is_elf(elf) or len(elf) < 52:
+        return None
+    shoff, = struct.unpack_from("<I", elf, 32)
+    shentsize, shnum, shstrndx = struct.unpack_from("<HHH", elf, 46)
+    if not shnum or shentsize < 40 or shoff + shnum * shentsize > len(elf) or shstrndx >= shnum:
+        return None
+    sections = [struct.unpack_from("<10I", elf, shoff + i * shentsize) for i in range(shnum)]
+    names_at, names_size = sections[shstrndx][4], sections[shstrndx][5]
+    names = elf[names_at:names_at + names_size]
+    for sh in sections:
+        name = names[sh[0]:names.find(b"\0", sh[0])]
+        if name != DEVICE_NOTE:
+            continue
+        note = elf[sh[4]:sh[4] + sh[5]]
+        if len(note) < 12:
+            return None
+        namesz, descsz, _type = struct.unpack_from("<3I", note, 0)
+        desc = note[12 + (namesz + 3) // 4 * 4:][:descsz]
+        strings = [w for w in desc.split(b"\0") if w]
+        last = strings[-1] if strings else b""
+        return last.decode("ascii") if re.fullmatch(rb"[a-z][a-z0-9]+", last) else None
+    return None
 
 
 def _record(rtype: int, addr: int, data: bytes) -> str:

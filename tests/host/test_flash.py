@@ -15,7 +15,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from flashcheck import Avrdude, elf_flash_image, elf_flash_sections, read_ihex  # noqa: E402
 
-from orfa import flash  # noqa: E402
+from orfa import boardmap, flash  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 BOARDS = ("m32d", "m128s")
@@ -294,7 +294,7 @@ def test_orfa_flash_when_avrdude_fails(avrdude, built):
     assert r.returncode == 1 and "orfa: avrdude failed" in r.stderr
 
 
-def test_orfa_flash_refuses_bad_input_before_avrdude(avrdude, tmp_path):
+def test_orfa_flash_refuses_bad_input_before_avrdude(avrdude, built, tmp_path):
     text = tmp_path / "notes.txt"
     text.write_text("not firmware\n")
     x86 = tmp_path / "x86.elf"                # a 32-bit ELF header for the i386
@@ -305,6 +305,12 @@ def test_orfa_flash_refuses_bad_input_before_avrdude(avrdude, tmp_path):
         (["--hex", str(text)], "orfa: %s is neither Intel HEX nor an ELF file\n" % text),
         (["--hex", str(x86)], "orfa: %s: an ELF for machine 3, not the AVR (83)\n" % x86),
     ]
+    # an ELF of the other board's MCU (its note says which: avr-libc's deviceinfo)
+    for board, other in (("m32d", "m128s"), ("m128s", "m32d")):
+        elf = ROOT / "build" / ("%s-gate" % other) / "orfa.elf"
+        cases.append((["--board", board, "--hex", str(elf)],
+                      "orfa: %s was built for the %s, not the %s's %s (--board)\n"
+                      % (elf, boardmap.load(other).mcu, board, boardmap.load(board).mcu)))
     for args, message in cases:
         r = orfa(avrdude, *args)
         assert r.returncode == 2, (args, r.stderr)
