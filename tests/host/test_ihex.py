@@ -109,3 +109,19 @@ def test_bad_elves():
     segment = struct.pack("<8I", 1, 200, 0, 0, 16, 16, 5, 2)      # data past the end
     with pytest.raises(ihex.ElfError, match="a segment past the end"):
         ihex.elf_to_ihex(elf_header(phnum=1) + segment)
+
+
+def test_the_device_an_elf_was_built_for(far_elf, tmp_path):
+    assert ihex.elf_device(far_elf.read_bytes()) == "atmega128"
+    # the note as avr-gcc writes it is what the device is read from: without
+    # it, no device (a HEX file never has one)
+    bare = tmp_path / "bare.elf"
+    subprocess.run(["avr-objcopy", "-R", ".note.gnu.avr.deviceinfo", str(far_elf), str(bare)],
+                   check=True)
+    assert ihex.elf_device(bare.read_bytes()) is None
+    assert ihex.elf_device(b":00000001FF\n") is None
+    tiny = tmp_path / "t.c"
+    tiny.write_text("int main(void) { return 0; }\n")
+    subprocess.run(["avr-gcc", "-mmcu=atmega32", str(tiny), "-o", str(tmp_path / "t32.elf")],
+                   check=True)
+    assert ihex.elf_device((tmp_path / "t32.elf").read_bytes()) == "atmega32"
