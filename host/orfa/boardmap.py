@@ -34,6 +34,11 @@ class Pin:
     def label(self) -> str:
         return "P%s%d" % (self.port, self.bit)
 
+    @property
+    def signal(self) -> str:
+        """The simulator's name of the pin ("D5": its signals, `pin D5`)."""
+        return "%s%d" % (self.port, self.bit)
+
 
 @dataclass(frozen=True)
 class DriverMap:
@@ -114,8 +119,10 @@ class BoardMap:
     def uids(self) -> Tuple[int, ...]:
         return tuple(d.uid for d in self.drivers)
 
-    def pins_of(self, function: str) -> Tuple[Pin, ...]:
-        return tuple(p for p in self.pins if p.function == function)
+    def pins_of(self, function: str, index: Optional[int] = None) -> Tuple[Pin, ...]:
+        """The pins of a function (and index: the channel, the motor)."""
+        return tuple(p for p in self.pins if p.function == function
+                     and (index is None or p.index == index))
 
 
 @lru_cache(maxsize=None)

@@ -52,6 +52,12 @@ def window(name: str, initial: int, edges: Sequence[Edge], start: int, end: int)
     return Wave(name, start, end, at_start, tuple(inside))
 
 
+def clip(wave: Wave, start: int, end: int) -> Wave:
+    """The part of a wave between start and end (within its own window)."""
+    return window(wave.name, wave.level, wave.edges, max(start, wave.start),
+                  min(end, wave.end))
+
+
 def high_time(wave: Wave) -> int:
     """Cycles the wave is high inside its window."""
     total, level, since = 0, wave.level, wave.start

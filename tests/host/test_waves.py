@@ -148,8 +148,8 @@ def test_labels_come_from_the_board_map():
                                                           for b in range(8)])
     assert m32.maps[""].board == "m32d"
     assert m32.label("A3") == "A3\nservo 3"
-    motor = [p for p in boardmap.load("m32d").pins if p.function == "MOTOR_PWM"][0]
-    pin = "%s%d" % (motor.port, motor.bit)
+    motor = boardmap.load("m32d").pins_of("MOTOR_PWM")[0]
+    pin = motor.signal
     assert "motor %d PWM" % (motor.index + 1) in m32.label(pin)
     assert m32.label("servo3") == "servo3\npin A3"
     assert m32.label("i2c") == "i2c\nbus busy"
@@ -157,8 +157,8 @@ def test_labels_come_from_the_board_map():
     m128 = cli_plot.Namer(["servo3"] + ["%s%d" % (p, b) for p in "ABCDEFG" for b in range(8)])
     assert m128.maps[""].board == "m128s"
     assert m128.rank("servo3") == 0
-    clk = [p for p in boardmap.load("m128s").pins if p.function == "SERVO_CLK"][0]
-    assert m128.rank("%s%d" % (clk.port, clk.bit)) is None
+    clk = boardmap.load("m128s").pins_of("SERVO_CLK")[0]
+    assert m128.rank(clk.signal) is None
 
 
 def test_select_by_pattern_keeps_the_order_and_refuses_unknown_names():

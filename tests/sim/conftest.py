@@ -235,13 +235,12 @@ def _layout(board: str) -> dict:
     """Registers and pins of a board with all its drivers, from its map
     (orfa.boardmap, generated from the firmware's C definitions)."""
     m = boardmap.load(board)
-    label = lambda pin: "%s%d" % (pin.port, pin.bit)          # noqa: E731
     servo_pins = sorted(m.pins_of("SERVO"), key=lambda pin: pin.index)
     fixed = {}
     for pin in m.pins:
         kind = pin.function.split("_")[0]
         if pin.function != "SERVO":          # a servo channel's pin is GPIO's when off
-            fixed[label(pin)] = kind
+            fixed[pin.signal] = kind
     return {
         "gpio_ports": m.gpio_ports,
         "gpio_val": m.reg("gpio", "VALUE_" + m.gpio_ports[0]),
@@ -250,12 +249,12 @@ def _layout(board: str) -> dict:
         "motor": m.reg("motor", "PWM1") if m.has("motor") else None,
         "servo": m.reg("servo", "RS"), "sys": m.reg("sys", "RESET"),
         "servo_channels": m.servo_channels, "adc_port": m.adc_port,
-        "spi_pins": {pin.function[4:]: label(pin) for pin in m.pins
+        "spi_pins": {pin.function[4:]: pin.signal for pin in m.pins
                      if pin.function.startswith("SPI_")},
         # channel n's pin; the simulator's signal when counters drive them
-        "servo_pins": ([label(pin) for pin in servo_pins] if servo_pins
+        "servo_pins": ([pin.signal for pin in servo_pins] if servo_pins
                        else ["servo%d" % n for n in range(m.servo_channels)]),
-        "fixed_scl": label(m.pins_of("TWI_SCL")[0]),
+        "fixed_scl": m.pins_of("TWI_SCL")[0].signal,
         # pins of functions that GPIO never has (UART, TWI, SPI, motors, counters)
         "fixed_pins": fixed,
     }

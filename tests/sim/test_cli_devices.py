@@ -16,8 +16,8 @@ M32D = boardmap.load("m32d")
 
 
 def pin_of(function, index):
-    (pin,) = [p for p in M32D.pins if p.function == function and p.index == index]
-    return "%s%d" % (pin.port, pin.bit)
+    (pin,) = M32D.pins_of(function, index)
+    return pin.signal
 
 
 @pytest.fixture(scope="module")

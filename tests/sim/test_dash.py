@@ -242,8 +242,8 @@ def test_gpio_control_sets_the_line(page, robot):
 
 
 def test_motor_control_runs_the_motor(page, robot):
-    pwm = [p for p in GW_MAP.pins_of("MOTOR_PWM") if p.index == 0][0]
-    direction = [p for p in GW_MAP.pins_of("MOTOR_DIR") if p.index == 0][0]
+    pwm = GW_MAP.pins_of("MOTOR_PWM", 0)[0]
+    direction = GW_MAP.pins_of("MOTOR_DIR", 0)[0]
     Select(page.find_element(By.ID, "b-%s-motor-n" % GW_KEY)).select_by_value("1")
     field = page.find_element(By.ID, "b-%s-motor-duty" % GW_KEY)
     field.clear()
@@ -253,9 +253,9 @@ def test_motor_control_runs_the_motor(page, robot):
     assert text(page, "b-%s-motor-dir-1" % GW_KEY) == "backward"
     start = robot.wait_s(0.001)
     robot.wait_s(0.002)
-    m = robot.control.measure("%s%d" % (pwm.port, pwm.bit), 20, start)
+    m = robot.control.measure(pwm.signal, 20, start)
     assert abs(m["duty"] - 128 / 255) < 0.01, m
-    assert robot.control.pin("%s%d" % (direction.port, direction.bit))[0] == 1
+    assert robot.control.pin(direction.signal)[0] == 1
 
 
 def test_a_bad_width_is_an_error_and_changes_nothing(page, robot):
@@ -274,7 +274,7 @@ def test_screenshot(page):
     servo_control(page, GW_KEY, 7, 1500)
     wait_for(page, "channel 7 at 1500 us", lambda d: text(d, "b-%s-servo-7" % GW_KEY) == "1500")
     # the servo channel on motor 1's PWM line: the running motor holds it
-    pwm = [p for p in GW_MAP.pins_of("MOTOR_PWM") if p.index == 0][0]
+    pwm = GW_MAP.pins_of("MOTOR_PWM", 0)[0]
     shared = [p.index for p in GW_MAP.pins_of("SERVO") if (p.port, p.bit) == (pwm.port, pwm.bit)]
     servo_control(page, GW_KEY, shared[0], 2100)
     wait_for(page, "the refusal", lambda d: "PIN_BUSY" in (text(d, "message") or ""))

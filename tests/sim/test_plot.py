@@ -127,8 +127,8 @@ def test_live_board_with_sim(tmp_path):
     require_builds(["m32d"])
     SHOTS.mkdir(parents=True, exist_ok=True)
     out = SHOTS / "plot-servo.png"
-    motor = [p for p in boardmap.load("m32d").pins if p.function == "MOTOR_PWM"][0]
-    pwm = "%s%d" % (motor.port, motor.bit)
+    motor = boardmap.load("m32d").pins_of("MOTOR_PWM")[0]
+    pwm = motor.signal
     r = orfa("--sim", "m32d", "plot", "--do", "servo 3 1500", "--do", "servo 5 --angle 45",
              "--do", "motor %d 100" % (motor.index + 1), "--signals", "servo3", "servo5", pwm,
              "--from", "0", "--to", "45ms", "-v", "-o", out)
@@ -150,8 +150,7 @@ def test_live_board_through_its_control_socket(tmp_path):
     sim = SimBoard("m128s", control=True, trace=False).start()
     try:
         out = tmp_path / "live.png"
-        rx = [p for p in boardmap.load("m128s").pins if p.function == "UART_RX"][0]
-        rx = "%s%d" % (rx.port, rx.bit)
+        rx = boardmap.load("m128s").pins_of("UART_RX")[0].signal
         r = orfa("plot", "--control", sim.control_path, "--port", sim.port,
                  "--do", "servo 20 1200", "--signals", "servo20", rx, "--for", "45ms", "-v",
                  "-o", out)

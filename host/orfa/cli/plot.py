@@ -64,10 +64,7 @@ class Namer:
             return [("SERVO_SIGNAL", int(local[5:]))]
         if local == "i2c":
             return [("I2C_BUSY", 0)]
-        if m is None or not re.fullmatch(r"[A-G][0-7]", local):
-            return []
-        return [(p.function, p.index) for p in m.pins
-                if p.port == local[0] and p.bit == int(local[1])]
+        return [(p.function, p.index) for p in (m.pins if m else ()) if p.signal == local]
 
     def label(self, name: str) -> str:
         prefix, local = self._split(name)
@@ -93,10 +90,8 @@ class Namer:
 
     def _servo_pin(self, prefix: str, index: int) -> Optional[str]:
         m = self.maps.get(prefix)
-        for p in (m.pins if m else ()):
-            if p.function == "SERVO" and p.index == index:
-                return "%s%d" % (p.port, p.bit)
-        return None
+        pins = m.pins_of("SERVO", index) if m else ()
+        return pins[0].signal if pins else None
 
     def rank(self, name: str) -> Optional[int]:
         """Where a changing signal goes among the default rows (None: not shown
@@ -154,6 +149,12 @@ def _cycles(us: float, f_cpu: int) -> int:
     return int(round(us * f_cpu / 1e6))
 
 
+def _windows(trace: vcd.Trace, start: int, end: int) -> Dict[str, waves.Wave]:
+    """Every signal of the trace between start and end."""
+    return {n: waves.window(n, trace.initial[n], trace.edges(n), start, end)
+            for n in trace.names()}
+
+
 def _from_file(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]:
     try:
         trace = vcd.load(args.trace)
@@ -167,7 +168,7 @@ def _from_file(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]
     if end <= start:
         raise UsageError("--to must be after --from")
     names = trace.names()
-    found = {n: waves.window(n, trace.initial[n], trace.edges(n), start, end) for n in names}
+    found = _windows(trace, start, end)
     boards = trace.board_of()
     if args.board:
         boards[""] = args.board
@@ -245,7 +246,7 @@ def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str, 
         finally:
             sim.stop()
         names = trace.names()
-        found = {n: waves.window(n, trace.initial[n], trace.edges(n), t0, t1) for n in names}
+        found = _windows(trace, t0, t1)
         return (found, names, Namer(names, trace.board_of()), trace.f_cpu,
                 "simulated %s" % args.sim, zero)
     if args.do and not args.port:
@@ -275,7 +276,7 @@ def _narrow(found: Dict[str, waves.Wave], args, f_cpu: int, zero: int
         end = zero + _cycles(args.stop, f_cpu) if args.stop is not None else w.end
         if end <= start:
             raise UsageError("--to must be after --from")
-        out[n] = waves.window(n, w.level, w.edges, max(start, w.start), min(end, w.end))
+        out[n] = waves.clip(w, start, end)
     return out
 
 
@@ -300,7 +301,7 @@ def _trim(found: Dict[str, waves.Wave], chosen: Sequence[str]) -> Dict[str, wave
     w0 = found[chosen[0]]
     pad = max((max(times) - min(times)) // 20, (w0.end - w0.start) // 200, 1)
     start, end = max(w0.start, min(times) - pad), min(w0.end, max(times) + pad + 1)
-    return {n: waves.window(n, found[n].level, found[n].edges, start, end) for n in chosen}
+    return {n: waves.clip(found[n], start, end) for n in chosen}
 
 
 def cmd_plot(args) -> int:
