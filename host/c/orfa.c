@@ -84,6 +84,8 @@ int orfa_open(orfa_t **out, const char *path, long baud)
 	orfa_t *o;
 	int flags;
 	int saved_errno;
+	int rc = ORFA_E_IO;
+	int changed = 0;                        /* the port's settings are ours */
 
 	if (out == NULL || path == NULL || speed_of(baud, &sp) != ORFA_OK) {
 		errno = EINVAL;
@@ -121,13 +123,11 @@ int orfa_open(orfa_t **out, const char *path, long baud)
 	if (tcsetattr(o->fd, TCSANOW, &t) < 0) {
 		goto fail;
 	}
+	changed = 1;
 	if (sp == B0 && orfa_speed_set(o->fd, baud) < 0) {
 		if (errno == ENOTSUP) {                 /* no rates by number here */
-			tcsetattr(o->fd, TCSANOW, &o->saved);
-			close(o->fd);
-			free(o);
+			rc = ORFA_E_ARG;
 			errno = EINVAL;
-			return ORFA_E_ARG;
 		}
 		goto fail;
 	}
@@ -139,12 +139,15 @@ int orfa_open(orfa_t **out, const char *path, long baud)
 	return ORFA_OK;
 fail:
 	saved_errno = errno;
+	if (changed) {
+		tcsetattr(o->fd, TCSANOW, &o->saved);
+	}
 	if (o->fd >= 0) {
 		close(o->fd);
 	}
 	free(o);
 	errno = saved_errno;
-	return ORFA_E_IO;
+	return rc;
 }
 
 void orfa_close(orfa_t *o)
