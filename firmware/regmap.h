@@ -22,7 +22,8 @@
 	X(NOT_READABLE, 0x05, "the register cannot be read") \
 	X(READ_WRAPPED, 0x06, "introspection read past the last driver and went on with driver 1") \
 	X(NOT_BOUND, 0x07, "SPI channel without a chip-select line") \
-	X(NO_REGISTER, 0x08, "a write frame named a register that no driver maps")
+	X(NO_REGISTER, 0x08, "a write frame named a register that no driver maps") \
+	X(DROPPED, 0x09, "a write frame its master abandoned was dropped, nothing of it applied")
 
 typedef enum {
 #define REG_STATUS_ENUM(name, code, text) REG_##name = code,

@@ -8,6 +8,7 @@
 #include "board.h"
 #include "firmware/clock.h"
 #include "firmware/mcu.h"
+#include "firmware/twi_quiet.h"
 #include "firmware/twi_rate.h"
 
 /* How long one step waits for the bus: a slave may stretch SCL while it
@@ -24,13 +25,49 @@ _Static_assert((TWI_WAIT_TICKS + 2) * CLOCK_TICK_CYCLES <= F_CPU / 100,
 	       "the wait, its phase and a tick for the reply within 10 ms");
 
 static struct {
-	uint8_t ticks;  /* clock ticks a step may take before it has failed */
+	uint8_t ticks;     /* clock ticks a step may take before it has failed */
+	uint8_t quiet;     /* the quiet fence is up (twi_quiet.h) */
+	uint8_t open;      /* a START of ours is on the bus, no STOP yet */
+	uint16_t quiet_t0; /* clock_now() when it went up */
 } twi;
+
+/* Nothing of ours on the bus until the fence is down: a frame this board
+ * gave up on, or may have been in when it reset, is dropped by its slave
+ * first (twi_quiet.h). */
+static void twi_fence_up(void)
+{
+	twi.quiet = 1;
+	twi.quiet_t0 = clock_now();
+}
+
+static void twi_fence_wait(void)
+{
+	if (twi.quiet) {
+		while ((uint16_t)(clock_now() - twi.quiet_t0) <= TWI_QUIET_FENCE_TICKS) {
+		}
+		twi.quiet = 0;
+	}
+}
+
+/* The transaction is given up without a STOP (that would make a slave
+ * apply a frame cut short): the TWI off and on again (TWBR/TWPS stay), the
+ * lines released, the fence up. */
+static twi_result_t twi_abandon(void)
+{
+	TWCR = 0;
+	TWCR = _BV(TWEN);
+	twi.open = 0;
+	twi_fence_up();
+	return TWI_FAIL;
+}
 
 void twi_init(void)
 {
 	TWCR = _BV(TWEN);
 	twi_set_khz(100);
+	/* This board may have reset in the middle of a frame. */
+	twi.open = 0;
+	twi_fence_up();
 }
 
 uint16_t twi_set_khz(uint16_t khz)
@@ -48,16 +85,15 @@ uint16_t twi_set_khz(uint16_t khz)
 }
 
 /* Waits until the TWCR bits in `mask` read `want`, within the bound. A step
- * that gets nowhere resets the TWI (off and on again; TWBR/TWPS stay), so
- * the next request starts clean. The watchdog is fed only when the bus
- * made progress: a wait that never ends cannot keep a hung board alive. */
+ * that gets nowhere abandons the transaction, so the next request starts
+ * clean. The watchdog is fed only when the bus made progress: a wait that
+ * never ends cannot keep a hung board alive. */
 static bool twi_wait_for(uint8_t mask, uint8_t want)
 {
 	uint8_t t0 = clock_now8();
 	while ((TWCR & mask) != want) {
 		if ((uint8_t)(clock_now8() - t0) > twi.ticks) {
-			TWCR = 0;
-			TWCR = _BV(TWEN);
+			twi_abandon();
 			return false;
 		}
 	}
@@ -73,10 +109,15 @@ static bool twi_wait(void)
 
 twi_result_t twi_start(uint8_t addr8)
 {
+	twi_fence_wait();
 	TWCR = _BV(TWINT) | _BV(TWSTA) | _BV(TWEN);
-	if (!twi_wait() || (TW_STATUS != TW_START && TW_STATUS != TW_REP_START)) {
+	if (!twi_wait()) {
 		return TWI_FAIL;
 	}
+	if (TW_STATUS != TW_START && TW_STATUS != TW_REP_START) {
+		return twi_abandon();
+	}
+	twi.open = 1;
 	TWDR = addr8;
 	TWCR = _BV(TWINT) | _BV(TWEN);
 	if (!twi_wait()) {
@@ -90,7 +131,8 @@ twi_result_t twi_start(uint8_t addr8)
 	case TW_MR_SLA_NACK:
 		return TWI_NACK;
 	default:
-		return TWI_FAIL;
+		/* arbitration lost, a bus error */
+		return twi_abandon();
 	}
 }
 
@@ -107,7 +149,7 @@ twi_result_t twi_write(uint8_t byte)
 	case TW_MT_DATA_NACK:
 		return TWI_NACK;
 	default:
-		return TWI_FAIL;
+		return twi_abandon();
 	}
 }
 
@@ -119,13 +161,17 @@ twi_result_t twi_read(uint8_t *byte, bool ack)
 	}
 	*byte = TWDR;
 	uint8_t want = ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK;
-	return TW_STATUS == want ? TWI_ACK : TWI_FAIL;
+	return TW_STATUS == want ? TWI_ACK : twi_abandon();
 }
 
-void twi_stop(void)
+bool twi_stop(void)
 {
+	if (!twi.open) {
+		return true;  /* nothing of ours on the bus (given up already) */
+	}
+	twi.open = 0;
 	TWCR = _BV(TWINT) | _BV(TWSTO) | _BV(TWEN);
-	twi_wait_for(_BV(TWSTO), 0);
+	return twi_wait_for(_BV(TWSTO), 0);
 }
 
 /* Open-drain lines by hand: low = output 0, released = input with pull-up. */
@@ -148,6 +194,8 @@ bool twi_clear_bus(void)
 	const uint8_t scl = _BV(BOARD_TWI_SCL);
 	const uint8_t sda = _BV(BOARD_TWI_SDA);
 
+	twi_fence_wait();  /* a STOP would end an abandoned frame as complete */
+	twi.open = 0;
 	TWCR = 0;  /* the pins become ordinary port pins */
 	line_release(p, scl);
 	line_release(p, sda);

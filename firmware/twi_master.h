@@ -1,8 +1,11 @@
 /*
  * TWI (I2C) master, polled, with a time bound on every step (clock.h ticks:
  * about 9 ms plus the step's own bus time) so that a missing or stuck
- * device gives an error within 10 ms, never a hang. A step that times out
- * resets the TWI (TWBR/TWPS kept).
+ * device gives an error within 10 ms, never a hang. A step that fails (times
+ * out, loses arbitration, sees a bus error) abandons the transaction: the
+ * TWI is reset (TWBR/TWPS kept), no STOP is sent, and nothing goes on the
+ * bus again until a slave has dropped the frame (twi_quiet.h), as after
+ * this board's own reset.
  */
 #ifndef ORFA_TWI_MASTER_H
 #define ORFA_TWI_MASTER_H
@@ -13,7 +16,7 @@
 typedef enum {
 	TWI_ACK = 0,   /* the byte was acknowledged */
 	TWI_NACK,      /* it was not */
-	TWI_FAIL,      /* bus error, arbitration lost or timeout (TWI reset) */
+	TWI_FAIL,      /* bus error, arbitration lost or timeout: abandoned */
 } twi_result_t;
 
 void twi_init(void);
@@ -22,15 +25,19 @@ void twi_init(void);
  * returns that rate in kHz, rounded down. */
 uint16_t twi_set_khz(uint16_t khz);
 
-/* START (or repeated START) and the address byte (8-bit form, bit 0 = read). */
+/* START (or repeated START) and the address byte (8-bit form, bit 0 = read);
+ * first waits out the quiet fence if it is up. */
 twi_result_t twi_start(uint8_t addr8);
 twi_result_t twi_write(uint8_t byte);
 /* Reads a byte; `ack` tells the slave more bytes are wanted. */
 twi_result_t twi_read(uint8_t *byte, bool ack);
-void twi_stop(void);
+/* STOP, ending the transaction. False when it could not be put on the bus
+ * (a step timed out: abandoned, the frame is dropped by its slave); true
+ * when it was, or the transaction was abandoned already. */
+bool twi_stop(void);
 
-/* Frees a bus held by a slave: clocks SCL until SDA is released (at most 9
- * clocks), then a STOP; the TWI is re-enabled afterwards (clock kept).
+/* Frees a bus held by a slave: after the quiet fence, clocks SCL until SDA
+ * is released (at most 9 clocks), then a STOP; the TWI is re-enabled afterwards (clock kept).
  * True when both lines are high at the end, false when SDA stayed low
  * after nine clocks or SCL is held low. */
 bool twi_clear_bus(void);

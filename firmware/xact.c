@@ -23,6 +23,14 @@ void xact_init(void)
 	xact.state = XACT_IDLE;
 }
 
+void xact_frame_drop(void)
+{
+	if (xact.state == XACT_DATA && xact.len > 0) {
+		regmap_set_status(REG_DROPPED);
+	}
+	xact.state = XACT_IDLE;
+}
+
 void xact_write_requested(uint8_t *buf, uint8_t cap)
 {
 	xact.state = XACT_SELECT;

@@ -27,8 +27,14 @@
 
 #include "firmware/regmap.h"
 
-/* Forget any frame in progress (reset, bus error). */
+/* Forget any frame in progress (reset). */
 void xact_init(void);
+
+/* The master abandoned the frame in progress (a bus error, a frame gone
+ * quiet: twi_quiet.h): nothing of it is applied, and a write that held
+ * data sets the status to REG_DROPPED (one refused already keeps its
+ * reason; a bare register selection stands). */
+void xact_frame_drop(void);
 
 /* A write frame begins; its data may use `cap` bytes at `buf`. */
 void xact_write_requested(uint8_t *buf, uint8_t cap);

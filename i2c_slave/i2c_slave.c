@@ -14,6 +14,7 @@
 
 #include "firmware/clock.h"
 #include "firmware/sys.h"
+#include "firmware/twi_quiet.h"
 #include "i2c_slave/slave_fsm.h"
 
 #ifndef ORFA_ADDR
@@ -27,13 +28,17 @@ _Static_assert(ORFA_ADDR >= 0x10 && ORFA_ADDR < 0xF0, "ADDR is an I2C reserved a
 #define SLAVE_TWCR (_BV(TWEN) | _BV(TWIE) | _BV(TWEA))
 
 static volatile uint8_t slave_deferred;
-/* Low byte of the clock tick of the last TWI event. */
+/* Low byte of the clock tick of the last TWI event, or of the end of the
+ * work it was deferred to (the master waited on us meanwhile). */
 static volatile uint8_t slave_seen;
 
-/* A frame left open with no bus event for this long: its master is gone
- * (reset in the middle of it). SMBus allows a device 25-35 ms. */
-#define SLAVE_STALL_TICKS CLOCK_TICKS_MS(30)
-_Static_assert(SLAVE_STALL_TICKS < 250, "the low byte of the clock suffices");
+/* Has the open frame had no bus event for longer than a healthy master
+ * leaves one? Its master abandoned it (twi_quiet.h). */
+static bool slave_quiet(void)
+{
+	return slave_fsm_in_frame() &&
+	       (uint8_t)(clock_now8() - slave_seen) > TWI_QUIET_DROP_TICKS;
+}
 
 static void slave_apply(slave_action_t act, uint8_t byte)
 {
@@ -67,6 +72,12 @@ ISR(TWI_vect)
 	/* TWIE off before interrupts are on again, or this one would come
 	 * back at once: TWINT is a level. Writing TWINT 0 leaves it set. */
 	TWCR = (uint8_t)(TWCR & ~(_BV(TWINT) | _BV(TWIE)));
+	/* An event that ends a frame gone quiet (the START of the next
+	 * request, however soon the main loop would have looked) finds it
+	 * dropped, not applied. */
+	if (slave_quiet()) {
+		slave_fsm_drop();
+	}
 	slave_seen = clock_now8();
 	sei();
 	uint8_t byte = TWDR;
@@ -88,13 +99,6 @@ void front_init(void)
 	TWCR = SLAVE_TWCR;
 }
 
-/* Is the frame open and silent for SLAVE_STALL_TICKS? */
-static bool slave_stalled(void)
-{
-	return slave_fsm_in_frame() &&
-	       (uint8_t)(clock_now8() - slave_seen) > SLAVE_STALL_TICKS;
-}
-
 void front_poll(void)
 {
 	if (!slave_deferred) {
@@ -102,11 +106,11 @@ void front_poll(void)
 		 * TWI addressed for good (a transmitter could hold SDA low):
 		 * start again, the frame dropped (a write is not applied).
 		 * Checked again with interrupts off: an event may just come. */
-		if (slave_stalled()) {
+		if (slave_quiet()) {
 			cli();
-			if (slave_stalled()) {
+			if (slave_quiet()) {
 				TWCR = 0;
-				slave_fsm_init();
+				slave_fsm_drop();
 				TWCR = SLAVE_TWCR;
 			}
 			sei();
@@ -118,5 +122,6 @@ void front_poll(void)
 	slave_deferred = 0;
 	uint8_t byte = 0xFF;
 	slave_action_t act = slave_fsm_work(&byte);
+	slave_seen = clock_now8();
 	slave_apply(act, byte);
 }

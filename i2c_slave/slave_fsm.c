@@ -26,6 +26,14 @@ void slave_fsm_init(void)
 	slave.in_frame = 0;
 }
 
+void slave_fsm_drop(void)
+{
+	xact_frame_drop();
+	slave.work = WORK_NONE;
+	slave.in_write = 0;
+	slave.in_frame = 0;
+}
+
 bool slave_fsm_in_frame(void)
 {
 	return slave.in_frame;
@@ -88,7 +96,7 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 		xact_frame_end();
 		return SLAVE_ACK;
 	case TW_BUS_ERROR:
-		slave_fsm_init();
+		slave_fsm_drop();
 		return SLAVE_RECOVER;
 	default:
 		/* General call is off (TWGCE = 0); nothing else is ours. */

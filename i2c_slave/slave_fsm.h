@@ -11,7 +11,10 @@
  *  - the own read address is always acknowledged: a register that cannot
  *    be read sends FF bytes, and the status register tells;
  *  - a write is applied when its frame ends (TW_SR_STOP: STOP or repeated
- *    START), all or nothing; a rejection then is told by the status only.
+ *    START), all or nothing; a rejection then is told by the status only;
+ *  - a frame its master abandons is dropped, never applied: on a bus error,
+ *    and when the frame goes quiet (i2c_slave.c calls slave_fsm_drop()
+ *    before the late event, twi_quiet.h).
  *
  * Work that calls a driver (applying a write, a driver's read answer) is
  * never done in the interrupt: the event returns SLAVE_DEFER, TWINT stays
@@ -37,6 +40,11 @@ typedef enum {
 } slave_action_t;
 
 void slave_fsm_init(void);
+
+/* The master abandoned the frame in progress (it went quiet: twi_quiet.h):
+ * dropped, a write in it not applied, the status says so. Also a bus
+ * error's doing. */
+void slave_fsm_drop(void);
 
 /* A TWI event: `status` is TW_STATUS; `*byte` holds TWDR for received
  * data and receives the byte to send for SLAVE_SEND. */

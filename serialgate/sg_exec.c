@@ -104,8 +104,10 @@ static void run_i2c(sg_parser_t *p)
 		}
 		i = (uint8_t)(i + 2 + n);
 	}
-	if (on_bus) {
-		twi_stop();
+	/* A STOP that cannot be made leaves the last frame unfinished: its
+	 * slave drops it (twi_quiet.h), so the request failed. */
+	if (on_bus && !twi_stop() && err == SG_OK) {
+		err = SG_ERR_DATA_NACK;
 	}
 	if (err != SG_OK) {
 		out_error(err);

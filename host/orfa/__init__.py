@@ -7,7 +7,7 @@ from .protocol import (  # noqa: F401
     ReplyTimeout, UnknownCommandError, Write, WriteResult,
 )
 from .errors import (  # noqa: F401
-    BadLengthError, BadValueError, NoDriverError, NoRegisterError, NotBoundError,
+    BadLengthError, BadValueError, DroppedError, NoDriverError, NoRegisterError, NotBoundError,
     NotReadableError, NotWritableError, PinBusyError, RegisterError, SerialError,
     Status,
 )

@@ -95,12 +95,18 @@ class NoRegisterError(RegisterError):
     status_name = "NO_REGISTER"
 
 
+class DroppedError(RegisterError):
+    """A slave dropped a write frame its master abandoned (docs/protocol.md,
+    "Abandoned frames"): nothing of it was applied."""
+    status_name = "DROPPED"
+
+
 #: The RegisterError subclass of each refusing status (OK and READ_WRAPPED
 #: are not refusals). A name the map does not have fails here, at import.
 REGISTER_ERRORS: Dict[Status, Type[RegisterError]] = {
     Status[cls.status_name]: cls
     for cls in (BadLengthError, BadValueError, PinBusyError, NotWritableError,
-                NotReadableError, NotBoundError, NoRegisterError)
+                NotReadableError, NotBoundError, NoRegisterError, DroppedError)
 }
 
 #: Status codes that are not refusals.

@@ -218,7 +218,7 @@ def test_status_and_error_classes():
     codes = {s.name: int(s) for s in Status}
     assert codes == {"OK": 0, "BAD_LENGTH": 1, "BAD_VALUE": 2, "PIN_BUSY": 3,
                      "NOT_WRITABLE": 4, "NOT_READABLE": 5, "READ_WRAPPED": 6,
-                     "NOT_BOUND": 7, "NO_REGISTER": 8}
+                     "NOT_BOUND": 7, "NO_REGISTER": 8, "DROPPED": 9}
     assert Status.BAD_VALUE.text.startswith("a value out of range")
     refusing = set(Status) - {Status.OK, Status.READ_WRAPPED}
     assert set(errors.REGISTER_ERRORS) == refusing

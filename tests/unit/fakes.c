@@ -42,7 +42,8 @@ void sg_out(uint8_t c)
 }
 
 /* Devices: 0xA0 EEPROM; 0x50 acknowledges its address, refuses data;
- * 0x60 hangs the bus (every step fails). */
+ * 0x60 hangs the bus (every step fails); 0x62 takes everything, then holds
+ * SCL so that no STOP can be made (the transaction is abandoned). */
 twi_result_t twi_start(uint8_t addr8)
 {
 	logf_("S %02X", addr8);
@@ -50,6 +51,11 @@ twi_result_t twi_start(uint8_t addr8)
 	if (dev == 0x60) {
 		logf_("! ", 0);
 		return TWI_FAIL;
+	}
+	if (dev == 0x62) {
+		logf_("+ ", 0);
+		bus.device = dev;
+		return TWI_ACK;
 	}
 	if (dev != 0xA0 && dev != 0x50) {
 		logf_("- ", 0);
@@ -65,6 +71,10 @@ twi_result_t twi_start(uint8_t addr8)
 twi_result_t twi_write(uint8_t byte)
 {
 	logf_("W%02X", byte);
+	if (bus.device == 0x62) {
+		logf_("+ ", 0);
+		return TWI_ACK;
+	}
 	if (bus.device != 0xA0) {
 		logf_("- ", 0);
 		return TWI_NACK;
@@ -88,10 +98,12 @@ twi_result_t twi_read(uint8_t *byte, bool ack)
 	return TWI_ACK;
 }
 
-void twi_stop(void)
+bool twi_stop(void)
 {
-	logf_("P ", 0);
+	bool held = bus.device == 0x62;
+	logf_(held ? "P! " : "P ", 0);
 	bus.device = -1;
+	return !held;
 }
 
 bool twi_clear_bus(void)

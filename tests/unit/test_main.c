@@ -213,6 +213,10 @@ static void test_i2c(void)
 	expect("S A2 00 S A1 01 P\r", "ERROR 06\r\n", "S A2- P ");
 	expect("S 50 01 02 P\r", "ERROR 07\r\n", "S 50+ W01- P ");
 	expect("S 60 01 P\r", "ERROR 06\r\n", "S 60! P ");
+	/* every byte taken but no STOP made: the frame is dropped by its
+	 * slave, so the request failed (docs/protocol.md, "Abandoned frames") */
+	expect("S 62 01 02 P\r", "ERROR 07\r\n", "S 62+ W01+ W02+ P! ");
+	expect("S 62 P\r", "ERROR 07\r\n", "S 62+ P! ");
 	expect("S A0 10 S A1 04 P\r", "SWASRFFFFFFFFP\r\n", NULL);
 	/* execution error: only the error, and STOP after the earlier frames */
 	expect("S A0 05 77 S A2 P\r", "ERROR 06\r\n", "S A0+ W05+ W77+ S A2- P ");

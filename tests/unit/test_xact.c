@@ -298,7 +298,30 @@ static void test_aborted_frames(void)
 	b = 0xDC;
 	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
 	CHECK_EQ(xact_model_twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
+	CHECK_EQ(regmap_status(), REG_DROPPED);
 	READ(sp, 2, "00 00");                    /* nothing applied */
+	/* A frame gone quiet (twi_quiet.h): i2c_slave.c drops it before the
+	 * late event that ends it (the next request's START: TW_SR_STOP),
+	 * which then applies nothing. */
+	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	const uint8_t cut[4] = { sp, 0x00, 0x05, 0xDC };
+	for (int i = 0; i < 4; i++) {
+		b = cut[i];
+		CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	}
+	CHECK(slave_fsm_in_frame());
+	slave_fsm_drop();
+	CHECK(!slave_fsm_in_frame());
+	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(regmap_status(), REG_DROPPED);
+	READ(sp, 2, "00 00");
+	/* a bare register selection dropped: the selection stands, the
+	 * status is not touched */
+	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	b = sp;
+	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	slave_fsm_drop();
+	CHECK_EQ(regmap_status(), REG_OK);
 	/* the next frame is served: the same write, ended properly */
 	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
 	const uint8_t w[4] = { sp, 0x00, 0x05, 0xDC };

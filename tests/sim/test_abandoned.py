@@ -1,0 +1,193 @@
+"""A write frame the gateway abandons is applied by no slave (docs/protocol.md,
+"Abandoned frames"; docs/registers.md, "On a slave board").
+
+A robot of one gateway (each board in turn) and two slave boards (an M128-S at
+0x10, an M32-D at 0x12). A servo write of 16 triples, or a GPIO mode write, to
+one slave is cut at several points: a device holds SCL low there for longer
+than the gateway waits (the gateway gives up: `ERROR 07`), or the gateway
+resets there. The next request comes right after, to the same slave or to the
+other one. Nothing of the cut write is applied (registers read back, and the
+servo pins stay quiet), the slave's status register says `09` once data had
+arrived, the bus is idle afterwards, and the next request is served as itself.
+Every cycle of a cut is relative to the cycle the simulator takes the batch at
+(`rx +N`, `wait`), so the cut lands at the same byte however late the wall
+clock delivers the batch."""
+
+import pytest
+
+from conftest import (DRV_LAYOUT, F_CPU, REPLY_TIMEOUT, require_builds, require_slave,
+                      running)
+from orfa.sim import BOARDS, SimBoard
+
+M128S, M32D = 0x10, 0x12
+SLAVES = {M128S: "m128s", M32D: "m32d"}
+OK, DROPPED = 0x00, 0x09
+MS = F_CPU // 1000
+LEAD = 2000                      # cycles from the batch to the request's first bit
+HOLD = 100000                    # SCL held this long: more than the gateway waits (9.7 ms)
+AFTER = 30000                    # then the next request comes this soon
+
+
+@pytest.fixture(scope="module", params=BOARDS)
+def robot(request):
+    gateway = request.param
+    require_builds([gateway])
+    slaves = [(SLAVES[a], a, require_slave(SLAVES[a], a)) for a in (M128S, M32D)]
+    sim = SimBoard(gateway, trace=True, control=True, slaves=slaves)
+    sim.expect_resets = True     # the gateway is reset on purpose below
+    with running(sim) as b:
+        b.timings = {}
+        yield b
+
+
+@pytest.fixture
+def rb(robot):
+    assert robot.sim.running, robot.sim.stderr
+    robot.gw.serial.reset_input_buffer()
+    for addr in SLAVES:
+        clear(robot, addr)
+    yield robot
+    robot.restore()
+
+
+def sp(addr):
+    return DRV_LAYOUT[SLAVES[addr]]["servo"] + 1
+
+
+def mode(addr):
+    return DRV_LAYOUT[SLAVES[addr]]["gpio_mode"]
+
+
+def clear(b, addr):
+    """Every servo of the slave off, its first GPIO port inputs, status OK."""
+    a = addr
+    offs = "".join("%02X0000" % ch for ch in range(16))
+    assert b.ask("S %02X %02X %s P" % (a, sp(a), offs)) == b"SW" + b"A" * 49 + b"P\r\n"
+    assert b.ask("S %02X %02X 00 P" % (a, mode(a))) == b"SWAAP\r\n"
+    assert status(b, a) == OK
+
+
+def status(b, addr):
+    reply = b.ask("S %02X 01 S %02X 01 P" % (addr, addr | 1))
+    assert reply[:5] == b"SWASR" and reply[7:] == b"P\r\n", reply
+    return int(reply[5:7], 16)
+
+
+def write_of(kind, addr):
+    """The write that gets cut, as the request's text (no spaces)."""
+    if kind == "servo":
+        return "S%02X%02X%sP" % (addr, sp(addr), "".join("%02X05DC" % ch for ch in range(16)))
+    return "S%02X%02X0F0FP" % (addr, mode(addr))      # lines 0-3 outputs
+
+
+def applied_nothing(b, addr, since):
+    """The slave's servos read 0 and its first channel's pin never moved;
+    its GPIO port is all inputs."""
+    a = addr
+    widths = b.ask("S %02X %02X 00 S %02X 20 P" % (a, sp(a), a | 1))
+    assert widths == b"SWAASR" + b"0" * 64 + b"P\r\n", widths
+    assert b.ask("S %02X %02X S %02X 01 P" % (a, mode(a), a | 1)) == b"SWASR00P\r\n"
+    pin = DRV_LAYOUT[SLAVES[a]]["servo_pins"][0]
+    assert b.sim.control.slave(a).edges(pin, since) == []
+
+
+def byte_times(b, kind, addr):
+    """Cycles from the request's first start bit to the address byte and to
+    each data byte of the write on the bus, from one run that is not cut
+    (then undone): the gateway's timing does not depend on what follows."""
+    key = (kind, addr)
+    if key not in b.timings:
+        text = write_of(kind, addr)
+        n = (len(text) - 4) // 2                 # bytes after the address
+        req = (text + "\r").encode()
+        ctl = b.sim.control
+        mark = b.mark()
+        end = int(ctl.requests(["rx +%d %s" % (LEAD, req.hex().upper())])[0])
+        first = end - 10 * ctl.line()["bit"] * len(req)
+        assert b.read_lines(1) == b"SW" + b"A" * n + b"P\r\n"
+        ev = [e for e in b.events(mark, ["twi"]) if e.kind in ("twi addr", "twi write")]
+        assert ev[0].kind == "twi addr" and len(ev) == 1 + n, ev
+        b.timings[key] = [e.cycle - first for e in ev]
+        clear(b, addr)
+    return b.timings[key]
+
+
+def cut_batch(b, kind, addr, after, fault):
+    """The write on the serial line and, `after` bytes of it on the bus (the
+    address counts), the fault: SCL held, or the gateway reset. The batch's
+    requests up to the fault; the cycle the write began at."""
+    req = (write_of(kind, addr) + "\r").encode()
+    t = byte_times(b, kind, addr)
+    # in the middle of the next byte; after the last one, before the STOP
+    # (the slave still holds SCL after that byte's acknowledge then)
+    at = LEAD + t[after] + ((t[1] - t[0]) // 2 if after < len(t) - 1 else 10)
+    lines = ["time", "rx +%d %s" % (LEAD, req.hex().upper()), "wait %d" % at]
+    if fault == "hold":
+        lines += ["i2c hold-scl on", "wait %d" % HOLD, "i2c hold-scl off"]
+    else:
+        lines += ["reset external"]
+    return lines
+
+
+#: after how many bytes on the bus (the address counts) the write is cut: in
+#: the register byte, in data, in the last byte, before the STOP
+CUTS = {"servo": [0, 1, 4, 25, 48, 49], "gpio": [0, 1, 2, 3]}
+CASES = [(kind, after) for kind in CUTS for after in CUTS[kind]]
+
+
+@pytest.mark.parametrize("victim", [M128S, M32D], ids=["m128s@10", "m32d@12"])
+@pytest.mark.parametrize("kind,after", CASES, ids=["%s-%d" % c for c in CASES])
+@pytest.mark.parametrize("fault", ["hold", "reset"])
+def test_cut_write_applies_nothing_next_to_same(rb, victim, kind, after, fault):
+    b = rb
+    ctl = b.sim.control
+    lines = cut_batch(b, kind, victim, after, fault)
+    nxt = b"S%02X01S%02X01P\r" % (victim, victim | 1)   # the status, first of all
+    out = ctl.requests(lines + ["wait %d" % AFTER, "rx +10 %s" % nxt.hex().upper()])
+    began = int(out[0])
+    want_status = DROPPED if after >= 2 else OK     # data had arrived (the register byte is not)
+    got = b.read_lines(2 if fault == "hold" else 1)
+    if fault == "hold":
+        assert got == b"ERROR 07\r\nSWASR%02XP\r\n" % want_status, got
+    else:
+        assert got == b"SWASR%02XP\r\n" % want_status, got
+    assert ctl.i2c()["sda"] == 1 and ctl.i2c()["scl"] == 1
+    applied_nothing(b, victim, began)
+
+
+@pytest.mark.parametrize("victim", [M128S, M32D], ids=["m128s@10", "m32d@12"])
+@pytest.mark.parametrize("kind,after", [("servo", 1), ("servo", 25), ("servo", 49), ("gpio", 2)],
+                         ids=["servo-1", "servo-25", "servo-49", "gpio-2"])
+@pytest.mark.parametrize("fault", ["hold", "reset"])
+def test_cut_write_applies_nothing_next_to_other(rb, victim, kind, after, fault):
+    """The next request goes to the other slave: a servo write it applies,
+    while the cut one is dropped, not applied by the START that addressed
+    the other."""
+    b = rb
+    ctl = b.sim.control
+    other = M32D if victim == M128S else M128S
+    lines = cut_batch(b, kind, victim, after, fault)
+    nxt = b"S%02X%02X0105DCP\r" % (other, sp(other))       # channel 1 at 1500 us
+    out = ctl.requests(lines + ["wait %d" % AFTER, "rx +10 %s" % nxt.hex().upper()])
+    began = int(out[0])
+    got = b.read_lines(2 if fault == "hold" else 1)
+    assert got == (b"ERROR 07\r\n" if fault == "hold" else b"") + b"SWAAAAP\r\n", got
+    assert status(b, victim) == (DROPPED if after >= 2 else OK)
+    applied_nothing(b, victim, began)
+    assert status(b, other) == OK
+    assert b.ask("S %02X %02X 01 S %02X 02 P" % (other, sp(other), other | 1)) \
+        == b"SWAASR05DCP\r\n"
+
+
+def test_a_healthy_write_right_after_is_applied(rb):
+    """The fence does not eat the next write: the same write, sent again
+    right after a cut one, is applied whole."""
+    b = rb
+    ctl = b.sim.control
+    lines = cut_batch(b, "servo", M32D, 25, "hold")
+    again = (write_of("servo", M32D) + "\r").encode()
+    ctl.requests(lines + ["wait %d" % AFTER, "rx +10 %s" % again.hex().upper()])
+    assert b.read_lines(2) == b"ERROR 07\r\nSW" + b"A" * 49 + b"P\r\n"
+    assert status(b, M32D) == OK
+    reply = b.ask("S 12 %02X 00 S 13 20 P" % sp(M32D))
+    assert reply == b"SWAASR" + b"05DC" * 16 + b"P\r\n", reply
