@@ -72,12 +72,7 @@ ISR(TWI_vect)
 	/* TWIE off before interrupts are on again, or this one would come
 	 * back at once: TWINT is a level. Writing TWINT 0 leaves it set. */
 	TWCR = (uint8_t)(TWCR & ~(_BV(TWINT) | _BV(TWIE)));
-	/* An event that ends a frame gone quiet (the START of the next
-	 * request, however soon the main loop would have looked) finds it
-	 * dropped, not applied. */
-	if (slave_quiet()) {
-		slave_fsm_drop();
-	}
+	uint8_t before = slave_seen;
 	slave_seen = clock_now8();
 	sei();
 	uint8_t byte = TWDR;
@@ -86,6 +81,13 @@ ISR(TWI_vect)
 	 * other addresses never reach here. */
 	if (status == TW_SR_SLA_ACK || status == TW_ST_SLA_ACK) {
 		SYS_HEARD();
+	}
+	/* The one event that applies a write (STOP or repeated START) ends
+	 * a frame gone quiet, however soon the main loop would have looked:
+	 * then it is dropped, not applied. (A START in the middle of a frame
+	 * is a repeated START to this TWI.) */
+	if (status == TW_SR_STOP && (uint8_t)(slave_seen - before) > TWI_QUIET_DROP_TICKS) {
+		slave_fsm_drop();
 	}
 	slave_action_t act = slave_fsm_event(status, &byte);
 	cli();
