@@ -197,7 +197,10 @@ static int read_line(orfa_t *o, char *line, size_t *len)
 			size_t end = (size_t)(lf - o->rx);
 			int rc = ORFA_OK;
 
-			if (o->rx_skip || end == 0 || o->rx[end - 1] != '\r') {
+			/* over the limit (whether it came in one read or
+			 * several), without CR: no reply, and never copied */
+			if (o->rx_skip || end == 0 || o->rx[end - 1] != '\r' ||
+			    end - 1 > ORFA_REPLY_MAX) {
 				rc = ORFA_E_PROTOCOL;
 			} else {
 				*len = end - 1;

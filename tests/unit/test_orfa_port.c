@@ -229,6 +229,32 @@ static void test_bad_lines(orfa_t *o)
 	CHECK(orfa_read_reply(o, &r) == ORFA_E_PROTOCOL, "no CR");
 	CHECK(orfa_read_reply(o, &r) == ORFA_E_PROTOCOL, "SWP to V");
 	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_VERSION, "back in step");
+
+	/* a line over 127 characters that arrives whole in one read, with the
+	 * next request's reply behind it: the long line is its own request's
+	 * ORFA_E_PROTOCOL and nothing of it reaches the next request */
+	CHECK(orfa_version(o) == ORFA_OK, "V");
+	CHECK(orfa_tr_start(o) == ORFA_OK && orfa_write(o, 0xAA, (const uint8_t *)"", 1) == ORFA_OK &&
+	      orfa_read(o, 0xAA, 1) == ORFA_OK && orfa_tr_commit(o) == ORFA_OK, "SAA00SAB01P");
+	sent(buf, sizeof(buf), 2);
+	CHECK(strcmp(buf, "V\nSAA00SAB01P\n") == 0, "sent %s", buf);
+	strcpy(longline + 200, "\r\nSWASR07P\r\n");
+	answer(longline);
+	CHECK(orfa_read_reply(o, &r) == ORFA_E_PROTOCOL, "200 characters in one read");
+	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_WRITE && r.size == 1,
+	      "the next request's SW");
+	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_READ && r.size == 1 &&
+	      r.data[0] == 7, "the next request's SR");
+	CHECK(orfa_read_reply(o, &r) == ORFA_E_STATE, "all read");
+	/* the same, the long line split over two reads */
+	CHECK(orfa_version(o) == ORFA_OK && orfa_version(o) == ORFA_OK, "2 V");
+	sent(buf, sizeof(buf), 2);
+	answer("AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA");
+	CHECK(orfa_read_reply(o, &r) == ORFA_E_TIMEOUT, "half of it");
+	answer("AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA"
+	       "\r\nV1.1\r\n");
+	CHECK(orfa_read_reply(o, &r) == ORFA_E_PROTOCOL, "180 characters in two reads");
+	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_VERSION, "in step");
 	CHECK(orfa_set_timeout(o, 2000) == ORFA_OK, "timeout");
 }
 
