@@ -241,3 +241,40 @@ def test_docs_sample_is_the_m32d_map():
     doc = (ROOT / "docs" / "c-library.md").read_text()
     shown = "".join(line[4:] + "\n" for line in doc.splitlines() if line.startswith("    UID "))
     assert shown == listing(boardmap.load("m32d").drivers)
+
+
+# --- the docs' build instructions -------------------------------------------------
+
+def _doc() -> str:
+    return (ROOT / "docs" / "c-library.md").read_text()
+
+
+def test_docs_build_line_builds_a_program(tmp_path):
+    """The `cc` line of docs/c-library.md's Build section, as written, run
+    from the repository root with the example's source as `myprog.c`: it
+    compiles and links (it once lacked host/c/orfa_speed.c), and the program
+    runs."""
+    import shlex
+    lines = [line.strip() for line in _doc().splitlines() if line.strip().startswith("cc ")]
+    assert len(lines) == 1, lines
+    args = shlex.split(lines[0])
+    assert "myprog.c" in args and args[args.index("-o") + 1] == "myprog", args
+    prog = tmp_path / "myprog"
+    args = [str(ROOT / "examples" / "get_drivers.c") if a == "myprog.c" else a for a in args]
+    args[args.index("-o") + 1] = str(prog)
+    r = subprocess.run(args, cwd=str(ROOT), capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    r = subprocess.run([str(prog)], capture_output=True, text=True, timeout=PROG_TIMEOUT)
+    assert r.returncode == 2 and r.stderr.startswith("usage: get_drivers PORT")
+
+
+def test_docs_file_table_lists_every_library_file():
+    """Every file of host/c is in the docs' table of the library's files, and
+    every .c file of it is on the build line."""
+    doc = _doc()
+    table = [line for line in doc.splitlines() if line.startswith("| `host/c/")]
+    build = [line for line in doc.splitlines() if line.strip().startswith("cc ")]
+    for f in sorted((ROOT / "host" / "c").iterdir()):
+        assert any("`%s`" % f.name in row or "`host/c/%s`" % f.name in row for row in table), f.name
+        if f.suffix == ".c":
+            assert "host/c/%s" % f.name in build[0], f.name
