@@ -145,12 +145,13 @@ class FakeGateway:
 
     QUIET = 0.05
 
-    def __init__(self, ndrivers: int):
-        records = [Record(0x0000, 1, 0, 0x00, 2)]
-        start = 2
-        for i in range(1, ndrivers):
-            records.append(Record(0x0100 + i, 1 + i % 3, i % 10, start, 1))
-            start += 1
+    def __init__(self, ndrivers: int = 0, records=None):
+        if records is None:
+            records = [Record(0x0000, 1, 0, 0x00, 2)]
+            start = 2
+            for i in range(1, ndrivers):
+                records.append(Record(0x0100 + i, 1 + i % 3, i % 10, start, 1))
+                start += 1
         self.records = records
         self.model = GatewayModel(BoardModel("m32d", records), BoardModel("m32d", records[:1]),
                                   slave_addr=0x10)
@@ -219,6 +220,59 @@ def test_many_drivers(get_drivers, ndrivers):
     if ndrivers == 200:
         # 21 requests of 14 characters: the library had to wait for replies
         assert fake.most_unanswered > 14 * 10
+
+
+def test_eeprom_is_not_an_orfa_board(get_drivers):
+    """A device that answers but is no ORFA board (the simulated bus's
+    24C02 at A0, blank: every byte FF): one line saying so, nothing on
+    stdout, exit 1 (it printed 255 records of FF and exited 0)."""
+    require_builds(["m32d"])
+    with running(SimBoard("m32d", eeproms=(0xA0,))) as b:
+        r = get_drivers(b.sim.port, "A0")
+        assert (r.returncode, r.stdout) == (1, "")
+        assert r.stderr == ("get_drivers: %s: address 0xA0: not an ORFA board: driver 1 is"
+                            " UID 0xFFFF with registers from 0xFF (255), not introspection"
+                            " (UID 0x0000, registers 0x00-0x01)\n" % b.sim.port)
+
+
+I = Record(0x0000, 1, 0, 0x00, 2)
+
+
+@pytest.mark.parametrize("records, why", [
+    ([Record(0x0000, 1, 0, 0x00, 3)],
+     "driver 1 is UID 0x0000 with registers from 0x00 (3), not introspection"
+     " (UID 0x0000, registers 0x00-0x01)"),
+    ([I, Record(0x0101, 1, 1, 0x02, 8), Record(0x0102, 1, 1, 0x0B, 2)],
+     "driver 3's registers start at 0x0B, not at 0x0A where driver 2's end"),
+    ([I, Record(0x0101, 1, 1, 0x02, 8), Record(0x0102, 1, 1, 0x08, 2)],
+     "driver 3's registers start at 0x08, not at 0x0A where driver 2's end"),
+    ([I, Record(0x0101, 1, 1, 0x02, 0xF0), Record(0x0102, 1, 1, 0xF2, 0x0F)],
+     "driver 3's registers run past 0xFF (0xF2-0x100)"),
+    ([I, Record(0x0101, 1, 1, 0x02, 8), Record(0x0000, 1, 0, 0x0A, 2)],
+     "driver 3 has UID 0x0000, introspection's"),
+], ids=["intro-size", "gap", "overlap", "past-FF", "second-intro"])
+def test_implausible_driver_list(get_drivers, records, why):
+    """The reference model serving a driver list that breaks one rule of the
+    layout (a driver 1 that is not introspection: the EEPROM test above)."""
+    fake = FakeGateway(records=records)
+    try:
+        r = get_drivers(fake.path)
+    finally:
+        fake.close()
+    assert (r.returncode, r.stdout) == (1, "")
+    assert r.stderr == "get_drivers: %s: address 0xAA: not an ORFA board: %s\n" % (fake.path, why)
+
+
+def test_plausible_edges(get_drivers):
+    """What a board may have: a driver with no registers, registers up to 0xFF."""
+    records = [I, Record(0x0101, 1, 1, 0x02, 0), Record(0x0102, 1, 1, 0x02, 0xFE)]
+    fake = FakeGateway(records=records)
+    try:
+        r = get_drivers(fake.path)
+    finally:
+        fake.close()
+    assert (r.returncode, r.stderr) == (0, "")
+    assert r.stdout == listing(records)
 
 
 def test_no_reply(get_drivers):
