@@ -11,7 +11,14 @@
  *     UID 0x0020  version 1.1  registers 0x02-0x09 (8)
  *
  * Exit status 0, or 1 with one line on stderr (a port that does not open, an
- * ERROR reply, no reply), 2 for wrong arguments.
+ * ERROR reply, no reply, a device whose answers are not an ORFA driver list),
+ * 2 for wrong arguments.
+ *
+ * Not every device that answers is an ORFA board (an EEPROM answers the same
+ * reads with whatever it holds), so the list is checked before anything is
+ * printed: driver 1 is introspection (UID 0x0000, registers 0x00-0x01), every
+ * next driver's registers start where the previous one's end, none runs past
+ * 0xFF and no other driver has introspection's UID.
  *
  * Kept from the manual: MAX_PER_PKG = 10 records per read (6 bytes each: ten
  * fill the 127-character reply exactly, "SWAASR" + 120 hex digits + "P"),
@@ -101,6 +108,42 @@ static int read_result(orfa_t *o, orfa_reply_t *reply)
 	return rc;
 }
 
+/* Why `count` records are no ORFA driver list, in `why`; 0 if they are one. */
+static int implausible(const uint8_t *recs, unsigned count, char *why, size_t size)
+{
+	unsigned next = 0;              /* where the next driver's registers start */
+	unsigned i;
+
+	for (i = 0; i < count; i++) {
+		const uint8_t *d = recs + (size_t)i * PKG_LEN;
+		unsigned uid = (unsigned)d[0] << 8 | d[1];
+		unsigned start = d[4];
+		unsigned n = d[5];
+
+		if (i == 0 && (uid != 0x0000 || start != 0x00 || n != 2)) {
+			snprintf(why, size, "driver 1 is UID 0x%04X with registers from 0x%02X (%u), "
+				 "not introspection (UID 0x0000, registers 0x00-0x01)", uid, start, n);
+			return 1;
+		}
+		if (i > 0 && uid == 0x0000) {
+			snprintf(why, size, "driver %u has UID 0x0000, introspection's", i + 1);
+			return 1;
+		}
+		if (start != next) {
+			snprintf(why, size, "driver %u's registers start at 0x%02X, not at 0x%02X "
+				 "where driver %u's end", i + 1, start, next, i);
+			return 1;
+		}
+		if (start + n > 0x100) {
+			snprintf(why, size, "driver %u's registers run past 0xFF (0x%02X-0x%03X)",
+				 i + 1, start, start + n - 1);
+			return 1;
+		}
+		next = start + n;
+	}
+	return 0;
+}
+
 static void print_record(const uint8_t *d)
 {
 	unsigned uid = (unsigned)d[0] << 8 | d[1];
@@ -123,7 +166,9 @@ int main(int argc, char **argv)
 	orfa_t *o = NULL;
 	orfa_reply_t reply;
 	unsigned count, max_cnt, min_cnt, requests, i;
-	size_t pi;
+	static uint8_t recs[255 * PKG_LEN];      /* the count is one byte */
+	size_t got = 0;
+	char why[160];
 	int rc;
 
 	if (argc < 2 || argc > 3 || argv[1][0] == '\0') {
@@ -198,18 +243,25 @@ int main(int argc, char **argv)
 		if (rc != ORFA_OK) {
 			break;
 		}
-		if (reply.size % PKG_LEN) {
+		if (reply.size % PKG_LEN || got + reply.size > (size_t)count * PKG_LEN) {
 			fprintf(stderr, "%s: %s: wrong read reply size: %zu\n", prog, port, reply.size);
 			orfa_close(o);
 			return 1;
 		}
-		for (pi = 0; pi < reply.size; pi += PKG_LEN) {
-			print_record(reply.data + pi);
-		}
+		memcpy(recs + got, reply.data, reply.size);
+		got += reply.size;
 	}
 	if (rc != ORFA_OK) {
 		return fail(port, (unsigned)address, o, rc);
 	}
 	orfa_close(o);
+	if (implausible(recs, count, why, sizeof(why))) {
+		fprintf(stderr, "%s: %s: address 0x%02lX: not an ORFA board: %s\n", prog, port,
+			address, why);
+		return 1;
+	}
+	for (i = 0; i < count; i++) {
+		print_record(recs + (size_t)i * PKG_LEN);
+	}
 	return 0;
 }

@@ -77,6 +77,60 @@ static int speed_of(long baud, speed_t *sp)
 	return baud > 0 && baud <= ORFA_BAUD_MAX ? ORFA_OK : ORFA_E_ARG;
 }
 
+static long now_ms(void);
+static int read_line(orfa_t *o, char *line, size_t *len, long deadline);
+
+/* Brings the line in step after the open (docs/c-library.md, "Opening"):
+ * LF ends whatever partial line the board holds (someone typed `S AA 0` in
+ * a terminal; a program left mid-line), then `V` and `L` (both only read).
+ * The board answers the ended line (or not: it was empty or a comment), then
+ * V, then L, so the first L reply after a V reply is ours, whatever the
+ * partial line was (a `V` or an `L` too) and whatever lines came before.
+ * Everything up to it is dropped. Bounded: ORFA_TIMEOUT_MS in all, however
+ * much the line carries. */
+static int resync(orfa_t *o)
+{
+	static const char sync[] = "\nV\nL\n";
+	long deadline = now_ms() + ORFA_TIMEOUT_MS;
+	orfa_req_t v, l;
+	orfa_reply_t results[ORFA_FRAMES_MAX];
+	char line[ORFA_REPLY_MAX + 1];
+	size_t len;
+	size_t done = 0;
+	int seen_v = 0;
+	int code;
+
+	orfa_req_version(&v);
+	orfa_req_local(&l, -1);
+	while (done < sizeof(sync) - 1) {
+		ssize_t n = write(o->fd, sync + done, sizeof(sync) - 1 - done);
+
+		if (n < 0) {
+			if (errno == EINTR) {
+				continue;
+			}
+			return ORFA_E_IO;
+		}
+		done += (size_t)n;
+	}
+	for (;;) {
+		int rc = read_line(o, line, &len, deadline);
+
+		if (rc == ORFA_E_PROTOCOL) {
+			continue;               /* no reply of the gateway's: dropped */
+		}
+		if (rc != ORFA_OK) {
+			return rc;
+		}
+		if (seen_v && orfa_reply_parse(&l, line, len, results, &code) == 1) {
+			return ORFA_OK;
+		}
+		if (orfa_reply_parse(&v, line, len, results, &code) == 1) {
+			seen_v = 1;
+		}
+	}
+}
+
 int orfa_open(orfa_t **out, const char *path, long baud)
 {
 	struct termios t;
@@ -135,6 +189,13 @@ int orfa_open(orfa_t **out, const char *path, long baud)
 		goto fail;
 	}
 	o->timeout_ms = ORFA_TIMEOUT_MS;
+	rc = resync(o);
+	if (rc != ORFA_OK) {
+		if (rc == ORFA_E_TIMEOUT) {
+			errno = ETIMEDOUT;
+		}
+		goto fail;
+	}
 	*out = o;
 	return ORFA_OK;
 fail:
@@ -179,14 +240,12 @@ static long now_ms(void)
 	return (long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
 }
 
-/* One line from the port into `line` (CR LF removed): ORFA_OK;
- * ORFA_E_PROTOCOL for a line that is over the reply limit or not ended by
- * CR LF (it is consumed: the next line is the next reply); ORFA_E_TIMEOUT
- * (what came of the line is kept) or ORFA_E_IO. */
-static int read_line(orfa_t *o, char *line, size_t *len)
+/* One line from the port into `line` (CR LF removed) by `deadline` (now_ms()
+ * time): ORFA_OK; ORFA_E_PROTOCOL for a line that is over the reply limit or
+ * not ended by CR LF (it is consumed: the next line is the next reply);
+ * ORFA_E_TIMEOUT (what came of the line is kept) or ORFA_E_IO. */
+static int read_line(orfa_t *o, char *line, size_t *len, long deadline)
 {
-	long deadline = now_ms() + o->timeout_ms;
-
 	for (;;) {
 		char *lf = memchr(o->rx, '\n', o->rx_len);
 		struct pollfd pfd;
@@ -197,7 +256,10 @@ static int read_line(orfa_t *o, char *line, size_t *len)
 			size_t end = (size_t)(lf - o->rx);
 			int rc = ORFA_OK;
 
-			if (o->rx_skip || end == 0 || o->rx[end - 1] != '\r') {
+			/* over the limit (whether it came in one read or
+			 * several), without CR: no reply, and never copied */
+			if (o->rx_skip || end == 0 || o->rx[end - 1] != '\r' ||
+			    end - 1 > ORFA_REPLY_MAX) {
 				rc = ORFA_E_PROTOCOL;
 			} else {
 				*len = end - 1;
@@ -255,7 +317,7 @@ static pending_t *entry(orfa_t *o, size_t i)
 static int receive(orfa_t *o)
 {
 	pending_t *p = entry(o, o->answered);
-	int rc = read_line(o, p->reply, &p->reply_len);
+	int rc = read_line(o, p->reply, &p->reply_len, now_ms() + o->timeout_ms);
 
 	if (rc == ORFA_E_PROTOCOL) {
 		p->bad = 1;

@@ -34,10 +34,14 @@ typedef struct orfa orfa_t;
 /* Milliseconds orfa_read_reply waits for a reply line, unless changed. */
 #define ORFA_TIMEOUT_MS 2000
 
-/* Opens `path` raw 8N1 at `baud` (2400 4800 9600 19200 38400 57600 115200
- * 230400: the rates termios names) and drops what was waiting in it.
- * ORFA_E_ARG for another rate, ORFA_E_IO with errno set when the port does
- * not open. */
+/* Opens `path` raw 8N1 at `baud` (the rates termios names by name, others up
+ * to 4000000 by number: orfa_speed.h) and drops what was waiting in it; then
+ * brings the line in step: an LF ends whatever partial line the board holds,
+ * `V` and `L` follow, and every line up to their replies is dropped, so the
+ * first request is answered as itself. ORFA_E_ARG for a rate it cannot set,
+ * ORFA_E_IO with errno set when the port does not open, ORFA_E_TIMEOUT
+ * (errno ETIMEDOUT) when no gateway answers within ORFA_TIMEOUT_MS in all,
+ * whatever else the line carries. */
 int orfa_open(orfa_t **o, const char *path, long baud);
 
 /* Closes the port (its settings put back) and frees `o`; NULL is allowed. */

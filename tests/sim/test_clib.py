@@ -99,6 +99,27 @@ def test_bad_orfa_baud(get_drivers, value):
                         " second (115200)\n" % value)
 
 
+@pytest.mark.parametrize("held", ["S AA 0", "SAA0000SAB01", "V", "# a comment"])
+def test_partial_line_left_in_the_board(get_drivers, held):
+    """Someone typed part of a line in a terminal and closed it: the board
+    holds it. The library's open ends it and drops its reply, so the first
+    request is answered as itself (it was ERROR 03, glued to the partial
+    line)."""
+    import time
+    require_builds(["m32d"])
+    with running(SimBoard("m32d")) as b:
+        fd = os.open(b.sim.port, os.O_RDWR | os.O_NOCTTY)
+        try:
+            os.write(fd, held.encode())
+            time.sleep(0.3)             # into the board before the port is closed
+        finally:
+            os.close(fd)
+        r = get_drivers(b.sim.port)
+        assert (r.returncode, r.stderr) == (0, "")
+        assert r.stdout == listing(boardmap.load("m32d").drivers)
+        assert b.gw.version() == "1.1"
+
+
 def test_error_reply(get_drivers):
     """No device at 0x42: the gateway's ERROR 06, one line, exit 1."""
     require_builds(["m32d"])
@@ -145,12 +166,13 @@ class FakeGateway:
 
     QUIET = 0.05
 
-    def __init__(self, ndrivers: int):
-        records = [Record(0x0000, 1, 0, 0x00, 2)]
-        start = 2
-        for i in range(1, ndrivers):
-            records.append(Record(0x0100 + i, 1 + i % 3, i % 10, start, 1))
-            start += 1
+    def __init__(self, ndrivers: int = 0, records=None):
+        if records is None:
+            records = [Record(0x0000, 1, 0, 0x00, 2)]
+            start = 2
+            for i in range(1, ndrivers):
+                records.append(Record(0x0100 + i, 1 + i % 3, i % 10, start, 1))
+                start += 1
         self.records = records
         self.model = GatewayModel(BoardModel("m32d", records), BoardModel("m32d", records[:1]),
                                   slave_addr=0x10)
@@ -204,13 +226,14 @@ def test_many_drivers(get_drivers, ndrivers):
     # the count, then the records ten at a time from driver 1: never a read
     # of 0 bytes (ERROR 04), ten records in exactly the 127-character reply
     full, rest = divmod(ndrivers, 10)
-    want = ["SAA0000SAB01P"]
+    # the open's V and L (the LF before them is an empty line: no reply)
+    want = ["V", "L", "SAA0000SAB01P"]
     want += ["SAA00%02XSAB3CP" % (10 * i + 1) for i in range(full)]
     if rest:
         want.append("SAA00%02XSAB%02XP" % (10 * full + 1, 6 * rest))
     assert fake.requests == want
     assert all(not reply.startswith(b"ERROR") for reply in fake.replies)
-    for req, reply in zip(want[1:], fake.replies[1:]):
+    for req, reply in zip(want[3:], fake.replies[3:]):
         if req.endswith("3CP"):
             assert len(reply) == 127 + 2, reply
     # the flow rule (docs/protocol.md): never more requests unanswered than the
@@ -219,6 +242,59 @@ def test_many_drivers(get_drivers, ndrivers):
     if ndrivers == 200:
         # 21 requests of 14 characters: the library had to wait for replies
         assert fake.most_unanswered > 14 * 10
+
+
+def test_eeprom_is_not_an_orfa_board(get_drivers):
+    """A device that answers but is no ORFA board (the simulated bus's
+    24C02 at A0, blank: every byte FF): one line saying so, nothing on
+    stdout, exit 1 (it printed 255 records of FF and exited 0)."""
+    require_builds(["m32d"])
+    with running(SimBoard("m32d", eeproms=(0xA0,))) as b:
+        r = get_drivers(b.sim.port, "A0")
+        assert (r.returncode, r.stdout) == (1, "")
+        assert r.stderr == ("get_drivers: %s: address 0xA0: not an ORFA board: driver 1 is"
+                            " UID 0xFFFF with registers from 0xFF (255), not introspection"
+                            " (UID 0x0000, registers 0x00-0x01)\n" % b.sim.port)
+
+
+I = Record(0x0000, 1, 0, 0x00, 2)
+
+
+@pytest.mark.parametrize("records, why", [
+    ([Record(0x0000, 1, 0, 0x00, 3)],
+     "driver 1 is UID 0x0000 with registers from 0x00 (3), not introspection"
+     " (UID 0x0000, registers 0x00-0x01)"),
+    ([I, Record(0x0101, 1, 1, 0x02, 8), Record(0x0102, 1, 1, 0x0B, 2)],
+     "driver 3's registers start at 0x0B, not at 0x0A where driver 2's end"),
+    ([I, Record(0x0101, 1, 1, 0x02, 8), Record(0x0102, 1, 1, 0x08, 2)],
+     "driver 3's registers start at 0x08, not at 0x0A where driver 2's end"),
+    ([I, Record(0x0101, 1, 1, 0x02, 0xF0), Record(0x0102, 1, 1, 0xF2, 0x0F)],
+     "driver 3's registers run past 0xFF (0xF2-0x100)"),
+    ([I, Record(0x0101, 1, 1, 0x02, 8), Record(0x0000, 1, 0, 0x0A, 2)],
+     "driver 3 has UID 0x0000, introspection's"),
+], ids=["intro-size", "gap", "overlap", "past-FF", "second-intro"])
+def test_implausible_driver_list(get_drivers, records, why):
+    """The reference model serving a driver list that breaks one rule of the
+    layout (a driver 1 that is not introspection: the EEPROM test above)."""
+    fake = FakeGateway(records=records)
+    try:
+        r = get_drivers(fake.path)
+    finally:
+        fake.close()
+    assert (r.returncode, r.stdout) == (1, "")
+    assert r.stderr == "get_drivers: %s: address 0xAA: not an ORFA board: %s\n" % (fake.path, why)
+
+
+def test_plausible_edges(get_drivers):
+    """What a board may have: a driver with no registers, registers up to 0xFF."""
+    records = [I, Record(0x0101, 1, 1, 0x02, 0), Record(0x0102, 1, 1, 0x02, 0xFE)]
+    fake = FakeGateway(records=records)
+    try:
+        r = get_drivers(fake.path)
+    finally:
+        fake.close()
+    assert (r.returncode, r.stderr) == (0, "")
+    assert r.stdout == listing(records)
 
 
 def test_no_reply(get_drivers):
@@ -241,3 +317,40 @@ def test_docs_sample_is_the_m32d_map():
     doc = (ROOT / "docs" / "c-library.md").read_text()
     shown = "".join(line[4:] + "\n" for line in doc.splitlines() if line.startswith("    UID "))
     assert shown == listing(boardmap.load("m32d").drivers)
+
+
+# --- the docs' build instructions -------------------------------------------------
+
+def _doc() -> str:
+    return (ROOT / "docs" / "c-library.md").read_text()
+
+
+def test_docs_build_line_builds_a_program(tmp_path):
+    """The `cc` line of docs/c-library.md's Build section, as written, run
+    from the repository root with the example's source as `myprog.c`: it
+    compiles and links (it once lacked host/c/orfa_speed.c), and the program
+    runs."""
+    import shlex
+    lines = [line.strip() for line in _doc().splitlines() if line.strip().startswith("cc ")]
+    assert len(lines) == 1, lines
+    args = shlex.split(lines[0])
+    assert "myprog.c" in args and args[args.index("-o") + 1] == "myprog", args
+    prog = tmp_path / "myprog"
+    args = [str(ROOT / "examples" / "get_drivers.c") if a == "myprog.c" else a for a in args]
+    args[args.index("-o") + 1] = str(prog)
+    r = subprocess.run(args, cwd=str(ROOT), capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    r = subprocess.run([str(prog)], capture_output=True, text=True, timeout=PROG_TIMEOUT)
+    assert r.returncode == 2 and r.stderr.startswith("usage: get_drivers PORT")
+
+
+def test_docs_file_table_lists_every_library_file():
+    """Every file of host/c is in the docs' table of the library's files, and
+    every .c file of it is on the build line."""
+    doc = _doc()
+    table = [line for line in doc.splitlines() if line.startswith("| `host/c/")]
+    build = [line for line in doc.splitlines() if line.strip().startswith("cc ")]
+    for f in sorted((ROOT / "host" / "c").iterdir()):
+        assert any("`%s`" % f.name in row or "`host/c/%s`" % f.name in row for row in table), f.name
+        if f.suffix == ".c":
+            assert "host/c/%s" % f.name in build[0], f.name

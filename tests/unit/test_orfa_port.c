@@ -10,9 +10,12 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "orfa.h"
@@ -78,6 +81,113 @@ static void answer(const char *text)
 	}
 }
 
+/* --- a gateway on the master side, in a child process --------------------------
+ * orfa_open talks before it returns (it ends the board's partial line and
+ * waits for V and L to be answered), so opens are served by a child: a
+ * small gateway that holds `held` as the partial line a terminal left,
+ * answers V, L, the count request SAA0000SAB01P and the short probe
+ * SAA00SAB01P (7 drivers), ERROR 03 to anything else, nothing to an empty
+ * line or a comment; with `noise`, it also sends a GPS's NMEA sentences and
+ * bytes with no line end all the time; with `silent`, it answers nothing. */
+
+enum { GW_ANSWER = 0, GW_SILENT = 1, GW_NOISE = 2 };
+
+static void gw_reply(const char *line)
+{
+	const char *reply = "ERROR 03\r\n";
+	char text[256];
+	size_t n = 0;
+
+	for (; *line != '\0'; line++) {
+		if (*line != ' ' && n + 1 < sizeof(text)) {
+			text[n++] = *line;
+		}
+	}
+	text[n] = '\0';
+	if (n == 0 || text[0] == '#') {
+		return;
+	}
+	if (strcmp(text, "V") == 0) {
+		reply = "V1.1\r\n";
+	} else if (strcmp(text, "L") == 0) {
+		reply = "LAA\r\n";
+	} else if (strcmp(text, "SAA0000SAB01P") == 0 || strcmp(text, "SAA00SAB01P") == 0) {
+		reply = strlen(text) == 13 ? "SWAASR07P\r\n" : "SWASR07P\r\n";
+	}
+	answer(reply);
+}
+
+static pid_t gw_start(const char *held, int mode)
+{
+	pid_t pid = fork();
+	char line[256];
+	size_t n;
+
+	if (pid < 0) {
+		perror("fork");
+		exit(2);
+	}
+	if (pid > 0) {
+		return pid;
+	}
+	alarm(20);              /* never outlive a test that failed to stop it */
+	snprintf(line, sizeof(line), "%s", held);
+	n = strlen(line);
+	for (;;) {
+		struct pollfd pfd = {master, POLLIN, 0};
+		char buf[256];
+		ssize_t got;
+
+		if (mode & GW_NOISE) {
+			answer("$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47\r\n"
+			       "\x87\xfe\x01garbage with no line end ");
+		}
+		if (poll(&pfd, 1, 1) <= 0) {
+			continue;
+		}
+		got = read(master, buf, sizeof(buf));
+		if (got <= 0) {
+			usleep(1000);   /* no slave side open just now */
+			continue;
+		}
+		for (ssize_t i = 0; i < got; i++) {
+			if (buf[i] == '\n' || buf[i] == '\r') {
+				line[n] = '\0';
+				if (!(mode & GW_SILENT)) {
+					gw_reply(line);
+				}
+				n = 0;
+			} else if (n + 1 < sizeof(line)) {
+				line[n++] = buf[i];
+			}
+		}
+	}
+}
+
+static void gw_stop(pid_t pid)
+{
+	kill(pid, SIGKILL);
+	waitpid(pid, NULL, 0);
+}
+
+/* orfa_open with the child gateway answering, stopped after it. */
+static int open_served(orfa_t **o, long baud)
+{
+	pid_t pid = gw_start("", GW_ANSWER);
+	int rc = orfa_open(o, slave_path, baud);
+
+	gw_stop(pid);
+	return rc;
+}
+
+static long ms_now(void)
+{
+	struct timespec ts;
+
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
 static int intro(orfa_t *o, uint8_t addr, uint8_t first, size_t count)
 {
 	uint8_t buf[2] = {0x00, first};
@@ -122,7 +232,7 @@ static void test_rates_by_number(void)
 	CHECK(fd >= 0, "open %s: %s", slave_path, strerror(errno));
 	for (i = 0; i < sizeof(rates) / sizeof(rates[0]) && fd >= 0; i++) {
 		orfa_t *o = NULL;
-		int rc = orfa_open(&o, slave_path, rates[i]);
+		int rc = open_served(&o, rates[i]);
 
 		CHECK(rc == ORFA_OK, "open at %ld: %d (%s)", rates[i], rc, strerror(errno));
 		CHECK(orfa_speed_get(fd) == rates[i], "rate %ld: the port says %ld", rates[i],
@@ -131,6 +241,90 @@ static void test_rates_by_number(void)
 	}
 	if (fd >= 0) {
 		close(fd);
+	}
+}
+
+/* The open ends whatever partial line the board holds and drops its reply:
+ * the first request is answered as itself. A held `V` or `L` gives a reply
+ * like the open's own, and nothing of it is left either. What the open
+ * sent: LF, then V and L. */
+static void test_open_ends_partial_line(void)
+{
+	static const char *const held[] = {"", "S AA 0", "SAA0000SAB01", "V", "L", "# a comment",
+					   "zz"};
+	size_t i;
+
+	for (i = 0; i < sizeof(held) / sizeof(held[0]); i++) {
+		pid_t pid = gw_start(held[i], GW_ANSWER);
+		orfa_t *o = NULL;
+		orfa_reply_t r;
+		int rc = orfa_open(&o, slave_path, 115200);
+
+		CHECK(rc == ORFA_OK, "'%s' held: open %d", held[i], rc);
+		if (rc == ORFA_OK) {
+			CHECK(intro(o, 0xAA, 0, 1) == ORFA_OK, "'%s': commit", held[i]);
+			rc = orfa_read_reply(o, &r);
+			CHECK(rc == ORFA_OK && r.type == ORFA_REPLY_WRITE, "'%s' held: first result %d",
+			      held[i], rc);
+			rc = orfa_read_reply(o, &r);
+			CHECK(rc == ORFA_OK && r.type == ORFA_REPLY_READ && r.data[0] == 7,
+			      "'%s' held: second result %d", held[i], rc);
+			orfa_close(o);
+		}
+		gw_stop(pid);
+	}
+	/* the bytes of the open, the test itself the gateway that does not
+	 * answer (a slave side held open, so that the master side has one
+	 * while the child's open comes and goes) */
+	{
+		char buf[64];
+		int fd = open(slave_path, O_RDWR | O_NOCTTY);
+		int status = -1;
+		pid_t pid = fork();
+
+		if (pid == 0) {
+			orfa_t *o = NULL;
+
+			_exit(orfa_open(&o, slave_path, 115200) == ORFA_E_TIMEOUT ? 0 : 1);
+		}
+		sent(buf, sizeof(buf), 3);
+		CHECK(strcmp(buf, "\nV\nL\n") == 0, "the open sent '%s'", buf);
+		waitpid(pid, &status, 0);
+		CHECK(status == 0, "unanswered, the open timed out: status %d", status);
+		close(fd);
+	}
+}
+
+/* Bounded, whatever the line carries: nothing at all, or a stream of NMEA
+ * sentences and junk with no gateway behind it: ORFA_E_TIMEOUT within
+ * ORFA_TIMEOUT_MS (and a little), no handle. With a gateway behind the
+ * noise, the open finds its replies among it. */
+static void test_open_bounded(void)
+{
+	static const int modes[] = {GW_SILENT, GW_SILENT | GW_NOISE};
+	size_t i;
+
+	for (i = 0; i < sizeof(modes) / sizeof(modes[0]); i++) {
+		pid_t pid = gw_start("S AA 0", modes[i]);
+		orfa_t *o = (orfa_t *)1;
+		long t0 = ms_now();
+		int rc = orfa_open(&o, slave_path, 115200);
+		long took = ms_now() - t0;
+
+		gw_stop(pid);
+		CHECK(rc == ORFA_E_TIMEOUT && errno == ETIMEDOUT && o == NULL,
+		      "mode %d: open %d (%s)", modes[i], rc, strerror(errno));
+		CHECK(took >= ORFA_TIMEOUT_MS - 50 && took < ORFA_TIMEOUT_MS + 500,
+		      "mode %d: the open took %ld ms", modes[i], took);
+	}
+	{
+		pid_t pid = gw_start("S AA 0", GW_NOISE);
+		orfa_t *o = NULL;
+		int rc = orfa_open(&o, slave_path, 115200);
+
+		gw_stop(pid);
+		CHECK(rc == ORFA_OK, "a gateway behind the noise: open %d", rc);
+		orfa_close(o);
 	}
 }
 
@@ -229,6 +423,32 @@ static void test_bad_lines(orfa_t *o)
 	CHECK(orfa_read_reply(o, &r) == ORFA_E_PROTOCOL, "no CR");
 	CHECK(orfa_read_reply(o, &r) == ORFA_E_PROTOCOL, "SWP to V");
 	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_VERSION, "back in step");
+
+	/* a line over 127 characters that arrives whole in one read, with the
+	 * next request's reply behind it: the long line is its own request's
+	 * ORFA_E_PROTOCOL and nothing of it reaches the next request */
+	CHECK(orfa_version(o) == ORFA_OK, "V");
+	CHECK(orfa_tr_start(o) == ORFA_OK && orfa_write(o, 0xAA, (const uint8_t *)"", 1) == ORFA_OK &&
+	      orfa_read(o, 0xAA, 1) == ORFA_OK && orfa_tr_commit(o) == ORFA_OK, "SAA00SAB01P");
+	sent(buf, sizeof(buf), 2);
+	CHECK(strcmp(buf, "V\nSAA00SAB01P\n") == 0, "sent %s", buf);
+	strcpy(longline + 200, "\r\nSWASR07P\r\n");
+	answer(longline);
+	CHECK(orfa_read_reply(o, &r) == ORFA_E_PROTOCOL, "200 characters in one read");
+	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_WRITE && r.size == 1,
+	      "the next request's SW");
+	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_READ && r.size == 1 &&
+	      r.data[0] == 7, "the next request's SR");
+	CHECK(orfa_read_reply(o, &r) == ORFA_E_STATE, "all read");
+	/* the same, the long line split over two reads */
+	CHECK(orfa_version(o) == ORFA_OK && orfa_version(o) == ORFA_OK, "2 V");
+	sent(buf, sizeof(buf), 2);
+	answer("AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA");
+	CHECK(orfa_read_reply(o, &r) == ORFA_E_TIMEOUT, "half of it");
+	answer("AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA"
+	       "\r\nV1.1\r\n");
+	CHECK(orfa_read_reply(o, &r) == ORFA_E_PROTOCOL, "180 characters in two reads");
+	CHECK(orfa_read_reply(o, &r) == ORFA_OK && r.type == ORFA_REPLY_VERSION, "in step");
 	CHECK(orfa_set_timeout(o, 2000) == ORFA_OK, "timeout");
 }
 
@@ -301,7 +521,9 @@ int main(void)
 	open_pty();
 	test_open();
 	test_rates_by_number();
-	CHECK(orfa_open(&o, slave_path, 115200) == ORFA_OK, "open %s", slave_path);
+	test_open_ends_partial_line();
+	test_open_bounded();
+	CHECK(open_served(&o, 115200) == ORFA_OK, "open %s", slave_path);
 	if (o != NULL) {
 		test_exchange(o);
 		test_bad_lines(o);
