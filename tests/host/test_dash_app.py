@@ -9,7 +9,7 @@ import json
 import pytest
 
 from fake_line import FakeLine
-from orfa import Gateway, PinBusyError, ReplyTimeout, boardmap
+from orfa import Gateway, PinBusyError, ReplyTimeout, SerialError, boardmap
 from orfa.cli import main
 from orfa.dash.live import ControlError, Dashboard, NotFound, Refused
 from test_api_requests import board_answers
@@ -239,6 +239,10 @@ def test_a_control_posts_json_to_the_dashboard():
      " another function)"),
     (ReplyTimeout("no reply to 'SAA13P' within 0.2 s"), 503,
      "the serial line: no reply to 'SAA13P' within 0.2 s"),
+    # the line failed under the page: no board refused anything (a
+    # SerialError is an OrfaError, as the board's refusals are)
+    (SerialError("/dev/ttyUSB0: device reports readiness to read but returned no data"), 503,
+     "the serial line: /dev/ttyUSB0: device reports readiness to read but returned no data"),
     (RuntimeError("a bug"), 500, "RuntimeError: a bug"),
 ])
 def test_control_errors_are_one_line_of_json(outcome, status, error):
@@ -255,6 +259,34 @@ def test_requests_the_app_does_not_take():
     assert (r.status_code, r.get_json()) == (405, {"error": "GET is not allowed on /api/AA/servo"})
     r = c.get("/nothing")
     assert (r.status_code, r.get_json()) == (404, {"error": "no such page: /nothing"})
+
+
+@pytest.mark.parametrize("depth", [900, 990, 1000, 5000, 100000])
+def test_a_deeply_nested_body_is_a_bad_request(dash, depth):
+    # json gives up on deep nesting with a RecursionError, which is no
+    # ValueError: the page gets 400 and one line, the board is not asked
+    c = create_app(dash).test_client()
+    for body in ("[" * depth + "]" * depth,
+                 '{"channel": 3, "us": ' + "[" * depth + "]" * depth + "}"):
+        r = c.post("/api/AA/servo", data=body, content_type="application/json")
+        assert r.status_code == 400, r.get_json()
+        error = r.get_json()["error"]
+        assert error.startswith("servo: ") and "\n" not in error and len(error) < 200, error
+    assert dash.line.written == []
+
+
+def test_a_serial_line_that_fails_under_a_control_is_503(dash):
+    # the real Dashboard on a line whose reads fail as a vanished USB
+    # adapter's do: the Gateway's SerialError, answered as the docs say
+    import serial
+
+    def broken(*args, **kw):
+        raise serial.SerialException("device reports readiness to read but returned no data")
+    dash.line.read = dash.line.read_until = dash.line.readline = broken
+    dash.line.write = broken
+    r = create_app(dash).test_client().post("/api/AA/servo", json={"channel": 3, "us": 1700})
+    assert r.status_code == 503, r.get_json()
+    assert r.get_json()["error"].startswith("the serial line: fake://: ")
 
 
 # --- the command line -------------------------------------------------------------

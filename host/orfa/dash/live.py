@@ -242,10 +242,21 @@ def _number(body: Dict, name: str, lo: float, hi: float, what: str, integer: boo
     return int(value) if integer else float(value)
 
 
+#: The most characters of a wrong value that an error message quotes.
+SHOW_MAX = 40
+
+
 def _show(value) -> str:
+    """A value as JSON would show it, cut to SHOW_MAX characters (a 100 kB
+    string or a list nested 900 deep is named, not echoed)."""
     if isinstance(value, float) and value.is_integer():
         value = int(value)
-    return "null" if value is None else repr(value) if isinstance(value, str) else str(value)
+    try:
+        text = "null" if value is None else repr(value) if isinstance(value, str) \
+            else str(value)
+    except RecursionError:
+        text = type(value).__name__
+    return text if len(text) <= SHOW_MAX else text[:SHOW_MAX - 3] + "..."
 
 
 def _check_keys(body: Dict, allowed, what: str) -> None:
