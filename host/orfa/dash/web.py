@@ -6,6 +6,7 @@
     POST /api/<addr>/servo {"channel": 3, "us": 1700} or {"channel": 3, "angle": 30}
     POST /api/<addr>/motor {"motor": 1, "duty": -128}
     POST /api/<addr>/gpio  {"port": "B", "bit": 2, "level": 1, "output": true}
+    POST /api/<addr>/adc   {"channels": [0, 1], "reference": "avcc", "bits": 10}
 
 A control answers 200 with what it set, or {"error": "..."} with 400 (a bad
 request), 404 (no such board), 409 (the board refused or a line is held)
