@@ -1,7 +1,8 @@
 """Draw waveforms (orfa.waves.Wave) as a PNG with matplotlib: one row per
-signal, the time axis in microseconds, each row annotated with what
-orfa.waves measures (every pulse's width when they fit, and a summary line:
-widths, period, duty).
+signal, the time axis counted from the window's start in a unit that suits
+its length (us, ms or s), each row annotated with what orfa.waves measures
+(every pulse's width when they fit, and a summary line: widths, and period
+and duty for a periodic line).
 
 matplotlib is the extra `orfa[plot]`; this module imports it only when it
 draws, and says which package is missing otherwise.
@@ -21,6 +22,25 @@ WIDTH_IN = 12.0
 class Row(NamedTuple):
     wave: waves.Wave
     label: str                # the y axis text: name and what the pin does
+    periodic: bool = True     # False: a bus or a serial line (no period, no duty)
+
+
+class Axis(NamedTuple):
+    origin: int               # the cycle the axis counts from (the window's start)
+    unit: str                 # "us", "ms" or "s"
+    us_per_unit: float
+    label: str                # the axis title
+
+
+def time_axis(start: int, end: int, f_cpu: int) -> Axis:
+    """The time axis of a window: counted from its start, in us below 2 ms,
+    ms below 2 s, else s; its title says where the window starts."""
+    span = waves.us(end - start, f_cpu)
+    unit, per = ("us", 1.0) if span < 2000 else ("ms", 1e3) if span < 2e6 else ("s", 1e6)
+    since = "from power-up" if start == 0 else \
+        "from %s after power-up" % waves.show_us(start, f_cpu)
+    return Axis(start, unit, per, "time (%s) %s, simulated, %.4g MHz CPU clock"
+                % ("\u00b5s" if unit == "us" else unit, _micro(since), f_cpu / 1e6))
 
 
 class Annotation(NamedTuple):
@@ -45,7 +65,9 @@ def annotations(rows: Sequence[Row], f_cpu: int) -> List[Annotation]:
                 out.append(Annotation(name, "pulse", waves.show_us(fall - rise, f_cpu),
                                       fall - rise))
         out.append(Annotation(name, "summary",
-                              waves.describe(waves.summary(row.wave), f_cpu), None))
+                              waves.describe(waves.summary(row.wave), f_cpu,
+                                             periodic=row.periodic, origin=row.wave.start),
+                              None))
     return out
 
 
@@ -68,13 +90,15 @@ def _micro(text: str) -> str:
     return text.replace(" us", " \u00b5s")
 
 
-def _steps(wave: waves.Wave, f_cpu: int):
-    xs = [waves.us(wave.start, f_cpu)]
+def _steps(wave: waves.Wave, f_cpu: int, axis: Axis):
+    def x(cycle):
+        return waves.us(cycle - axis.origin, f_cpu) / axis.us_per_unit
+    xs = [x(wave.start)]
     ys = [wave.level]
     for cycle, level in wave.edges:
-        xs += [waves.us(cycle, f_cpu)] * 2
+        xs += [x(cycle)] * 2
         ys += [ys[-1], level]
-    xs.append(waves.us(wave.end, f_cpu))
+    xs.append(x(wave.end))
     ys.append(ys[-1])
     return xs, ys
 
@@ -88,10 +112,10 @@ def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[A
     fig, axes = plt.subplots(n, 1, sharex=True, squeeze=False,
                              figsize=(WIDTH_IN, 1.1 + ROW_HEIGHT_IN * n))
     axes = [a[0] for a in axes]
-    start = waves.us(rows[0].wave.start, f_cpu) if rows else 0.0
-    end = waves.us(rows[0].wave.end, f_cpu) if rows else 1.0
+    start, end = (rows[0].wave.start, rows[0].wave.end) if rows else (0, 1)
+    axis = time_axis(start, end, f_cpu)
     for ax, row in zip(axes, rows):
-        xs, ys = _steps(row.wave, f_cpu)
+        xs, ys = _steps(row.wave, f_cpu, axis)
         ax.plot(xs, ys, color="tab:blue", linewidth=1.0)
         ax.fill_between(xs, 0, ys, color="tab:blue", alpha=0.15, linewidth=0)
         ax.set_ylim(-0.25, 1.75)
@@ -103,14 +127,15 @@ def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[A
         mine = [a for a in notes if a.signal == row.wave.name]
         pulses = waves.pulses(row.wave)
         for (rise, fall), note in zip(pulses, [a for a in mine if a.kind == "pulse"]):
-            ax.annotate(_micro(note.text), xy=(waves.us((rise + fall) / 2, f_cpu), 1.05),
+            middle = waves.us((rise + fall) / 2 - axis.origin, f_cpu) / axis.us_per_unit
+            ax.annotate(_micro(note.text), xy=(middle, 1.05),
                         ha="center", va="bottom", fontsize=7.5, color="tab:red")
         summary = [a.text for a in mine if a.kind == "summary"]
         ax.text(1.01, 0.35, _micro(summary[0]).replace(", ", "\n", 1) if summary else "",
                 transform=ax.transAxes, ha="left", va="center", fontsize=8, color="0.2")
-    axes[-1].set_xlim(start, end)
+    axes[-1].set_xlim(0, waves.us(end - start, f_cpu) / axis.us_per_unit)
     axes[-1].ticklabel_format(axis="x", useOffset=False, style="plain")
-    axes[-1].set_xlabel("time (\u00b5s, simulated, %.4g MHz CPU clock)" % (f_cpu / 1e6))
+    axes[-1].set_xlabel(axis.label)
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()

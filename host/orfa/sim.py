@@ -63,16 +63,32 @@ def parse_trace(text: str) -> List[TraceEvent]:
     return [parse_trace_line(line) for line in text.splitlines() if line.strip()]
 
 
-#: A slave board on the simulated bus: (board, 8-bit address, ELF or None).
-#: None means the board's slave build, build/<board>-slave/orfa.elf.
-SlaveSpec = Tuple[str, int, Union[str, Path, None]]
+#: A slave board on the simulated bus: (board, 8-bit address) or (board,
+#: 8-bit address, ELF or None). Without an ELF, the slave build for that
+#: address (slave_firmware_path: the installed package's, or build/'s), as
+#: `orfa sim --slave BOARD:ADDR` and the pytest marker take it.
+SlaveSpec = Union[Tuple[str, int], Tuple[str, int, Union[str, Path, None]]]
+
+
+def slave_spec(spec) -> Tuple[str, int, Union[str, Path, None]]:
+    """(board, addr) or (board, addr, elf) -> (board, addr, elf or None);
+    anything else is a ValueError that says what a slave is."""
+    if not isinstance(spec, (tuple, list)) or len(spec) not in (2, 3) \
+            or isinstance(spec[1], bool) or not isinstance(spec[1], int):
+        raise ValueError("slave %r: (board, addr) or (board, addr, elf), e.g. (\"m128s\", 0x10)"
+                         % (spec,))
+    board, addr = spec[0], spec[1]
+    if board not in BOARDS:
+        raise ValueError("slave board %r: one of %s" % (board, ", ".join(BOARDS)))
+    if addr & 1 or not 0x10 <= addr <= 0xEE:
+        raise ValueError("slave address %s: an 8-bit address, even, 0x10..0xEE"
+                         % ("0x%02X" % addr if addr >= 0 else addr))
+    return (board, addr, spec[2] if len(spec) == 3 else None)
 
 
 def slave_option(spec: SlaveSpec) -> str:
     """The simulator's `--slave BOARD:ADDR:ELF` value of a SlaveSpec."""
-    board, addr, elf = spec
-    if board not in BOARDS:
-        raise ValueError("slave board must be one of %s" % (BOARDS,))
+    board, addr, elf = slave_spec(spec)
     path = Path(elf) if elf else slave_firmware_path(board, addr)
     return "%s:0x%02X:%s" % (board, addr, path)
 
@@ -105,8 +121,9 @@ class SimBoard:
     puts SRF08 range finders on the I2C bus (their `srf08` control request
     sets what they sense).
 
-    slaves=[("m128s", 0x10, elf_path), ...] puts further boards, each running
-    its own firmware (elf_path None: build/<board>-slave/orfa.elf), on the
+    slaves=[("m128s", 0x10), ("m32d", 0x12, elf_path), ...] puts further
+    boards, each running its own firmware (without an ELF, or None: the
+    slave build for that address, slave_firmware_path), on the
     same I2C bus as I2C slaves: a robot. The control socket reaches them as
     `10/servo3` (signals) and `@10` (other requests); see docs/simulator.md.
     """
@@ -133,7 +150,7 @@ class SimBoard:
         self.adc = dict(adc or {})
         self.avcc = avcc
         self.aref = aref
-        self.slaves = tuple(slaves)
+        self.slaves = tuple(slave_spec(spec) for spec in slaves)
         self.slave_options = [slave_option(spec) for spec in self.slaves]
         self.control_path: Optional[Path] = None
         self.vcd_path: Optional[Path] = None
@@ -348,7 +365,7 @@ class SimBoard:
 class SimRobot(SimBoard):
     """A gateway board and its slave boards on one simulated I2C bus.
 
-    SimRobot("m32d", slaves=[("m128s", 0x10, None), ("m128s", 0x12, None)])
+    SimRobot("m32d", slaves=[("m128s", 0x10), ("m32d", 0x12)])
     is SimBoard with the gateway board first; every SimBoard option applies
     (to the gateway's board, and the control socket reaches every board).
     """

@@ -115,8 +115,10 @@ def us(cycles: float, f_cpu: int) -> float:
 
 
 def show_us(cycles: float, f_cpu: int) -> str:
-    """A duration for a person: 1500.0 us, 20.00 ms, 0.54 us."""
+    """A duration for a person: 1500.0 us, 20.00 ms, 0.54 us, 12.50 s."""
     t = us(cycles, f_cpu)
+    if t >= 10000000:
+        return "%.2f s" % (t / 1000000)
     if t >= 10000:
         return "%.2f ms" % (t / 1000)
     if t >= 100:
@@ -124,14 +126,18 @@ def show_us(cycles: float, f_cpu: int) -> str:
     return "%.2f us" % t
 
 
-def describe(s: Summary, f_cpu: int) -> str:
-    """One line: the measured widths, period (or frequency) and duty."""
-    if s.pulses == 0 and s.period is None:
+def describe(s: Summary, f_cpu: int, periodic: bool = True, origin: int = 0) -> str:
+    """One line: the measured widths, period (or frequency) and duty. A line
+    that is not periodic (a bus, a serial line, a chip select: its pulses
+    come when there is something to send) gets its widths and how many
+    pulses, no period or duty. A time ("rises at") counts from `origin`
+    (the cycle a plot's axis starts at)."""
+    if s.pulses == 0 and (s.period is None or not periodic):
         if s.last_edge is None:
             return "steady %d" % s.level
         # one edge, or a pulse that the window cuts: when it last changed
         cycle, level = s.last_edge
-        return "%s at %.2f us" % ("rises" if level else "falls", us(cycle, f_cpu))
+        return "%s at %s" % ("rises" if level else "falls", show_us(cycle - origin, f_cpu))
     parts = []
     kind = "high" if s.polarity else "low"
     if s.width_min is not None:
@@ -140,6 +146,9 @@ def describe(s: Summary, f_cpu: int) -> str:
         else:
             parts.append("%s %s-%s" % (kind, show_us(s.width_min, f_cpu),
                                        show_us(s.width_max, f_cpu)))
+    if not periodic:
+        parts.append("%d pulse%s" % (s.pulses, "" if s.pulses == 1 else "s"))
+        return ", ".join(parts)
     if s.period:
         parts.append("period %s (%s)" % (show_us(s.period, f_cpu), show_hz(f_cpu / s.period)))
     if s.duty is not None:

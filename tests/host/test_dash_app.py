@@ -9,7 +9,7 @@ import json
 import pytest
 
 from fake_line import FakeLine
-from orfa import Gateway, PinBusyError, ReplyTimeout, boardmap
+from orfa import Gateway, PinBusyError, ReplyTimeout, SerialError, boardmap
 from orfa.cli import main
 from orfa.dash.live import ControlError, Dashboard, NotFound, Refused
 from test_api_requests import board_answers
@@ -25,7 +25,9 @@ LOCAL = "%02X" % M32D.local_address
 def dash(monkeypatch):
     """A Dashboard of the gateway's own M32-D on a scripted line (no slaves);
     `dash.line` is the fake, emptied after discovery."""
-    table = {"L": "L" + LOCAL, "SAA130306A4P": "SWAAAAP"}
+    table = {"L": "L" + LOCAL, "SAA130306A4P": "SWAAAAP",
+             # the ADC's RC: channel 0 on, AVCC, 10 bits; 0 and 1 asked, only 0 on
+             "SAA0C0501P": "SWAAAP", "SAA0C0503P": "SWAAAP", "SAA0CSAB02P": "SWASR0501P"}
     line = FakeLine(board_answers("m32d", M32D.local_address, table))
     monkeypatch.setattr("orfa.gateway.serial.serial_for_url", lambda url, **kw: line)
     d = Dashboard(Gateway("fake://", timeout=0.2), slaves=())
@@ -79,6 +81,18 @@ def test_a_good_servo_control_sends_the_typed_apis_request(dash):
     ("gpio", {"port": "B", "bit": 2}, "gpio: give level (0 or 1), output (true or false) or both"),
     ("gpio", {"port": "B", "bit": 2, "level": 2}, "gpio: level 2 is outside 0..1"),
     ("gpio", {"port": "B", "bit": 2, "output": 1}, "gpio: output must be true or false, not 1"),
+    ("adc", {"reference": "avcc"}, "adc: channels is missing (a list of 0..7, [] for none)"),
+    ("adc", {"channels": 3}, "adc: channels must be a list of 0..7, not 3"),
+    ("adc", {"channels": [8]}, "adc: channel 8 is outside 0..7"),
+    ("adc", {"channels": ["1"]}, "adc: channel must be an integer number, not '1'"),
+    ("adc", {"channels": [0], "reference": "vcc"},
+     "adc: reference 'vcc': one of aref, avcc, internal"),
+    ("adc", {"channels": [0], "bits": 12}, "adc: bits must be 8 or 10, not 12"),
+    ("adc", {"channels": [0], "bits": True}, "adc: bits must be 8 or 10, not True"),
+    ("adc", {"channels": [0], "rate": 1}, "adc: unknown field rate (fields: channels, reference,"
+                                          " bits)"),
+    ("servo", {"channel": 3, "us": "x" * 1000},
+     "servo: us must be an integer number, not 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx..."),
 ])
 def test_a_bad_control_is_refused_before_the_line(dash, kind, body, message):
     with pytest.raises(ControlError) as exc:
@@ -87,10 +101,23 @@ def test_a_bad_control_is_refused_before_the_line(dash, kind, body, message):
     assert dash.line.written == []
 
 
+def test_the_adc_control_configures_the_adc(dash):
+    # the page can turn the ADC on: one write of RC, read back
+    assert dash.control(LOCAL, "adc", {"channels": [0], "reference": "avcc", "bits": 10}) == \
+        {"adc": [0], "reference": "avcc", "bits": 10, "board": LOCAL}
+    assert dash.line.written == ["SAA0C0501P", "SAA0CSAB02P"]
+    # a channel that did not turn on (its pin another function's) is named
+    del dash.line.written[:]
+    with pytest.raises(Refused) as exc:
+        dash.control(LOCAL, "adc", {"channels": [1, 0, 1]})
+    assert str(exc.value) == "adc: PA1 did not turn on: another function holds it"
+    assert dash.line.written == ["SAA0C0503P", "SAA0CSAB02P"]
+
+
 def test_an_unknown_board_or_control(dash):
     with pytest.raises(NotFound, match=r"no board at '10' here \(boards: AA\)"):
         dash.control("10", "servo", {"channel": 3, "us": 1500})
-    with pytest.raises(NotFound, match=r"no control 'spi' \(controls: servo, motor, gpio\)"):
+    with pytest.raises(NotFound, match=r"no control 'spi' \(controls: servo, motor, gpio, adc\)"):
         dash.control(LOCAL, "spi", {})
     assert dash.line.written == []
 
@@ -239,6 +266,10 @@ def test_a_control_posts_json_to_the_dashboard():
      " another function)"),
     (ReplyTimeout("no reply to 'SAA13P' within 0.2 s"), 503,
      "the serial line: no reply to 'SAA13P' within 0.2 s"),
+    # the line failed under the page: no board refused anything (a
+    # SerialError is an OrfaError, as the board's refusals are)
+    (SerialError("/dev/ttyUSB0: device reports readiness to read but returned no data"), 503,
+     "the serial line: /dev/ttyUSB0: device reports readiness to read but returned no data"),
     (RuntimeError("a bug"), 500, "RuntimeError: a bug"),
 ])
 def test_control_errors_are_one_line_of_json(outcome, status, error):
@@ -255,6 +286,34 @@ def test_requests_the_app_does_not_take():
     assert (r.status_code, r.get_json()) == (405, {"error": "GET is not allowed on /api/AA/servo"})
     r = c.get("/nothing")
     assert (r.status_code, r.get_json()) == (404, {"error": "no such page: /nothing"})
+
+
+@pytest.mark.parametrize("depth", [900, 990, 1000, 5000, 100000])
+def test_a_deeply_nested_body_is_a_bad_request(dash, depth):
+    # json gives up on deep nesting with a RecursionError, which is no
+    # ValueError: the page gets 400 and one line, the board is not asked
+    c = create_app(dash).test_client()
+    for body in ("[" * depth + "]" * depth,
+                 '{"channel": 3, "us": ' + "[" * depth + "]" * depth + "}"):
+        r = c.post("/api/AA/servo", data=body, content_type="application/json")
+        assert r.status_code == 400, r.get_json()
+        error = r.get_json()["error"]
+        assert error.startswith("servo: ") and "\n" not in error and len(error) < 200, error
+    assert dash.line.written == []
+
+
+def test_a_serial_line_that_fails_under_a_control_is_503(dash):
+    # the real Dashboard on a line whose reads fail as a vanished USB
+    # adapter's do: the Gateway's SerialError, answered as the docs say
+    import serial
+
+    def broken(*args, **kw):
+        raise serial.SerialException("device reports readiness to read but returned no data")
+    dash.line.read = dash.line.read_until = dash.line.readline = broken
+    dash.line.write = broken
+    r = create_app(dash).test_client().post("/api/AA/servo", json={"channel": 3, "us": 1700})
+    assert r.status_code == 503, r.get_json()
+    assert r.get_json()["error"].startswith("the serial line: fake://: ")
 
 
 # --- the command line -------------------------------------------------------------

@@ -262,3 +262,45 @@ def test_dash_page_is_in_the_package_and_flask_is_asked_for(installed, tmp_path)
     r = run([installed.bin / "orfa", "dash", "--sim", "m32d"], cwd=tmp_path)
     assert (r.returncode, r.stdout, r.stderr) == (
         2, "", "orfa: orfa dash needs Flask: pip install 'orfa[dash]'\n")
+
+
+def readme_python_examples():
+    """README's Python examples: each indented block that imports orfa, as
+    (its code, the comments of its print lines: what it prints)."""
+    import re
+    text = (ROOT / "README.md").read_text()
+    out = []
+    for block in re.findall(r"\n\n((?:    .*\n|\n(?=    ))+)", text):
+        code = "\n".join(line[4:] for line in block.splitlines())
+        if not re.search(r"^(from orfa|import orfa)", code, re.M):
+            continue
+        shown = [line.split("#", 1)[1].strip() for line in code.splitlines()
+                 if line.lstrip().startswith("print(") and "#" in line]
+        out.append((code, shown))
+    return out
+
+
+def test_readme_python_examples_run_from_the_installed_package(installed, tmp_path):
+    """Every Python example of README.md, as a new user pastes it, run by the
+    venv's Python in a directory outside the repository: it runs (the
+    firmware it needs comes from the package, not from build/), and prints
+    what its comments show. An example for a real port gets a simulated
+    board's port instead."""
+    from orfa.sim import SimBoard
+    examples = readme_python_examples()
+    assert len(examples) >= 3 and all(shown for _, shown in examples)
+    board = None
+    try:
+        for i, (code, shown) in enumerate(examples):
+            if "/dev/ttyUSB0" in code:
+                if board is None:
+                    board = SimBoard("m32d", trace=False).start()
+                code = code.replace("/dev/ttyUSB0", board.port)
+            script = tmp_path / ("example_%d.py" % i)
+            script.write_text(code + "\n")
+            r = run([installed.bin / "python", script], cwd=tmp_path)
+            assert (r.returncode, r.stderr) == (0, ""), code
+            assert r.stdout.splitlines() == shown, code
+    finally:
+        if board is not None:
+            board.stop()

@@ -41,3 +41,31 @@ def test_missing_firmware_says_how_to_build(tmp_path):
 def test_unknown_board():
     with pytest.raises(ValueError):
         sim.SimBoard("m8")
+
+
+def test_a_slave_without_an_elf_runs_the_build_for_its_address():
+    # ("m128s", 0x10) as `--slave m128s:0x10` and the pytest marker take it:
+    # the slave build for that address (it was a ValueError: not enough
+    # values to unpack)
+    robot = sim.SimRobot("m32d", slaves=[("m128s", 0x10), ("m32d", 0x12, None),
+                                         ["m128s", 0x14, "/x/orfa.elf"]])
+    assert robot.slaves == (("m128s", 0x10, None), ("m32d", 0x12, None),
+                            ("m128s", 0x14, "/x/orfa.elf"))
+    assert robot.slave_options == [
+        "m128s:0x10:%s" % sim.slave_firmware_path("m128s", 0x10),
+        "m32d:0x12:%s" % sim.slave_firmware_path("m32d", 0x12),
+        "m128s:0x14:/x/orfa.elf"]
+
+
+@pytest.mark.parametrize("spec, message", [
+    (("m128s",), "slave ('m128s',): (board, addr) or (board, addr, elf), e.g. (\"m128s\", 0x10)"),
+    ("m128s:0x10", "slave 'm128s:0x10': (board, addr) or (board, addr, elf)"),
+    (("m128s", "0x10"), "slave ('m128s', '0x10'): (board, addr) or (board, addr, elf)"),
+    (("m64", 0x10), "slave board 'm64': one of m32d, m128s"),
+    (("m128s", 0x11), "slave address 0x11: an 8-bit address, even, 0x10..0xEE"),
+    (("m128s", 0x08), "slave address 0x08: an 8-bit address, even, 0x10..0xEE"),
+])
+def test_a_slave_that_is_no_slave_is_one_line(spec, message):
+    with pytest.raises(ValueError) as exc:
+        sim.SimRobot("m32d", slaves=[spec])
+    assert str(exc.value).startswith(message) and "\n" not in str(exc.value)

@@ -106,7 +106,9 @@ def test_a_line_that_idles_high_has_low_pulses():
 
 def test_a_line_that_only_rises_or_falls_says_when():
     rise = waves.summary(waves.window("B0", 0, [(73728, 1)], 0, 100000))
-    assert waves.describe(rise, F) == "rises at 10000.00 us"
+    assert waves.describe(rise, F) == "rises at 10.00 ms"
+    # counted from where the plot's axis starts
+    assert waves.describe(rise, F, origin=73728 - 737) == "rises at 99.96 us"
     fall = waves.summary(waves.window("B0", 1, [(737, 0)], 0, 100000))
     assert waves.describe(fall, F) == "falls at 99.96 us"
     # a whole period, rise to rise, around one whole high pulse
@@ -128,7 +130,8 @@ def test_an_edge_at_the_files_last_time_is_drawn(tmp_path, capsys):
     src.write_text(make_vcd({"B0": [(73728, 1)]}).replace("#%d\n" % ps(73728), "#%d\n" % ps(73728)))
     assert vcd.parse(src.read_text()).end == 73728
     assert main(["plot", str(src), "--signals", "B0", "-o", str(tmp_path / "t.png")]) == 0
-    assert capsys.readouterr().out == "B0         rises at 10000.00 us\n"
+    # the window is trimmed to the edge, 50 us (369 cycles) either side
+    assert capsys.readouterr().out == "B0         rises at 50.05 us\n"
 
 
 @pytest.mark.parametrize("text, us", [("1500", 1500), ("1500us", 1500), ("1.5ms", 1500),
@@ -193,13 +196,100 @@ def test_command_on_a_file(tmp_path, capsys):
     assert main(["plot", str(src), "-o", str(out)]) == 0
     assert capsys.readouterr().out == (
         "A3         high 1500.0 us-1500.2 us, period 20.00 ms (50.0 Hz), duty 7.5%\n"
-        "i2c        high 949.4 us\n")
+        "i2c        high 949.4 us, 1 pulse\n")
     width, height = png_size(out)
     assert width > 1000 and height > 150
     assert main(["plot", str(src), "--signals", "servo3", "--from", "0", "--to", "15ms",
                  "-o", str(out), "-v"]) == 0
     assert capsys.readouterr().out == ("servo3     1500.0 us\n"
                                        "servo3     high 1500.0 us\n")
+
+
+def svg_texts(path):
+    """The texts of a matplotlib SVG, in order (each is drawn as paths
+    after a comment that carries it)."""
+    return re.findall(r"<!-- (.*?) -->", path.read_text())
+
+
+@pytest.mark.parametrize("start, end, unit, label", [
+    (0, 7373, "us", "time (\u00b5s) from power-up, simulated, 7.373 MHz CPU clock"),
+    (2742682, 2742682 + 331776, "ms",
+     "time (ms) from 372.00 ms after power-up, simulated, 7.373 MHz CPU clock"),
+    (F * 10, F * 610, "s", "time (s) from 10.00 s after power-up, simulated,"
+                           " 7.373 MHz CPU clock"),
+])
+def test_the_time_axis_counts_from_the_windows_start(start, end, unit, label):
+    axis = plot.time_axis(start, end, F)
+    assert (axis.origin, axis.unit, axis.label) == (start, unit, label)
+
+
+def test_a_window_is_drawn_from_its_start_in_readable_units(tmp_path, capsys):
+    # a servo pulsing from 370 ms on; --from 372ms --to 417ms is drawn as
+    # 0..45 ms, not as 372000..417000 us since power-up
+    pytest.importorskip("matplotlib")
+    period, start = 147456, 2727936                     # 20 ms; 370 ms
+    servo = [e for k in range(40) for e in ((start + k * period, 1),
+                                            (start + k * period + 11059, 0))]
+    src = tmp_path / "t.vcd"
+    src.write_text(make_vcd({"A3": servo}))
+    out = tmp_path / "t.svg"
+    assert main(["plot", str(src), "--signals", "A3", "--from", "372ms", "--to", "417ms",
+                 "-o", str(out)]) == 0
+    texts = svg_texts(out)
+    label = [t for t in texts if t.startswith("time (")]
+    assert label == ["time (ms) from 372.00 ms after power-up, simulated, 7.373 MHz CPU clock"]
+    ticks = [int(t) for t in texts if t.isdigit()]
+    assert ticks[0] == 0 and ticks[-1] == 45 and ticks == sorted(ticks), ticks
+    assert "372000" not in out.read_text()
+    assert capsys.readouterr().out == \
+        "A3         high 1500.0 us, period 20.00 ms (50.0 Hz), duty 7.5%\n"
+
+
+def bus_vcd(tmp_path):
+    """A board's life as `orfa sim --vcd` writes it: the SPI chip select and
+    the UART's receive line go high at power-up; 300 ms and 500 ms later a
+    request each (bytes on RX, then a bus transaction); the file ends at
+    10 minutes."""
+    ms = F // 1000
+    rx = [(500, 1)]
+    i2c = []
+    for t in (300 * ms, 500 * ms):
+        for byte in range(5):                      # a start bit and a zero bit a byte
+            b = t + byte * 640
+            rx += [(b, 0), (b + 64, 1), (b + 320, 0), (b + 384, 1)]
+        i2c += [(t + 4000, 1), (t + 4000 + 2944, 0)]
+    src = tmp_path / "bus.vcd"
+    src.write_text(make_vcd({"B4": [(7143, 1)], "D0": rx, "i2c": i2c,
+                             "B0": [(600 * 1000 * ms, 1)]}))
+    return src
+
+
+def test_a_window_is_trimmed_to_where_the_activity_is(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "bus.svg"
+    assert main(["plot", str(bus_vcd(tmp_path)), "-o", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    # the chip select's power-up edge and a pin set ten minutes later are
+    # not what happened: the rows are the bus and the serial line, and the
+    # window is their 200 ms and 5 % of that either side (10 ms before the
+    # first byte at 299.97 ms)
+    assert [line.split()[0] for line in lines] == ["i2c", "D0"]
+    texts = svg_texts(out)
+    label = [t for t in texts if t.startswith("time (")]
+    assert label == ["time (ms) from 289.92 ms after power-up, simulated, 7.373 MHz CPU clock"]
+    ticks = [int(t) for t in texts if t.isdigit()]
+    assert ticks[0] == 0 and 200 <= ticks[-1] <= 220, ticks
+
+
+def test_bus_and_serial_rows_count_their_pulses_without_a_period(tmp_path, capsys):
+    # a transaction or a byte comes when there is one to send: a period of
+    # 200 ms (5 Hz) and a duty of 0.2 % would mean nothing
+    pytest.importorskip("matplotlib")
+    assert main(["plot", str(bus_vcd(tmp_path)), "--signals", "i2c", "D0", "B4",
+                 "-o", str(tmp_path / "bus.png")]) == 0
+    assert capsys.readouterr().out == ("i2c        high 399.3 us, 2 pulses\n"
+                                       "D0         low 8.68 us, 20 pulses\n"
+                                       "B4         steady 1\n")
 
 
 @pytest.mark.parametrize("argv, message", [

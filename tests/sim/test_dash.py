@@ -86,10 +86,9 @@ def dash(robot):
     with Gateway(robot.port, timeout=REPLY_TIMEOUT) as gw:
         board = Dashboard(gw, interval=0.1)
         board.discover()
-        # live values to look at: the ADC on (its lines PA0-PA2 are then
-        # the ADC's, not servo channels 0-2)
+        # live values to look at: the slave's ADC on (the gateway's is
+        # turned on through the page, test_adc_control_turns_the_adc_on)
         with board.lock:
-            board.board(GW_KEY).adc.configure([0, 1, 2], "avcc", 10)
             board.board(SLAVE_KEY).adc.configure([0], "avcc", 10)
         server = Server(board, "127.0.0.1", 0)
         board.start()
@@ -189,12 +188,34 @@ def test_both_boards_show_with_their_own_values(page):
         cells = page.find_elements(By.CSS_SELECTOR, "#b-%s .servo" % key)
         assert len(cells) == m.servo_channels
         assert bool(page.find_elements(By.ID, "b-%s-motor-set" % key)) == m.has("motor")
-    # each board's own ADC: 1.2 V on the gateway's channel 0, 1.8 V on the slave's
-    wait_for(page, "the gateway's ADC channel 0 at 1.2 V",
-             lambda d: text(d, "b-%s-adc-0" % GW_KEY) in ("1.196 V", "1.201 V"))
+    # the slave's own ADC: 1.8 V on its channel 0
     wait_for(page, "the slave's ADC channel 0 at 1.8 V",
              lambda d: text(d, "b-%s-adc-0" % SLAVE_KEY) in ("1.797 V", "1.802 V"))
     assert text(page, "b-%s-status" % SLAVE_KEY) == "00 OK"
+
+
+def test_adc_control_turns_the_adc_on(page, robot):
+    # a fresh gateway converts nothing; the page's ADC control turns its
+    # channels 0-2 on (PA0-PA2 are then the ADC's, not servo channels 0-2)
+    adc = "b-%s-adc" % GW_KEY
+    wait_for(page, "the gateway's ADC off", lambda d: (text(d, adc + "-config") or "")
+             .endswith("no channel on") and text(d, adc + "-0") == "off")
+    for ch in (0, 1, 2):
+        box = page.find_element(By.ID, "%s-on-%d" % (adc, ch))
+        if not box.is_selected():
+            box.click()
+    Select(page.find_element(By.ID, adc + "-ref")).select_by_value("avcc")
+    Select(page.find_element(By.ID, adc + "-bits")).select_by_value("10")
+    page.find_element(By.ID, adc + "-set").click()
+    wait_for(page, "the gateway's ADC channel 0 at 1.2 V",
+             lambda d: text(d, adc + "-0") in ("1.196 V", "1.201 V"))
+    assert text(page, "message") == "0x%s adc: channels 0, 1, 2 on (avcc, 10 bits)" % GW_KEY
+    assert text(page, adc + "-config") == "avcc, 10 bits"
+    # within one step of 10 bits at AVCC 5 V
+    wait_for(page, "3.3 V and 2.5 V on channels 1 and 2", lambda d: all(
+        abs(float((text(d, "%s-%d" % (adc, ch)) or "0 V")[:-2]) - v) <= 0.005
+        for ch, v in ((1, 3.3), (2, 2.5))))  # one step: 4.9 mV
+    assert text(page, adc + "-3") == "off"
 
 
 def test_servo_control_moves_the_pin(page, robot):

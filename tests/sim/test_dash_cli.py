@@ -113,6 +113,32 @@ def test_serves_the_robot_and_ends_on_sigterm():
     assert (status, out, err) == (0, "", "")
 
 
+def test_the_page_turns_the_adc_on_and_shows_its_voltage():
+    # `orfa dash --sim m32d --adc 0=2500`: a fresh board converts nothing;
+    # the ADC control turns channel 0 on, and the next readings show 2.5 V
+    proc, url = start("--adc", "0=2500", "--interval", "0.05")
+    try:
+        snap = snapshot_after(url, 0)
+        assert snap["boards"][0]["adc"]["enabled"] == []
+        assert post(url + "api/AA/adc", {"channels": [0], "reference": "avcc", "bits": 10}) \
+            == (200, {"adc": [0], "reference": "avcc", "bits": 10, "board": "AA"})
+        deadline = time.monotonic() + TIMEOUT
+        while time.monotonic() < deadline:
+            adc = snapshot_after(url, snap["seq"])["boards"][0]["adc"]
+            if adc["volts"][0]:
+                break
+            time.sleep(0.05)
+        assert adc["enabled"] == [0] and adc["volts"][1:] == [None] * 7
+        # 2.5 V of AVCC's 5 V, within one step of 10 bits (the simulator gives 511)
+        assert abs(adc["volts"][0] - 2.5) <= 0.005, adc
+        # servo 0 is PA0, which the ADC now holds: the board says so
+        status, body = post(url + "api/AA/servo", {"channel": 0, "us": 1500})
+        assert status == 409 and "PIN_BUSY" in body["error"], body
+    finally:
+        status, out, err = stop(proc, signal.SIGTERM)
+    assert (status, out, err) == (0, "", "")
+
+
 def test_ctrl_c_exits_130():
     proc, url = start()
     snapshot_after(url, 0)

@@ -145,6 +145,22 @@ def test_live_board_with_sim(tmp_path):
     assert width > 1000 and height > 200
 
 
+def test_live_window_is_drawn_from_zero_in_ms(tmp_path):
+    # --from 0 --to 45ms live is the 45 ms after the commands: the axis
+    # runs 0..45 ms (it was microseconds since power-up, 372000-417000)
+    require_builds(["m32d"])
+    out = tmp_path / "servo.svg"
+    r = orfa("--sim", "m32d", "plot", "--do", "servo 3 1500", "--signals", "servo3",
+             "--from", "0", "--to", "45ms", "-o", out)
+    assert r.returncode == 0, r.stderr
+    texts = re.findall(r"<!-- (.*?) -->", out.read_text())
+    (label,) = [t for t in texts if t.startswith("time (")]
+    assert re.fullmatch(r"time \(ms\) from \d+\.\d\d ms after power-up, simulated,"
+                        r" 7\.373 MHz CPU clock", label), label
+    ticks = [int(t) for t in texts if t.isdigit()]
+    assert ticks[0] == 0 and ticks[-1] == 45 and ticks == sorted(ticks), ticks
+
+
 def test_live_board_through_its_control_socket(tmp_path):
     require_builds(["m128s"])
     sim = SimBoard("m128s", control=True, trace=False).start()

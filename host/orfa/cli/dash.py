@@ -113,7 +113,8 @@ def add_parsers(sub, common) -> None:
                     " direction, ADC volts, GPIO levels and directions, status, reset"
                     " cause and failsafe, read every --interval and pushed to the page,"
                     " with"
-                    " controls for servos, motors and GPIO lines. Prints the page's URL,"
+                    " controls for servos, motors, GPIO lines and the ADC. Prints the"
+                    " page's URL,"
                     " serves until Ctrl-C (exit 130) or SIGTERM (exit 0). Needs Flask"
                     " (pip install 'orfa[dash]'). docs/dashboard.md.",
         epilog="example: orfa dash --sim m32d --slave m128s:0x10; orfa dash --port"

@@ -27,6 +27,10 @@ _RANK = {"SERVO_SIGNAL": 0, "SERVO": 0, "MOTOR_PWM": 1, "MOTOR_DIR": 1, "SPI_SS"
          "SPI_MOSI": 2, "SPI_MISO": 2, "I2C_BUSY": 3, "TWI_SCL": 3, "TWI_SDA": 3, "UART_RX": 4,
          "UART_TX": 4}
 _HIDDEN = {"SERVO_CLK", "SERVO_RST"}   # the M128-S's counter lines: its servoN rows show the pulses
+#: Lines whose pulses come when there is something to send (a transaction,
+#: a byte): their rows give widths and a count, no period or duty.
+_NOT_PERIODIC = {"I2C_BUSY", "TWI_SCL", "TWI_SDA", "UART_RX", "UART_TX", "SPI_SS", "SPI_SCK",
+                 "SPI_MOSI", "SPI_MISO"}
 
 
 def parse_time(text: str) -> float:
@@ -92,6 +96,12 @@ class Namer:
         m = self.maps.get(prefix)
         pins = m.pins_of("SERVO", index) if m else ()
         return pins[0].signal if pins else None
+
+    def periodic(self, name: str) -> bool:
+        """Whether a period and a duty mean something on this line (a servo,
+        a PWM output, a pin nobody named: yes; a bus or a serial line: no)."""
+        uses = [f for f, _ in self.functions(name)]
+        return not uses or not all(f in _NOT_PERIODIC for f in uses)
 
     def rank(self, name: str) -> Optional[int]:
         """Where a changing signal goes among the default rows (None: not shown
@@ -292,16 +302,30 @@ def _idle_servo(namer: Namer, name: str, wave: waves.Wave, f_cpu: int) -> bool:
     return all(end - begin < _cycles(SERVO_SHOWN_US, f_cpu) for begin, end in waves.pulses(wave, 1))
 
 
-def _trim(found: Dict[str, waves.Wave], chosen: Sequence[str]) -> Dict[str, waves.Wave]:
-    """Without --from/--to: the window from a little before the rows' first
-    edge to a little after their last (a bus transfer in a long recording)."""
-    times = [c for n in chosen for c, _ in found[n].edges]
+#: The least margin around the activity when a window is trimmed to it.
+TRIM_PAD_US = 50
+
+
+def _activity(found: Dict[str, waves.Wave], names: Sequence[str], f_cpu: int
+              ) -> Optional[Tuple[int, int]]:
+    """The window around the activity of `names`: from a little before the
+    first pulse of a row to a little after the last one. A lone edge (a pin
+    the firmware sets at power-up, seconds before the servo moves) counts
+    only when no row pulses. None: nothing moved."""
+    # a row's pulses at its polarity: a UART line's bytes, not the long
+    # "high pulse" from its power-up rise to the first byte
+    times = [c for n in names for pulse in waves.pulses(found[n]) for c in pulse]
     if not times:
-        return found
-    w0 = found[chosen[0]]
-    pad = max((max(times) - min(times)) // 20, (w0.end - w0.start) // 200, 1)
-    start, end = max(w0.start, min(times) - pad), min(w0.end, max(times) + pad + 1)
-    return {n: waves.clip(found[n], start, end) for n in chosen}
+        times = [c for n in names for c, _ in found[n].edges]
+    if not times:
+        return None
+    w0 = found[names[0]]
+    pad = max((max(times) - min(times)) // 20, _cycles(TRIM_PAD_US, f_cpu))
+    return max(w0.start, min(times) - pad), min(w0.end, max(times) + pad + 1)
+
+
+def _clip_all(found: Dict[str, waves.Wave], window: Tuple[int, int]) -> Dict[str, waves.Wave]:
+    return {n: waves.clip(w, *window) for n, w in found.items()}
 
 
 def cmd_plot(args) -> int:
@@ -320,14 +344,23 @@ def cmd_plot(args) -> int:
     else:
         found, names, namer, f_cpu, source = _from_file(args)
     patterns = [p for item in (args.signals or ()) for p in item.split(",") if p]
-    changing = [n for n in names if found[n].edges and not _idle_servo(namer, n, found[n], f_cpu)]
-    chosen, more = select(namer, names, changing, patterns)
+
+    def changing():
+        return [n for n in names
+                if found[n].edges and not _idle_servo(namer, n, found[n], f_cpu)]
+    chosen, more = select(namer, names, changing(), patterns)
+    if chosen and args.start is None and args.stop is None:
+        # no window asked for: the one where the rows' activity is, and
+        # the default rows those that change in it
+        window = _activity(found, chosen, f_cpu)
+        if window is not None:
+            found = _clip_all(found, window)
+            if not patterns:
+                chosen, more = select(namer, names, changing(), patterns)
     if not chosen:
         # nothing moved: the servo rows, flat, rather than an empty picture
         chosen = [n for n in names if namer.rank(n) == 0][:4] or names[:4]
-    if args.start is None and args.stop is None:
-        found = _trim(found, chosen)
-    rows = [drawing.Row(found[n], namer.label(n)) for n in chosen]
+    rows = [drawing.Row(found[n], namer.label(n), namer.periodic(n)) for n in chosen]
     try:
         notes = drawing.render(rows, f_cpu, args.output, title=source)
     except drawing.PlotUnavailable as exc:
@@ -347,8 +380,9 @@ def add_parsers(sub, common) -> None:
         "plot", parents=[common],
         help="draw waveforms from a VCD or a live simulated board",
         description="Draw servo pulses, motor PWM, chip selects and bus activity as a PNG"
-                    " (matplotlib), the time axis in microseconds and the measured widths"
-                    " written on it. From a VCD file (orfa sim --vcd FILE), or live: --sim"
+                    " (matplotlib), the time axis counted from the window's start"
+                    " (without --from/--to: trimmed to where the rows change) and the"
+                    " measured widths written on it. From a VCD file (orfa sim --vcd FILE), or live: --sim"
                     " BOARD starts a board, runs the --do commands and records --for of"
                     " simulated time; --control PATH does the same on a running"
                     " `orfa sim --control PATH`. Prints one line per row: what it measured.",

@@ -5,6 +5,7 @@ and the controls (web requests on their own threads) take turns on the line.
     dash = Dashboard(gateway, interval=0.2).start()
     queue = dash.subscribe()          # every new snapshot, latest first
     dash.control("AA", "servo", {"channel": 3, "us": 1700})
+    dash.control("AA", "adc", {"channels": [0, 1], "reference": "avcc", "bits": 10})
     dash.close()
 """
 
@@ -18,6 +19,7 @@ from typing import Callable, Dict, List, Optional, Sequence
 
 from .. import protocol as p
 from ..board import Board
+from ..clients.adc import CHANNELS as ADC_CHANNELS, REFERENCES as ADC_REFERENCES
 from ..errors import explain
 from ..gateway import Gateway
 from . import snapshot
@@ -194,7 +196,7 @@ class Dashboard:
 
     # --- the controls -------------------------------------------------------------
     def control(self, key: str, kind: str, body: object) -> Dict[str, object]:
-        """Run a control ("servo", "motor", "gpio") with its JSON body on the
+        """Run a control ("servo", "motor", "gpio", "adc") with its JSON body on the
         board at `key`; what was set. NotFound, ControlError (bad
         request), Refused or an OrfaError (the board's answer)."""
         board = self.board(key)
@@ -242,10 +244,21 @@ def _number(body: Dict, name: str, lo: float, hi: float, what: str, integer: boo
     return int(value) if integer else float(value)
 
 
+#: The most characters of a wrong value that an error message quotes.
+SHOW_MAX = 40
+
+
 def _show(value) -> str:
+    """A value as JSON would show it, cut to SHOW_MAX characters (a 100 kB
+    string or a list nested 900 deep is named, not echoed)."""
     if isinstance(value, float) and value.is_integer():
         value = int(value)
-    return "null" if value is None else repr(value) if isinstance(value, str) else str(value)
+    try:
+        text = "null" if value is None else repr(value) if isinstance(value, str) \
+            else str(value)
+    except RecursionError:
+        text = type(value).__name__
+    return text if len(text) <= SHOW_MAX else text[:SHOW_MAX - 3] + "..."
 
 
 def _check_keys(body: Dict, allowed, what: str) -> None:
@@ -326,6 +339,40 @@ def set_gpio(board: Board, info: Dict, body: Dict) -> Dict[str, object]:
     return done
 
 
+def set_adc(board: Board, info: Dict, body: Dict) -> Dict[str, object]:
+    """{"channels": [0, 3], "reference": "avcc"|"internal"|"aref", "bits": 10|8}:
+    the channels to convert (the others off; [] all off), the reference
+    (default avcc) and the resolution (default 10); read back, a channel
+    the board did not turn on (its pin busy) is Refused."""
+    _check_keys(body, ("channels", "reference", "bits"), "adc")
+    if "channels" not in body:
+        raise ControlError("adc: channels is missing (a list of 0..%d, [] for none)"
+                           % (ADC_CHANNELS - 1))
+    channels = body["channels"]
+    if not isinstance(channels, list):
+        raise ControlError("adc: channels must be a list of 0..%d, not %s"
+                           % (ADC_CHANNELS - 1, _show(channels)))
+    wanted = sorted({_number({"channel": ch}, "channel", 0, ADC_CHANNELS - 1, "adc")
+                     for ch in channels})
+    reference = body.get("reference", "avcc")
+    if reference not in ADC_REFERENCES:
+        raise ControlError("adc: reference %s: one of %s"
+                           % (_show(reference), ", ".join(ADC_REFERENCES)))
+    bits = body.get("bits", 10)
+    if isinstance(bits, bool) or bits not in (8, 10):
+        raise ControlError("adc: bits must be 8 or 10, not %s" % _show(bits))
+    adc = board.adc
+    adc.configure(wanted, reference, int(bits))
+    got_ref, got_bits, got = adc.config()
+    if list(got) != wanted:
+        port = info.get("adc_port", "")
+        missing = ["P%s%d" % (port, ch) for ch in wanted if ch not in got]
+        raise Refused("adc: %s did not turn on: another function holds %s"
+                      % (", ".join(missing) or "the channels asked",
+                         "it" if len(missing) == 1 else "them"))
+    return {"adc": wanted, "reference": got_ref, "bits": got_bits}
+
+
 CONTROLS: Dict[str, Callable[[Board, Dict, Dict], Dict[str, object]]] = {
-    "servo": set_servo, "motor": set_motor, "gpio": set_gpio,
+    "servo": set_servo, "motor": set_motor, "gpio": set_gpio, "adc": set_adc,
 }

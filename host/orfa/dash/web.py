@@ -6,6 +6,7 @@
     POST /api/<addr>/servo {"channel": 3, "us": 1700} or {"channel": 3, "angle": 30}
     POST /api/<addr>/motor {"motor": 1, "duty": -128}
     POST /api/<addr>/gpio  {"port": "B", "bit": 2, "level": 1, "output": true}
+    POST /api/<addr>/adc   {"channels": [0, 1], "reference": "avcc", "bits": 10}
 
 A control answers 200 with what it set, or {"error": "..."} with 400 (a bad
 request), 404 (no such board), 409 (the board refused or a line is held)
@@ -25,6 +26,7 @@ from flask import Flask, Response, jsonify, request
 from werkzeug.serving import make_server, select_address_family
 
 from .. import protocol as p
+from ..errors import SerialError
 from .live import ControlError, Dashboard, NotFound, Refused, explain
 
 #: Seconds between SSE comments while no snapshot comes (a stream to a
@@ -79,7 +81,10 @@ def create_app(dash: Dashboard) -> Flask:
 
     @app.post("/api/<addr>/<kind>")
     def control(addr: str, kind: str):
-        body = request.get_json(silent=True)
+        try:
+            body = request.get_json(silent=True)
+        except RecursionError:             # nested deeper than the parser goes
+            return _error("%s: the body is nested too deep to be a control" % kind, 400)
         if body is None:
             return _error("%s: the body must be JSON (Content-Type: application/json)"
                           % kind, 400)
@@ -93,7 +98,8 @@ def create_app(dash: Dashboard) -> Flask:
             return _error("%s: %s" % (kind, exc), 400)
         except Refused as exc:
             return _error(str(exc), 409)
-        except (p.ReplyTimeout, OSError) as exc:
+        except (p.ReplyTimeout, SerialError, OSError) as exc:
+            # before OrfaError: SerialError is one, but no board refused anything
             return _error("the serial line: %s" % explain(exc), 503)
         except p.OrfaError as exc:
             return _error(explain(exc), 409)

@@ -56,6 +56,10 @@ function post(addr, kind, body) {
 function describeDone(d) {
   if ("servo" in d) { return "channel " + d.servo + " set to " + d.us + " us"; }
   if ("motor" in d) { return "motor " + d.motor + " set to duty " + d.duty; }
+  if ("adc" in d) {
+    return (d.adc.length ? "channels " + d.adc.join(", ") + " on" : "every channel off") +
+      " (" + d.reference + ", " + d.bits + " bits)";
+  }
   var parts = ["P" + d.port + d.bit];
   if ("output" in d) { parts.push(d.output ? "output" : "input"); }
   if ("level" in d) { parts.push("level " + d.level); }
@@ -151,10 +155,30 @@ function buildAdc(b) {
       el("span", {cls: "us", id: id + "-" + ch, text: "-"})
     ]);
   });
+  // the configuration: which channels convert, the reference, the resolution
+  var boxes = range(b.adc.volts.length).map(function (ch) {
+    var box = el("input", {id: id + "-on-" + ch, type: "checkbox", value: ch});
+    box.checked = b.adc.enabled.indexOf(ch) >= 0;
+    return el("label", {cls: "check"}, [box, document.createTextNode(String(ch))]);
+  });
+  var ref = el("select", {id: id + "-ref"}, options(["avcc", "internal", "aref"],
+                                                     ["AVCC (5 V)", "internal (2.56 V)", "AREF pin"]));
+  ref.value = b.adc.reference;
+  var bits = el("select", {id: id + "-bits"}, options(["10", "8"], ["10 bits", "8 bits"]));
+  bits.value = String(b.adc.bits);
+  var set = el("button", {id: id + "-set", type: "button", text: "Set"});
+  set.addEventListener("click", function () {
+    var on = boxes.map(function (l) { return l.firstChild; })
+      .filter(function (box) { return box.checked; })
+      .map(function (box) { return Number(box.value); });
+    post(b.addr, "adc", {channels: on, reference: ref.value, bits: Number(bits.value)});
+  });
   return el("section", {cls: "part"}, [
     el("h3", {}, [document.createTextNode("ADC "),
                   el("span", {cls: "dim", id: id + "-config", text: ""})]),
-    el("div", {cls: "adcs"}, cells)
+    el("div", {cls: "adcs"}, cells),
+    el("div", {cls: "control"}, [el("label", {text: "channels"})].concat(boxes).concat(
+      [ref, bits, set]))
   ]);
 }
 
