@@ -81,8 +81,11 @@ static long now_ms(void);
 static int read_line(orfa_t *o, char *line, size_t *len, long deadline);
 
 /* Brings the line in step after the open (docs/c-library.md, "Opening"):
- * LF ends whatever partial line the board holds (someone typed `S AA 0` in
- * a terminal; a program left mid-line), then `V` and `L` (both only read).
+ * `!` LF ends whatever partial line the board holds (someone typed `S AA 0`
+ * in a terminal; a program left mid-line) as an error, so that nothing of it
+ * runs, even a request that lacked only its line end (`!` is no command
+ * letter, no hex digit, and nothing may follow a complete command); then `V`
+ * and `L` (both only read).
  * The board answers the ended line (or not: it was empty or a comment), then
  * V, then L, so the first L reply after a V reply is ours, whatever the
  * partial line was (a `V` or an `L` too) and whatever lines came before.
@@ -90,7 +93,7 @@ static int read_line(orfa_t *o, char *line, size_t *len, long deadline);
  * much the line carries. */
 static int resync(orfa_t *o)
 {
-	static const char sync[] = "\nV\nL\n";
+	static const char sync[] = "!\nV\nL\n";
 	long deadline = now_ms() + ORFA_TIMEOUT_MS;
 	orfa_req_t v, l;
 	orfa_reply_t results[ORFA_FRAMES_MAX];

@@ -120,6 +120,23 @@ def test_partial_line_left_in_the_board(get_drivers, held):
         assert b.gw.version() == "1.1"
 
 
+def test_a_held_request_without_its_line_end_does_not_run(get_drivers):
+    """A whole request lacking only its line end (`S A0 10 77 P`, an EEPROM
+    write) is ended by the open as an error: nothing of it runs."""
+    import time
+    require_builds(["m32d"])
+    with running(SimBoard("m32d", eeproms=(0xA0,))) as b:
+        fd = os.open(b.sim.port, os.O_RDWR | os.O_NOCTTY)
+        try:
+            os.write(fd, b"S A0 10 77 P")
+            time.sleep(0.3)             # into the board before the port is closed
+        finally:
+            os.close(fd)
+        r = get_drivers(b.sim.port)
+        assert (r.returncode, r.stderr) == (0, "")
+        assert b.ask("S A0 10 S A1 01 P") == b"SWASRFFP\r\n"
+
+
 def test_error_reply(get_drivers):
     """No device at 0x42: the gateway's ERROR 06, one line, exit 1."""
     require_builds(["m32d"])
@@ -226,13 +243,14 @@ def test_many_drivers(get_drivers, ndrivers):
     # the count, then the records ten at a time from driver 1: never a read
     # of 0 bytes (ERROR 04), ten records in exactly the 127-character reply
     full, rest = divmod(ndrivers, 10)
-    # the open's V and L (the LF before them is an empty line: no reply)
-    want = ["V", "L", "SAA0000SAB01P"]
+    # the open's `!` (an error line on purpose: it ends a partial line), V, L
+    want = ["!", "V", "L", "SAA0000SAB01P"]
     want += ["SAA00%02XSAB3CP" % (10 * i + 1) for i in range(full)]
     if rest:
         want.append("SAA00%02XSAB%02XP" % (10 * full + 1, 6 * rest))
     assert fake.requests == want
-    assert all(not reply.startswith(b"ERROR") for reply in fake.replies)
+    assert fake.replies[0] == b"ERROR 02\r\n"
+    assert all(not reply.startswith(b"ERROR") for reply in fake.replies[1:])
     for req, reply in zip(want[3:], fake.replies[3:]):
         if req.endswith("3CP"):
             assert len(reply) == 127 + 2, reply

@@ -288,7 +288,7 @@ static void test_open_ends_partial_line(void)
 			_exit(orfa_open(&o, slave_path, 115200) == ORFA_E_TIMEOUT ? 0 : 1);
 		}
 		sent(buf, sizeof(buf), 3);
-		CHECK(strcmp(buf, "\nV\nL\n") == 0, "the open sent '%s'", buf);
+		CHECK(strcmp(buf, "!\nV\nL\n") == 0, "the open sent '%s'", buf);
 		waitpid(pid, &status, 0);
 		CHECK(status == 0, "unanswered, the open timed out: status %d", status);
 		close(fd);
