@@ -86,13 +86,17 @@ def cmd_sim(args) -> int:
         raise UsageError(str(exc)) from None
     link = None
     signal.signal(signal.SIGTERM, _raise_interrupt)
+    # for a program, the bare paths (`port=$(orfa sim | head -1)`); with
+    # --terminal a person reads them, so each says what it is
+    port_label, control_label = (("serial port:    ", "control socket: ") if args.terminal
+                                 else ("", ""))
     try:
-        print(board.port, flush=True)
+        print(port_label + board.port, flush=True)
         if args.control is not None:
             link = args.control or None
             if link:
                 _link(board.control_path, link)
-            print(link or board.control_path, flush=True)
+            print(control_label + (link or board.control_path), flush=True)
         if args.terminal:
             with board.gateway(args.baud, autobaud=args.autobaud) as gw:
                 return run_console(gw)
@@ -115,7 +119,8 @@ def add_parsers(sub, common) -> None:
                     " its serial port on the first line (with --control, the control"
                     " socket's on the second). Runs until Ctrl-C or SIGTERM (exit 0),"
                     " or with --terminal for a console on the board until the end of"
-                    " its input. Bus addresses are the protocol's 8-bit form."
+                    " its input (then the lines say what they are: `serial port:"
+                    " PATH`). Bus addresses are the protocol's 8-bit form."
                     " docs/simulator.md describes the devices and the control socket.",
         epilog="example: orfa sim --board m32d --eeprom 0xA0 --slave m128s:0x10 --terminal")
     cmd.add_argument("--board", choices=BOARDS, default="m32d",
