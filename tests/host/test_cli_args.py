@@ -203,6 +203,7 @@ def one_usage_error(status, out, err, option):
     (["adc", "--vref", "0"], "--vref"),
     (["adc", "--watch", "inf"], "--watch"),
     (["adc", "--watch", "nan"], "--watch"),
+    (["adc", "--watch", "-1"], "--watch"),
     (["sim", "--baud", "99999999999999999999", "--terminal"] + NO_FIRMWARE, "--baud"),
     (["sim", "--baud", "0", "--terminal"] + NO_FIRMWARE, "--baud"),
 ])
@@ -214,8 +215,8 @@ def test_numbers_that_overflow_or_mean_nothing_are_usage_errors(argv, option, ca
 
 def test_sane_numbers_are_taken():
     args = cli.build_parser().parse_args(["--timeout", "0.25", "--baud", "9600", "adc",
-                                          "--vref", "2.5", "--watch", "1"])
-    assert (args.timeout, args.baud, args.vref, args.watch) == (0.25, 9600, 2.5, 1.0)
+                                          "--vref", "2.5", "--watch", "0"])
+    assert (args.timeout, args.baud, args.vref, args.watch) == (0.25, 9600, 2.5, 0.0)
 
 
 @pytest.mark.parametrize("argv, option", [

@@ -46,7 +46,7 @@ def byte(text: str) -> int:
 #: The serial rates --baud takes: Linux's named rates go up to 4000000, and
 #: the gateway runs 2400..115200 fixed, up to 460800 with BAUD=auto.
 MIN_BAUD, MAX_BAUD = 50, 4000000
-#: The longest --timeout (and adc --watch): a reply comes within milliseconds or not at all,
+#: The longest --timeout (and adc --watch interval): a reply comes within milliseconds or not at all,
 #: and an hour is far beyond any board's.
 MAX_TIMEOUT_S = 3600.0
 
@@ -73,12 +73,22 @@ def _finite(text: str) -> Optional[float]:
 
 
 def seconds(text: str) -> float:
-    """--timeout, --watch: seconds, above 0 and at most MAX_TIMEOUT_S (not
-    nan, not inf: they would hang or overflow the OS's wait)."""
+    """--timeout: seconds, above 0 and at most MAX_TIMEOUT_S (not nan, not
+    inf: they would hang or overflow the OS's wait)."""
     value = _finite(text)
     if value is None or not 0 < value <= MAX_TIMEOUT_S:
         raise argparse.ArgumentTypeError(
             "%r: seconds above 0, at most %g (0.5, 2)" % (text, MAX_TIMEOUT_S))
+    return value
+
+
+def interval(text: str) -> float:
+    """adc --watch: seconds between reads, 0 (as fast as the line goes) up
+    to MAX_TIMEOUT_S."""
+    value = _finite(text)
+    if value is None or not 0 <= value <= MAX_TIMEOUT_S:
+        raise argparse.ArgumentTypeError(
+            "%r: seconds, 0 to %g (0.5)" % (text, MAX_TIMEOUT_S))
     return value
 
 
