@@ -250,8 +250,8 @@ soak: setup
 	python3 tools/soak.py --requests $(SOAK_REQUESTS) --seed $(SOAK_SEED)
 
 demo: setup
-	@$(MAKE) --no-print-directory BOARD=m32d MODE=gate firmware sim
-	PYTHONPATH=host python3 -m orfa sim --board m32d --eeprom 0xA0 --terminal
+	@$(MAKE) -s --no-print-directory BOARD=m32d MODE=gate firmware sim
+	@PYTHONPATH=host exec python3 -m orfa sim --board m32d --eeprom 0xA0 --terminal
 
 # A robot: the M32-D gateway, an M128-S slave at 0x10, an M32-D slave at 0x12
 # and the EEPROM at A0, all on one simulated I2C bus.

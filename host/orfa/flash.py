@@ -22,10 +22,13 @@ from typing import List, Optional, Sequence
 
 from . import boardmap, ihex
 from .protocol import OrfaError
-from .locate import firmware_path
+from .locate import firmware_dirs, firmware_path
 
 PROGRAMMER = "usbasp"
 MODES = ("gate", "slave")
+#: The bus address of the packaged slave builds, build/<board>-slave/ (the
+#: Makefile's ADDR default; `pip install .` ships these).
+SLAVE_ADDR = 0x10
 #: Exit status when avrdude, the firmware or the board is missing.
 EXIT_SETUP = 2
 #: Exit status when avrdude ran and failed.
@@ -72,10 +75,49 @@ def build_hex(board: str, mode: str) -> Path:
     return firmware_path(board, mode).with_suffix(".hex")
 
 
-def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str) -> Path:
+def built_address(elf: Path) -> int:
+    """The bus address a slave build answers on: the ORFA_ADDR of make's
+    `flags` file next to the ELF, SLAVE_ADDR where there is none (the
+    installed package's copies, built with make's default)."""
+    try:
+        words = (elf.parent / "flags").read_text().split()
+    except OSError:
+        return SLAVE_ADDR
+    for word in words:
+        if word.startswith("-DORFA_ADDR="):
+            try:
+                return int(word.split("=", 1)[1], 0)
+            except ValueError:
+                break
+    return SLAVE_ADDR
+
+
+def slave_elf(board: str, addr: int) -> Path:
+    """The slave build of `board` that answers on `addr`: <board>-slave/
+    (what `make flash MODE=slave` writes) when it was built for that
+    address, else the test robot's robot/<board>-0x<ADDR>/ (`make robot`);
+    a FlashError says how to build one."""
+    if addr & 1 or not 0x10 <= addr <= 0xEE:
+        raise FlashError("--addr 0x%02X: a slave's 8-bit bus address is even, 0x10..0xEE"
+                         % addr)
+    for d in firmware_dirs():
+        packaged = d / ("%s-slave" % board) / "orfa.elf"
+        if packaged.is_file() and built_address(packaged) == addr:
+            return packaged
+        robot = d / "robot" / ("%s-0x%02X" % (board, addr)) / "orfa.elf"
+        if robot.is_file():
+            return robot
+    raise FlashError("no %s slave build at 0x%02X (the packaged one answers on 0x%02X):"
+                     " build it with `make BOARD=%s MODE=slave ADDR=0x%02X`, or give --hex FILE"
+                     % (board, addr, SLAVE_ADDR, board, addr))
+
+
+def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str,
+                 addr: Optional[int] = None) -> Path:
     """The Intel HEX to write: `given` (an ELF is converted), else the build's
     .hex if it is as new as its ELF, else that ELF converted (a .hex older
-    than its ELF, or none: an ELF given by ORFA_FIRMWARE alone). Conversions go to `tmpdir`."""
+    than its ELF, or none: an ELF given by ORFA_FIRMWARE alone). Conversions go to `tmpdir`.
+    With `addr` (slave mode): the slave build that answers on it (slave_elf)."""
     if given:
         path = Path(given)
         try:
@@ -88,16 +130,20 @@ def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str) -> Pa
         if head[:1] != b":":
             raise FlashError("%s is neither Intel HEX nor an ELF file" % given)
         return path
-    elf = firmware_path(board, mode)
-    hex_path = build_hex(board, mode)
+    if addr is not None:
+        elf = slave_elf(board, addr)
+        hex_path = elf.with_suffix(".hex")
+    else:
+        elf = firmware_path(board, mode)
+        hex_path = build_hex(board, mode)
     if hex_path.is_file() and (not elf.is_file()
                                or hex_path.stat().st_mtime >= elf.stat().st_mtime):
         return _near(hex_path)
     if elf.is_file():
         return _converted(elf, tmpdir, board_map(board))
-    addr = " ADDR=0x10" if mode == "slave" else ""
+    addr_var = " ADDR=0x%02X" % SLAVE_ADDR if mode == "slave" else ""
     raise FlashError("no firmware for %s %s: build it with `make BOARD=%s MODE=%s%s`,"
-                     " or give --hex FILE" % (board, mode, board, mode, addr))
+                     " or give --hex FILE" % (board, mode, board, mode, addr_var))
 
 
 def _near(path: Path) -> Path:
@@ -149,12 +195,19 @@ def run(argv: List[str]) -> int:
 
 def cmd_flash(args) -> int:
     kw = dict(programmer=args.programmer, port=args.port, avrdude=args.avrdude)
+    if args.addr is not None:
+        clash = ("--mode gate" if args.mode != "slave" else "--hex" if args.hex
+                 else "--fuses" if args.fuses else None)
+        if clash:
+            print("orfa: --addr picks the slave build that answers on it: it goes with"
+                  " --mode slave, not %s" % clash, file=sys.stderr)
+            return EXIT_SETUP
     try:
         with tempfile.TemporaryDirectory(prefix="orfa-flash-") as tmpdir:
             if args.fuses:
                 argv = fuses_argv(args.board, **kw)
             else:
-                hex_path = firmware_hex(args.board, args.mode, args.hex, tmpdir)
+                hex_path = firmware_hex(args.board, args.mode, args.hex, tmpdir, args.addr)
                 argv = flash_argv(args.board, str(hex_path), **kw)
             if args.dry_run:
                 print(shlex.join(argv))
@@ -169,6 +222,14 @@ def cmd_flash(args) -> int:
     return 0
 
 
+def _number(text: str) -> int:
+    try:
+        return int(text, 0)
+    except ValueError:
+        import argparse
+        raise argparse.ArgumentTypeError("%r is not a number (0x10)" % text) from None
+
+
 def add_parser(subparsers) -> None:
     """Register `flash` on an argparse subparsers object."""
     p = subparsers.add_parser(
@@ -178,8 +239,14 @@ def add_parser(subparsers) -> None:
                     " writes the board's fuses instead, as `make fuses`.")
     p.add_argument("--board", choices=boardmap.BOARDS, default="m32d")
     p.add_argument("--mode", choices=MODES, default="gate",
-                   help="which build (default %(default)s); a slave's bus address"
-                        " is the one it was built with")
+                   help="which build (default %%(default)s); a slave's bus address"
+                        " is the one it was built with: 0x%02X for the packaged"
+                        " build/<board>-slave (make's ADDR default)" % SLAVE_ADDR)
+    p.add_argument("--addr", type=_number, metavar="ADDR",
+                   help="with --mode slave: the 8-bit bus address the slave is to answer"
+                        " on (default: the packaged build's, 0x%02X); another address"
+                        " takes the test robot's build robot/<board>-<ADDR> (make robot)"
+                        " or says how to build one" % SLAVE_ADDR)
     what = p.add_mutually_exclusive_group()
     what.add_argument("--hex", metavar="FILE",
                       help="the Intel HEX (or ELF, converted to a temporary .hex)"

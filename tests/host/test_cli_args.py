@@ -169,3 +169,119 @@ def test_flash_plugs_in_when_orfa_flash_is_there(monkeypatch, capsys):
     flash.add_parser = add_parser
     monkeypatch.setitem(sys.modules, "orfa.flash", flash)
     assert run(["flash"], capsys) == (0, "flashing\n", "")
+
+
+# --- issue 16: numbers that overflow, hang or mean nothing ----------------------
+
+#: a simulator that cannot start: on a build that took the bad number, `sim`
+#: ends there (never runs on, never waits on a line)
+NO_FIRMWARE = ["--firmware", "/nonexistent/orfa.elf"]
+
+
+def one_usage_error(status, out, err, option):
+    """Exit 2, nothing on stdout, one error line naming the option (argparse's
+    usage synopsis before it), no traceback."""
+    errors = [line for line in err.splitlines() if "error:" in line]
+    assert status == 2 and out == "", err
+    assert len(errors) == 1 and "argument %s:" % option in errors[0], err
+    assert "Traceback" not in err and err.splitlines()[-1] == errors[0], err
+
+
+@pytest.mark.parametrize("argv, option", [
+    (["--timeout", "inf", "version"], "--timeout"),
+    (["--timeout", "1e20", "version"], "--timeout"),
+    (["--timeout", "nan", "version"], "--timeout"),
+    (["--timeout", "0", "version"], "--timeout"),
+    (["--timeout", "-1", "version"], "--timeout"),
+    (["version", "--timeout", "inf"], "--timeout"),
+    (["--baud", "99999999999999999999", "version"], "--baud"),
+    (["--baud", "0", "version"], "--baud"),
+    (["scan", "--baud", "0"], "--baud"),
+    (["adc", "--vref", "nan"], "--vref"),
+    (["adc", "--vref", "-1"], "--vref"),
+    (["adc", "--vref", "inf"], "--vref"),
+    (["adc", "--vref", "0"], "--vref"),
+    (["adc", "--watch", "inf"], "--watch"),
+    (["adc", "--watch", "nan"], "--watch"),
+    (["adc", "--watch", "-1"], "--watch"),
+    (["sim", "--baud", "99999999999999999999", "--terminal"] + NO_FIRMWARE, "--baud"),
+    (["sim", "--baud", "0", "--terminal"] + NO_FIRMWARE, "--baud"),
+])
+def test_numbers_that_overflow_or_mean_nothing_are_usage_errors(argv, option, capsys,
+                                                                monkeypatch):
+    monkeypatch.delenv("ORFA_PORT", raising=False)
+    one_usage_error(*run(argv, capsys), option)
+
+
+def test_sane_numbers_are_taken():
+    args = cli.build_parser().parse_args(["--timeout", "0.25", "--baud", "9600", "adc",
+                                          "--vref", "2.5", "--watch", "0"])
+    assert (args.timeout, args.baud, args.vref, args.watch) == (0.25, 9600, 2.5, 0.0)
+
+
+@pytest.mark.parametrize("argv, option", [
+    (["--sim", "m32d", "--eeprom", "0xA1", "version"], "--eeprom"),
+    (["--sim", "m32d", "--eeprom", "0xAA", "version"], "--eeprom"),
+    (["--sim", "m32d", "--slave", "m128s:0xAA", "version"], "--slave"),
+    (["sim", "--eeprom", "0xA1"] + NO_FIRMWARE, "--eeprom"),
+    (["sim", "--eeprom", "0xAA"] + NO_FIRMWARE, "--eeprom"),
+    (["sim", "--eeprom", "0x02"] + NO_FIRMWARE, "--eeprom"),
+])
+def test_eeprom_addresses_are_checked_as_slave_addresses_are(argv, option, capsys):
+    """An odd address, a reserved one, or the gateway's own 0xAA: one line
+    from the command line, not the simulator's three (its command line)."""
+    status, out, err = run(argv, capsys)
+    one_usage_error(status, out, err, option)
+    assert "command:" not in err
+    if "0xAA" in argv[-1] or "0xAA" in " ".join(argv):
+        assert "the gateway's own address" in err
+
+
+def test_two_devices_at_one_address_is_one_line(capsys):
+    assert run(["--sim", "m32d", "--eeprom", "0xA0", "--slave", "m128s:0xA0", "version"],
+               capsys) == (2, "", "orfa: --slave 0xA0: --eeprom put a device there already\n")
+
+
+def test_an_address_out_of_range_says_so(capsys):
+    """`orfa read 0x100 0` is not about evenness: 0x100 is no 8-bit address."""
+    status, out, err = run(["--port", "loop://", "read", "0x100", "0"], capsys)
+    assert (status, out, err) == (
+        2, "", "orfa: address 0x100: out of range: an 8-bit address is 0x00..0xFE\n")
+    with pytest.raises(UsageError, match="-2: out of range"):
+        address(Args(), -2)
+
+
+def test_an_explicit_sim_wins_over_the_environments_port(monkeypatch):
+    """ORFA_PORT is a default: `orfa --sim m32d ...` does not clash with it
+    (the board --sim starts is the one used), while an explicit --port does."""
+    from orfa.cli import common
+    used = []
+
+    class FakeSim:
+        def start(self):
+            return self
+
+        def gateway(self, *a, **kw):
+            used.append("sim")
+            return contextlib_nullcontext("sim gateway")
+
+        def stop(self):
+            pass
+
+    monkeypatch.setattr(common, "sim_board", lambda *a, **kw: FakeSim())
+    monkeypatch.setenv("ORFA_PORT", "/dev/ttyUSB9")
+    args = cli.build_parser().parse_args(["--sim", "m32d", "version"])
+    with common.connect(args) as gw:
+        assert gw == "sim gateway"
+    args = cli.build_parser().parse_args(["version", "--sim", "m32d"])
+    with common.connect(args) as gw:
+        assert gw == "sim gateway"
+    args = cli.build_parser().parse_args(["--port", "loop://", "version", "--sim", "m32d"])
+    with pytest.raises(UsageError, match="give --port or --sim, not both"):
+        with common.connect(args):
+            pass
+
+
+def contextlib_nullcontext(value):
+    import contextlib
+    return contextlib.nullcontext(value)

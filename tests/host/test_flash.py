@@ -366,3 +366,62 @@ def test_the_docs_command_lines_are_what_runs(doc, avrdude, built):
         assert r.returncode == 0, (words, r.stderr)
         assert avrdude.calls()[-1] == argv, words
     assert {"flash", "fuses"} <= targets
+
+
+# --- --addr: which slave build (issue 16) ---------------------------------------
+
+def _fake_build(root, rel, addr=None):
+    """An ELF and a newer .hex at root/rel (and make's flags file with ADDR)."""
+    d = root / rel
+    d.mkdir(parents=True)
+    (d / "orfa.elf").write_bytes(b"\x7fELF")
+    (d / "orfa.hex").write_text(":00000001FF\n")
+    if addr is not None:
+        (d / "flags").write_text("-mmcu=atmega128 -DORFA_ADDR=%s -DORFA_MODE_slave\n" % addr)
+    return d
+
+
+def test_orfa_flash_slave_addr_picks_the_build_that_answers_on_it(avrdude, tmp_path):
+    """`--mode slave --addr 0x10` is the packaged slave build (built at 0x10);
+    another address is the robot's build there, or how to build one."""
+    fw = tmp_path / "fw"
+    _fake_build(fw, "m128s-slave")                        # no flags: the package's copy
+    _fake_build(fw, "robot/m128s-0x14", "0x14")
+    env = dict(avrdude.env(), ORFA_FIRMWARE=str(fw))
+    r = orfa(avrdude, "--board", "m128s", "--mode", "slave", "--addr", "0x10", "--dry-run",
+             env=env)
+    assert (r.returncode, r.stderr) == (0, "")
+    assert r.stdout == ("avrdude -c usbasp -p m128 -U flash:w:%s:i\n"
+                        % (fw / "m128s-slave" / "orfa.hex"))
+    r = orfa(avrdude, "--board", "m128s", "--mode", "slave", "--addr", "0x14", "--dry-run",
+             env=env)
+    assert r.returncode == 0 and "robot/m128s-0x14/orfa.hex" in r.stdout, r.stderr
+    r = orfa(avrdude, "--board", "m128s", "--mode", "slave", "--addr", "0x12", env=env)
+    assert (r.returncode, r.stderr) == (
+        2, "orfa: no m128s slave build at 0x12 (the packaged one answers on 0x10): build it"
+           " with `make BOARD=m128s MODE=slave ADDR=0x12`, or give --hex FILE\n")
+    # a work tree's build/<board>-slave built at another ADDR says so in its flags
+    (fw / "m128s-slave" / "flags").write_text("-DORFA_ADDR=0x12 -DORFA_MODE_slave\n")
+    r = orfa(avrdude, "--board", "m128s", "--mode", "slave", "--addr", "0x12", "--dry-run",
+             env=env)
+    assert r.returncode == 0 and "m128s-slave/orfa.hex" in r.stdout, r.stderr
+    assert avrdude.calls() == []
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--addr", "0x10"], "it goes with --mode slave, not --mode gate"),
+    (["--mode", "slave", "--addr", "0x10", "--fuses"], "not --fuses"),
+    (["--mode", "slave", "--addr", "0x11"], "--addr 0x11: a slave's 8-bit bus address is even"),
+    (["--mode", "slave", "--addr", "0x100"], "--addr 0x100: a slave's 8-bit bus address"),
+])
+def test_orfa_flash_bad_addr_is_one_line(args, message, avrdude):
+    r = orfa(avrdude, "--board", "m128s", "--dry-run", *args)
+    assert r.returncode == 2 and r.stdout == "" and r.stderr.count("\n") == 1, r.stderr
+    assert message in r.stderr
+
+
+def test_orfa_flash_help_says_the_packaged_slave_builds_address(avrdude):
+    r = orfa(avrdude, "--help")
+    text = " ".join(r.stdout.split())
+    assert "0x10 for the packaged build/<board>-slave" in text
+    assert "--addr ADDR with --mode slave" in text

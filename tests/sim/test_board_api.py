@@ -267,6 +267,28 @@ def test_pin_busy(t):
     assert b.motor.get(1) == -100
 
 
+@pytest.mark.parametrize("t", ["m32d", "m32d@12"], indirect=True)
+def test_pin_busy_names_the_busy_line(t):
+    """Motor.set writes from PWM1 (both motors in one write), so the board's
+    refusal names PWM1 whichever line is busy: the error names the motor
+    whose line a servo holds (servo 15 holds motor 2's PWM2, PD4)."""
+    b = t.board
+    b.servo.set_width(15, 1500)
+    try:
+        with pytest.raises(PinBusyError) as e:
+            b.motor.set(2, 100)
+        assert e.value.register == "motor PWM2", str(e.value)
+        assert "PWM1" not in str(e.value)
+        assert b.status() is Status.PIN_BUSY        # nothing was read to find out
+        b.motor.set(1, 100)                         # PWM1 is free
+        with pytest.raises(PinBusyError) as e:
+            b.motor.set_all(0, 50)                  # only motor 2 needs its line
+        assert e.value.register == "motor PWM2", str(e.value)
+    finally:
+        b.servo.off(15)
+        b.motor.set_all(0, 0)
+
+
 # --- reset cause ----------------------------------------------------------------
 
 @pytest.mark.parametrize("t", ["m128s@10", "m32d@12"], indirect=True)

@@ -53,8 +53,9 @@ def test_terminal_through_a_pipe():
     assert result.returncode == 0, result.stderr
     lines = result.stdout.splitlines()
     assert lines[1:] == ["V1.1", "LAA", "SWP", "ERROR 06", "ERROR 02"]
-    assert lines[0].endswith("/tty")
-    assert not os.path.exists(lines[0])          # the simulator has stopped
+    label, port = lines[0].split(None, 2)[:2], lines[0].split()[-1]
+    assert label == ["serial", "port:"] and port.endswith("/tty")
+    assert not os.path.exists(port)              # the simulator has stopped
 
 
 def test_sim_runs_until_interrupted():

@@ -147,6 +147,10 @@ def test_console_from_a_pipe(orfa, monkeypatch):
     lines = ["V", comment, "S A0 40 41 P", "#" + "d" * 999, "S A0 40 S A1 01 P",
              "V" * 129, "", "   ", "l", "Q", "caf\u00e9"]
     monkeypatch.setattr("sys.stdin", io.StringIO("\n".join(lines) + "\n"))
-    assert orfa("console") == (0, "\n".join([
+    status, out, err = orfa("console")
+    assert (status, out) == (0, "\n".join([
         "V1.1", "SWAAP", "SWASR41P", "ERROR 04", "LAA", "ERROR 02",
-        "host: a request is ASCII text", ""]), "")
+        "host: a request is ASCII text", ""]))
+    # each ERROR explained, as `orfa request` explains it
+    assert [line.split(": ")[2] for line in err.splitlines()] == ["ERROR 04", "ERROR 02"]
+    assert err.startswith("orfa: %s: ERROR 04: " % ("V" * 129)), err

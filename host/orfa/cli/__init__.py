@@ -23,7 +23,8 @@ from .. import __version__
 from .. import protocol as p
 from ..sim import BOARDS
 from . import bus, console, dash, devices, plot, simulate
-from .common import ADDRESS_RULE, PORT_ENV, UsageError, add_sim_devices, env_port, explain, number
+from .common import (ADDRESS_RULE, MAX_TIMEOUT_S, PORT_ENV, UsageError, add_sim_devices,
+                     baud_rate, explain, number, seconds)
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -35,17 +36,18 @@ def _connection_options(parser, suppress: bool) -> None:
         return argparse.SUPPRESS if suppress else value
     group = parser.add_argument_group("the board")
     where = group.add_mutually_exclusive_group()
-    where.add_argument("--port", "-p", metavar="URL", default=default(env_port()),
+    where.add_argument("--port", "-p", metavar="URL", default=default(None),
                        help="serial port or pyserial URL (/dev/ttyUSB0, socket://host:port);"
                             " default $%s" % PORT_ENV)
     where.add_argument("--sim", choices=BOARDS, metavar="BOARD", default=default(None),
                        help="start a simulated board (%s) for this one command; --eeprom,"
                             " --slave, --adc, --spi (before the command) add devices"
                             % "|".join(BOARDS))
-    group.add_argument("--baud", type=int, default=default(p.DEFAULT_BAUD),
+    group.add_argument("--baud", type=baud_rate, default=default(p.DEFAULT_BAUD),
                        help="serial rate (default %d)" % p.DEFAULT_BAUD)
-    group.add_argument("--timeout", type=float, default=default(2.0), metavar="S",
-                       help="seconds to wait for a reply (default 2)")
+    group.add_argument("--timeout", type=seconds, default=default(2.0), metavar="S",
+                       help="seconds to wait for a reply, above 0, at most %g (default 2)"
+                            % MAX_TIMEOUT_S)
     group.add_argument("--addr", type=number,
                        default=default(None), metavar="A",
                        help="the board the driver commands talk to: a slave's bus"

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import os
 from typing import Iterator, List, Optional
 
@@ -42,13 +43,74 @@ def byte(text: str) -> int:
     return value
 
 
+#: The serial rates --baud takes: Linux's named rates go up to 4000000, and
+#: the gateway runs 2400..115200 fixed, up to 460800 with BAUD=auto.
+MIN_BAUD, MAX_BAUD = 50, 4000000
+#: The longest --timeout (and adc --watch interval): a reply comes within milliseconds or not at all,
+#: and an hour is far beyond any board's.
+MAX_TIMEOUT_S = 3600.0
+
+
+def baud_rate(text: str) -> int:
+    """--baud: a serial rate, MIN_BAUD..MAX_BAUD (0 or 10**20 are no rate)."""
+    try:
+        value = int(text, 10)
+    except ValueError:
+        value = None
+    if value is None or not MIN_BAUD <= value <= MAX_BAUD:
+        raise argparse.ArgumentTypeError(
+            "%r is not a serial rate: %d..%d baud (the gateway's default is %d)"
+            % (text, MIN_BAUD, MAX_BAUD, p.DEFAULT_BAUD))
+    return value
+
+
+def _finite(text: str) -> Optional[float]:
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return value if math.isfinite(value) else None
+
+
+def seconds(text: str) -> float:
+    """--timeout: seconds, above 0 and at most MAX_TIMEOUT_S (not nan, not
+    inf: they would hang or overflow the OS's wait)."""
+    value = _finite(text)
+    if value is None or not 0 < value <= MAX_TIMEOUT_S:
+        raise argparse.ArgumentTypeError(
+            "%r: seconds above 0, at most %g (0.5, 2)" % (text, MAX_TIMEOUT_S))
+    return value
+
+
+def interval(text: str) -> float:
+    """adc --watch: seconds between reads, 0 (as fast as the line goes) up
+    to MAX_TIMEOUT_S."""
+    value = _finite(text)
+    if value is None or not 0 <= value <= MAX_TIMEOUT_S:
+        raise argparse.ArgumentTypeError(
+            "%r: seconds, 0 to %g (0.5)" % (text, MAX_TIMEOUT_S))
+    return value
+
+
+def volts(text: str) -> float:
+    """--vref: a voltage above 0 (not nan, not inf)."""
+    value = _finite(text)
+    if value is None or value <= 0:
+        raise argparse.ArgumentTypeError("%r is not a reference voltage: volts above 0"
+                                         " (5, 2.56)" % text)
+    return value
+
+
 def address(args, value: int, what: str = "address") -> int:
     """A command-line address as the protocol's 8-bit form (see ADDRESS_RULE)."""
     if getattr(args, "seven_bit", False):
         if not 0 <= value <= 0x7F:
             raise UsageError("%s 0x%02X: a 7-bit address is 0x00..0x7F" % (what, value))
         return value << 1
-    if not 0 <= value <= 0xFF or value & 1:
+    if not 0 <= value <= 0xFF:
+        raise UsageError("%s %s: out of range: an 8-bit address is 0x00..0xFE"
+                         % (what, "0x%02X" % value if value >= 0 else value))
+    if value & 1:
         hint = " (the 7-bit 0x%02X is 0x%02X, or give --7bit)" % (value, value << 1) \
             if 0 <= value <= 0x7F else ""
         raise UsageError("%s 0x%02X: an 8-bit address is even, 0x00..0xFE%s"
@@ -74,15 +136,16 @@ def open_gateway(url: str, args) -> Gateway:
 
 def add_sim_devices(parser, suppress: bool = False) -> None:
     """The simulated board's devices: for `sim`, and for --sim."""
-    from .simulate import adc_spec, slave_spec
+    from .simulate import adc_spec, eeprom_spec, slave_spec
     default = argparse.SUPPRESS if suppress else None
-    parser.add_argument("--eeprom", type=number, action="append", default=default or [],
+    parser.add_argument("--eeprom", type=eeprom_spec, action="append", default=default or [],
                         metavar="ADDR",
-                        help="a 24C02-like EEPROM at the 8-bit bus address ADDR (0xA0),"
-                             " repeatable")
+                        help="a 24C02-like EEPROM at the 8-bit bus address ADDR (0xA0;"
+                             " even, 0x10..0xEE, not the gateway's 0xAA), repeatable")
     parser.add_argument("--slave", type=slave_spec, action="append", default=default or [],
                         metavar="BOARD:ADDR[:ELF]",
-                        help="a slave board on the bus at the 8-bit ADDR (repeatable); ELF"
+                        help="a slave board on the bus at the 8-bit ADDR (even, 0x10..0xEE,"
+                             " not the gateway's 0xAA; repeatable); ELF"
                              " defaults to build/robot/<board>-<ADDR>/orfa.elf (make robot)"
                              " if built, else build/<board>-slave/orfa.elf")
     parser.add_argument("--adc", type=adc_spec, action="append", default=default or [],
@@ -95,7 +158,15 @@ def add_sim_devices(parser, suppress: bool = False) -> None:
 
 
 def sim_board(board: str, args, **kw) -> SimBoard:
-    """A SimBoard with the devices of args (not started)."""
+    """A SimBoard with the devices of args (not started); two devices at
+    one address are a UsageError."""
+    seen = {}
+    for opt, addr in ([("--eeprom", a) for a in getattr(args, "eeprom", None) or ()]
+                      + [("--slave", s[1]) for s in getattr(args, "slave", None) or ()]):
+        if addr in seen:
+            raise UsageError("%s 0x%02X: %s put a device there already"
+                             % (opt, addr, seen[addr]))
+        seen[addr] = opt
     return SimBoard(board, eeproms=getattr(args, "eeprom", None) or (),
                     slaves=getattr(args, "slave", None) or (),
                     adc=dict(getattr(args, "adc", None) or ()),
@@ -105,7 +176,8 @@ def sim_board(board: str, args, **kw) -> SimBoard:
 @contextlib.contextmanager
 def connect(args) -> Iterator[Gateway]:
     """The Gateway of --port URL (or $ORFA_PORT), or of a board --sim starts
-    for this one command (stopped when the command ends)."""
+    for this one command (stopped when the command ends). An explicit --sim
+    wins over $ORFA_PORT; --port and --sim both given is a usage error."""
     devices = [opt for opt in ("eeprom", "slave", "adc", "spi") if getattr(args, opt, None)]
     if args.sim is None and devices:
         raise UsageError("--%s describes a simulated board: give --sim BOARD too" % devices[0])
@@ -123,9 +195,8 @@ def connect(args) -> Iterator[Gateway]:
         finally:
             sim.stop()
         return
-    if args.port:
-        url = args.port
-    else:
+    url = args.port or env_port()        # $ORFA_PORT only where no --sim is given
+    if not url:
         raise UsageError("no board: give --port URL (or set %s) or --sim BOARD (%s)"
                          % (PORT_ENV, "|".join(BOARDS)))
     with open_gateway(url, args) as gw:

@@ -3,23 +3,54 @@
 Each line goes to the board as it is and the board's reply is printed, so
 the console answers what the board answers: a line over 128 characters gets
 the board's `ERROR 04`, a comment line (`#` first) of any length is sent and
-gets no reply, an empty line is not sent. Only a line that is not ASCII is
-refused on the host (`host: ...`): the protocol is ASCII text.
+gets no reply, an empty line is not sent. A CR inside an input line ends a
+request, as it does on the board, so each request gets its own reply shown.
+An `ERROR` reply is explained on stderr as `orfa request` explains it.
+`help` and `?` are answered here (HELP), not sent. Only a line that is not
+ASCII is refused on the host (`host: ...`): the protocol is ASCII text.
 """
 
 from __future__ import annotations
 
 import os
+import re
 import sys
-from typing import Callable, Optional, TextIO
+from typing import Callable, List, Optional, TextIO
 
 from .. import protocol as p
-from .common import connect
+from .common import connect, explain
 
 HISTORY_ENV = "ORFA_HISTORY"
 HISTORY_FILE = "~/.orfa_history"
 HISTORY_LENGTH = 1000
 PROMPT = "orfa> "
+
+
+#: What `help` and `?` print (the board would answer them ERROR 02).
+HELP = """\
+Requests (docs/protocol.md), one a line; the board's reply is printed:
+  V                      protocol version: V1.1
+  L  /  L<addr>          the gateway's own bus address: LAA
+  C  /  C<kHz>           the I2C clock in kHz, 4 hex digits: C0063
+  X                      clear a stuck I2C bus
+  S <addr> <bytes> P     I2C write:  S A0 10 41 42 P      -> SWAAAP
+  S <addr> <reg> S <addr+1> <count> P
+                         I2C read:   S A0 10 S A1 02 P    -> SWASR4142P
+  # ...                  a comment: sent, no reply
+Bytes are hex; addresses are 8-bit (bit 0: 1 reads), the gateway's own is AA.
+An ERROR reply's meaning follows it (orfa: ...). Ctrl-D or Ctrl-C ends."""
+
+#: The lines the console answers itself.
+HELP_WORDS = ("help", "?")
+
+#: Where the board ends a request: LF or CR (CR LF: a request, then an empty line).
+_LINE_END = re.compile(r"\r\n|\r|\n")
+
+
+def requests_of(line: str) -> List[str]:
+    """The requests an input line holds: a CR inside it ends one, as on
+    the board (`V\rS 42 P` is two requests, each with its reply)."""
+    return _LINE_END.split(line)
 
 
 def expects_reply(line: str) -> bool:
@@ -47,9 +78,11 @@ def exchange(gw, line: str) -> Optional[str]:
 
 
 def terminal(gw, stdin: TextIO, stdout: TextIO,
-             read_line: Optional[Callable[[], Optional[str]]] = None) -> int:
+             read_line: Optional[Callable[[], Optional[str]]] = None,
+             stderr: Optional[TextIO] = None) -> int:
     """Each line of stdin (or of read_line(), None at the end) a request,
-    its reply printed."""
+    its reply printed (an ERROR's meaning on stderr)."""
+    stderr = stderr or sys.stderr
     if read_line is None:
         def read_line() -> Optional[str]:
             line = stdin.readline()
@@ -58,10 +91,22 @@ def terminal(gw, stdin: TextIO, stdout: TextIO,
         line = read_line()
         if line is None:
             return 0
-        reply = exchange(gw, line)
-        if reply is not None:
+        for request in requests_of(line):
+            if request.strip(" ").lower() in HELP_WORDS:
+                stdout.write(HELP + "\n")
+                stdout.flush()
+                continue
+            reply = exchange(gw, request)
+            if reply is None:
+                continue
             stdout.write(reply + "\n")
             stdout.flush()
+            if reply.startswith("ERROR"):
+                try:
+                    p.check_error(reply)
+                except p.OrfaError as exc:      # as `orfa request` explains it
+                    stderr.write("orfa: %s: %s\n" % (request, explain(exc)))
+                    stderr.flush()
 
 
 def readline_input() -> Callable[[], Optional[str]]:
@@ -114,12 +159,14 @@ def add_parsers(sub, common) -> None:
     cmd = sub.add_parser(
         "console", parents=[common], help="a line console: requests in, replies out",
         description="Each line is a request (docs/protocol.md), sent as typed; the"
-                    " board's reply is printed. On a terminal: line editing and"
-                    " history (readline; the history file is $%s or %s). A line"
-                    " over 128 characters gets the board's ERROR 04; comment lines"
-                    " (# first) of any length are sent and get no reply. Ends at"
-                    " end of input (Ctrl-D) or Ctrl-C, exit status 0; a serial"
-                    " failure ends it with one line, exit status 1."
+                    " board's reply is printed, and an ERROR's meaning on stderr as"
+                    " `orfa request` prints it. `help` or `?` lists the requests. On"
+                    " a terminal: line editing and history (readline; the history"
+                    " file is $%s or %s). A CR inside a line ends a request, as on"
+                    " the board. A line over 128 characters gets the board's ERROR"
+                    " 04; comment lines (# first) of any length are sent and get no"
+                    " reply. Ends at end of input (Ctrl-D) or Ctrl-C, exit status 0;"
+                    " a serial failure ends it with one line, exit status 1."
                     % (HISTORY_ENV, HISTORY_FILE),
         epilog="example: orfa --sim m32d --eeprom 0xA0 console")
     cmd.set_defaults(func=cmd_console)

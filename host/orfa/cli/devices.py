@@ -15,7 +15,7 @@ from ..board import Board
 from ..clients.adc import CHANNELS as ADC_CHANNELS, VREF
 from ..clients.servo import ServoRange
 from .common import (UsageError, address, byte, connect, explain, hex_bytes, number,
-                     show_address, table)
+                     interval, show_address, table, volts)
 from .names import board_of, driver_name
 
 
@@ -411,9 +411,9 @@ def add_parsers(sub, common) -> None:
     cmd.add_argument("--ref", choices=("avcc", "aref", "internal"),
                      help="the reference (default avcc)")
     cmd.add_argument("--bits", type=int, choices=(8, 10), help="the resolution (default 10)")
-    cmd.add_argument("--vref", type=float, metavar="V",
+    cmd.add_argument("--vref", type=volts, metavar="V",
                      help="the reference's volts (for aref; default 5.0 avcc, 2.56 internal)")
-    cmd.add_argument("--watch", nargs="?", type=float, const=0.5, metavar="SECONDS",
+    cmd.add_argument("--watch", nargs="?", type=interval, const=0.5, metavar="SECONDS",
                      help="redraw the table every SECONDS (default 0.5)")
     cmd.add_argument("--count", type=number, metavar="N", help="with --watch: stop after N tables")
     cmd.set_defaults(func=cmd_adc)

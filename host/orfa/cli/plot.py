@@ -17,7 +17,7 @@ from .. import boardmap, vcd, waves
 from .. import plot as drawing
 from ..sim import SimError
 from ..simctl import SimControl, SimControlError, parse_edges
-from .common import UsageError, sim_board
+from .common import UsageError, env_port, sim_board
 
 DEFAULT_FOR_US = 50000           # live: 50 ms of simulated time, 2.5 servo frames
 MAX_DEFAULT_ROWS = 12
@@ -259,7 +259,8 @@ def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str, 
         found = _windows(trace, t0, t1)
         return (found, names, Namer(names, trace.board_of()), trace.f_cpu,
                 "simulated %s" % args.sim, zero)
-    if args.do and not args.port:
+    port = args.port or env_port()
+    if args.do and not port:
         raise UsageError("--do with --control needs the board's --port (orfa sim prints it)")
     try:
         ctl = SimControl(args.control, connect_timeout=2.0)
@@ -269,7 +270,7 @@ def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str, 
         names = ctl.signals()
         namer = Namer(names, {"": args.board} if args.board else None)
         main_map = namer.maps.get("") or boardmap.load("m32d")
-        _run_commands(args.port, args)
+        _run_commands(port, args)
         found, names, zero = _record(ctl, main_map.f_cpu, args)
     return found, names, namer, main_map.f_cpu, "simulator at %s" % args.control, zero
 

@@ -10,7 +10,7 @@ import sys
 
 from .. import protocol as p
 from ..sim import BOARDS, SimError
-from .common import UsageError, add_sim_devices, sim_board
+from .common import UsageError, add_sim_devices, baud_rate, sim_board
 from .console import run_console
 
 
@@ -24,9 +24,28 @@ def slave_spec(text: str):
         addr = int(parts[1], 0)
     except ValueError:
         raise argparse.ArgumentTypeError("%r: ADDR like 0x10" % text) from None
+    _check_device_address(text, addr)
+    return (parts[0], addr, parts[2] if len(parts) == 3 and parts[2] else None)
+
+
+def eeprom_spec(text: str) -> int:
+    """`ADDR` of --eeprom, checked as --slave's is."""
+    try:
+        addr = int(text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0xA0" % text) from None
+    _check_device_address(text, addr)
+    return addr
+
+
+def _check_device_address(text: str, addr: int) -> None:
+    """A simulated device's 8-bit bus address: even, outside the addresses
+    I2C reserves, and not the gateway's own (its requests never reach the bus)."""
     if addr & 1 or not 0x10 <= addr <= 0xEE:
         raise argparse.ArgumentTypeError("%r: ADDR must be even, 0x10..0xEE" % text)
-    return (parts[0], addr, parts[2] if len(parts) == 3 and parts[2] else None)
+    if addr == p.DEFAULT_LOCAL_ADDRESS:
+        raise argparse.ArgumentTypeError("%r: 0x%02X is the gateway's own address (its"
+                                         " requests never reach the bus)" % (text, addr))
 
 
 def adc_spec(text: str):
@@ -67,13 +86,17 @@ def cmd_sim(args) -> int:
         raise UsageError(str(exc)) from None
     link = None
     signal.signal(signal.SIGTERM, _raise_interrupt)
+    # for a program, the bare paths (`port=$(orfa sim | head -1)`); with
+    # --terminal a person reads them, so each says what it is
+    port_label, control_label = (("serial port:    ", "control socket: ") if args.terminal
+                                 else ("", ""))
     try:
-        print(board.port, flush=True)
+        print(port_label + board.port, flush=True)
         if args.control is not None:
             link = args.control or None
             if link:
                 _link(board.control_path, link)
-            print(link or board.control_path, flush=True)
+            print(control_label + (link or board.control_path), flush=True)
         if args.terminal:
             with board.gateway(args.baud, autobaud=args.autobaud) as gw:
                 return run_console(gw)
@@ -96,7 +119,8 @@ def add_parsers(sub, common) -> None:
                     " its serial port on the first line (with --control, the control"
                     " socket's on the second). Runs until Ctrl-C or SIGTERM (exit 0),"
                     " or with --terminal for a console on the board until the end of"
-                    " its input. Bus addresses are the protocol's 8-bit form."
+                    " its input (then the lines say what they are: `serial port:"
+                    " PATH`). Bus addresses are the protocol's 8-bit form."
                     " docs/simulator.md describes the devices and the control socket.",
         epilog="example: orfa sim --board m32d --eeprom 0xA0 --slave m128s:0x10 --terminal")
     cmd.add_argument("--board", choices=BOARDS, default="m32d",
@@ -109,7 +133,7 @@ def add_parsers(sub, common) -> None:
     cmd.add_argument("--vcd", metavar="FILE", help="write every pin's waveform to FILE (VCD)")
     cmd.add_argument("--terminal", action="store_true",
                      help="also open a line console on the board (as orfa console)")
-    cmd.add_argument("--baud", type=int, default=p.DEFAULT_BAUD,
+    cmd.add_argument("--baud", type=baud_rate, default=p.DEFAULT_BAUD,
                      help="the console's rate (default %(default)s)")
     cmd.add_argument("--autobaud", action="store_true",
                      help="the console opens with the BAUD=auto preamble (eight CRs,"

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import List, Optional
 
+from ..errors import PinBusyError
+
 
 class Motor:
     def __init__(self, board):
@@ -31,16 +33,39 @@ class Motor:
         n, duty = self._n(n), self._duty(duty)
         duties = self.duties()
         duties[n - 1] = duty
-        self.set_all(*duties)
+        self._write(duties, changed=n)
 
     def set_all(self, *duties: int) -> None:
         """Every motor at once, one write from PWM1 (`80 60 00 01`): both
         change in the same PWM period."""
         if len(duties) != self.count:
             raise ValueError("set_all takes %d duties, not %d" % (self.count, len(duties)))
-        duties = tuple(self._duty(d) for d in duties)
+        self._write(tuple(self._duty(d) for d in duties))
+
+    def _write(self, duties, changed: Optional[int] = None) -> None:
         data = [abs(d) for d in duties] + [1 if d < 0 else 0 for d in duties]
-        self.board.write("motor", "PWM1", data)
+        try:
+            self.board.write("motor", "PWM1", data)
+        except PinBusyError as exc:
+            raise self._busy(exc, duties, changed if changed and duties[changed - 1] else None
+                             ) from exc.__cause__        # the ERROR 07, as the board's
+
+    def _busy(self, exc: PinBusyError, duties, changed: Optional[int] = None) -> PinBusyError:
+        """A PIN_BUSY refusal (the write starts at PWM1, so the board names
+        PWM1) named after the motor whose PWM line a servo channel holds:
+        `changed` when set() changed only that one, else each motor given a
+        duty whose line a servo channel can hold. Nothing is read to find
+        out: a read would overwrite the status register's PIN_BUSY."""
+        bmap = self.board.board_map("motor")
+        servo_pins = {(q.port, q.bit) for q in bmap.pins_of("SERVO")}
+        motors = [changed] if changed else [n for n, d in enumerate(duties, 1) if d]
+        busy = [n for n in motors
+                if any((pin.port, pin.bit) in servo_pins
+                       for pin in bmap.pins_of("MOTOR_PWM", n - 1))]
+        if not busy:
+            return exc
+        return type(exc)(exc.status, exc.addr, "motor " + "/".join("PWM%d" % n for n in busy),
+                         "write", code=exc.code)
 
     def get(self, n: int) -> int:
         """Motor n's signed duty (negative: backward)."""
