@@ -59,8 +59,17 @@ def _connection_options(parser, suppress: bool) -> None:
                        help="open the line with the BAUD=auto preamble (eight CRs, 20 ms quiet)")
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse with a usage error in one line (the command and the
+    problem, where to read more), exit 2: the synopsis argparse prints
+    first is five lines long and hides what was wrong."""
+
+    def error(self, message: str):
+        self.exit(EXIT_USAGE, "%s: error: %s (%s --help)\n" % (self.prog, message, self.prog))
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="orfa", description="ORFA host tools: talk to an ORFA gateway and the boards"
                                  " on its I2C bus, or simulate them. " + ADDRESS_RULE,
         epilog="examples: orfa --sim m32d scan; orfa --port /dev/ttyUSB0 servo 3 1500;"
@@ -70,7 +79,7 @@ def build_parser() -> argparse.ArgumentParser:
     _connection_options(parser, suppress=False)
     sim_devices = parser.add_argument_group("devices of the --sim board")
     add_sim_devices(sim_devices, suppress=True)
-    common = argparse.ArgumentParser(add_help=False)
+    common = Parser(add_help=False)
     _connection_options(common, suppress=True)
 
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
