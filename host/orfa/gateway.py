@@ -282,13 +282,17 @@ class Gateway:
         """The next line if it comes before `deadline`; else ReplyTimeout
         (the line marked out of step) that says what came instead."""
         left = deadline - time.monotonic()
-        if left <= 0 and seen:
+        try:
+            if left <= 0:
+                raise p.ReplyTimeout("no reply line")
+            return self._read_line(left)
+        except p.ReplyTimeout:
             self._dirty = True
-            raise p.ReplyTimeout(
-                "no V1.1 to the V marker within %g s: the line carries lines that are not"
-                " replies (%d lines, the last %r)" % (self.timeout, len(seen),
-                                                      _clip(seen[-1])))
-        return self._read_line(max(left, 0.001))
+            if not seen:
+                raise
+        raise p.ReplyTimeout(
+            "no V1.1 to the V marker within %g s: the line carries lines that are not"
+            " replies (%d lines, the last %r)" % (self.timeout, len(seen), _clip(seen[-1])))
 
     def _until_marker(self, deadline: float, markers: int = 1) -> List[str]:
         """Read up to the `markers`-th `V1.1`; every line before it (other
