@@ -69,6 +69,10 @@ def os_reason(e: BaseException, errno: bool = True) -> str:
 
 Reply = Union[str, p.OrfaError]
 
+#: A read may end this much after its deadline rather than change the
+#: port's timeout for it.
+_TIMEOUT_GRACE = 0.01
+
 #: The opening sync (Gateway.sync_open): a character that no request may
 #: hold and a CR end a partial line as a refused one; then two requests
 #: whose replies are known.
@@ -152,9 +156,10 @@ class Gateway:
 
     def _read_until(self, left: float) -> bytes:
         """Bytes up to an LF, or what came within `left` seconds: the
-        port's own timeout is shortened for this read when less is left."""
+        port's own timeout is shortened for this read when clearly less is
+        left (on a real port that reconfigures it: not for every line)."""
         port = self.serial
-        short = port.timeout is None or left < port.timeout
+        short = port.timeout is None or left < port.timeout - _TIMEOUT_GRACE
         try:
             if not short:
                 return port.read_until(b"\n")
@@ -238,9 +243,9 @@ class Gateway:
         (an `ERROR xx`, dropped) and never runs it; on a clean line that is
         an `ERROR 02`. The pair of replies, `V1.1` then the clock (`C` and
         four digits, never an error), is known: a partial line's one reply
-        cannot be it, nor can stale replies of requests other than these. Everything goes
-        in one write (a handful of characters, within the flow rule) and
-        takes one round trip. ReplyTimeout if the pair does not come within
+        cannot be it, nor can stale replies of requests other than these.
+        Everything goes in one write (a handful of characters, within the
+        flow rule) and takes one round trip. ReplyTimeout if the pair does not come within
         the gateway's timeout (no board, or a line that carries lines that
         are not replies); the next send tries again. Returns the number of
         lines dropped."""
