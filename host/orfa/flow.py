@@ -18,6 +18,10 @@ FLOW_WINDOW = 256
 #: The resynchronisation marker: a request whose reply is known exactly.
 MARKER = "V"
 MARKER_REPLY = "V1.1"
+#: The request after the marker in the opening sync (Gateway.sync_open): the
+#: clock, a read that changes nothing and whose reply is not `V1.1`.
+SYNC_SECOND = "C"
+SYNC_SECOND_REPLY = re.compile(r"C[0-9A-F]{4}\Z")
 
 _ERROR = r"ERROR [0-9A-F]{2}"
 _HEX = re.compile(r"[0-9A-F]*\Z")

@@ -22,11 +22,31 @@ SCAN_FIRST, SCAN_LAST = 0x08, 0x77
 
 
 def open_port(url: str, baudrate: int, timeout: float) -> serial.SerialBase:
-    """serial.serial_for_url, its errors as one-line SerialErrors."""
+    """serial.serial_for_url, its errors as one-line SerialErrors; a real
+    port in low-latency mode (low_latency)."""
     try:
-        return serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
+        port = serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
     except (serial.SerialException, OSError, ValueError) as e:
         raise SerialError("cannot open %s: %s" % (url, os_reason(e))) from e
+    low_latency(port)
+    return port
+
+
+def low_latency(port) -> bool:
+    """Ask the OS to hand received bytes over at once rather than after a
+    USB-serial adapter's latency timer (16 ms on FTDI chips): pyserial's
+    set_low_latency_mode(True), which Linux real ports have
+    (ASYNC_LOW_LATENCY). A port without it (another OS, socket://, loop://)
+    or that refuses it (a pty: no such ioctl) stays as it is, quietly.
+    True if the mode was set."""
+    setter = getattr(port, "set_low_latency_mode", None)
+    if setter is None:
+        return False
+    try:
+        setter(True)
+    except (ValueError, OSError, serial.SerialException, NotImplementedError):
+        return False
+    return True
 
 
 def os_reason(e: BaseException, errno: bool = True) -> str:
@@ -49,6 +69,22 @@ def os_reason(e: BaseException, errno: bool = True) -> str:
 
 Reply = Union[str, p.OrfaError]
 
+#: A read may end this much after its deadline rather than change the
+#: port's timeout for it.
+_TIMEOUT_GRACE = 0.01
+
+#: The opening sync (Gateway.sync_open): a character that no request may
+#: hold and a CR end a partial line as a refused one; then two requests
+#: whose replies are known.
+SYNC_OPEN = b"!\r" + p.encode_request(flow.MARKER) + p.encode_request(flow.SYNC_SECOND)
+
+
+def _clip(text, size: int = 60):
+    """A line's start, for a one-line error message."""
+    if len(text) <= size:
+        return text
+    return text[:size] + (b"..." if isinstance(text, bytes) else "...")
+
 
 #: The status register: introspection's second, on every board (docs/registers.md).
 _STATUS_REGISTER = boardmap.load(boardmap.BOARDS[0]).reg("intro", "STATUS")
@@ -59,11 +95,16 @@ class Gateway:
 
     autobaud=True sends the preamble of a BAUD=auto firmware (eight CRs, then
     quiet) right after opening; see preamble().
+
+    Before the first bytes it sends, the gateway ends whatever partial line
+    the board holds and drops every line up to the replies of its own
+    requests (sync_open()), so the first request is answered as itself;
+    sync=False leaves that out (a line that is not a board's).
     """
 
     def __init__(self, url: str, baudrate: int = p.DEFAULT_BAUD, timeout: float = 2.0,
                  local_address: int = p.DEFAULT_LOCAL_ADDRESS, autobaud: bool = False,
-                 wait: Optional[Callable[[float], None]] = None):
+                 wait: Optional[Callable[[float], None]] = None, sync: bool = True):
         self.timeout = timeout
         self.local = local_address
         self.url = url
@@ -72,6 +113,8 @@ class Gateway:
         #: set when the line may hold replies nobody waits for (a timeout,
         #: noise): the next run resynchronises first
         self._dirty = False
+        #: False until the opening sync is done (sync_open)
+        self._synced = not sync
         #: times the line was brought back in step (noise, stale lines, timeouts)
         self.resyncs = 0
         if autobaud:
@@ -83,7 +126,7 @@ class Gateway:
         that time: a simulator's simulated clock (SimBoard.wait_s); by
         default time.sleep, for a real board. Empty lines to a firmware of
         a fixed rate (no reply)."""
-        self.send(p.AUTOBAUD_PREAMBLE)
+        self._write(p.AUTOBAUD_PREAMBLE)
         (wait or time.sleep)(p.autobaud_wait_s(self.serial.baudrate))
 
     # --- lifetime -----------------------------------------------------------
@@ -98,28 +141,47 @@ class Gateway:
 
     # --- lines ----------------------------------------------------------------
     def send(self, data: bytes) -> None:
-        """Write raw bytes (no checks, no terminator added)."""
+        """Write raw bytes (no checks, no terminator added); the opening
+        sync first if it is not done (sync_open)."""
+        if not self._synced:
+            self.sync_open()
+        self._write(data)
+
+    def _write(self, data: bytes) -> None:
         try:
             self.serial.write(data)
             self.serial.flush()
         except (serial.SerialException, OSError) as e:
             raise SerialError("%s: %s" % (self.url, os_reason(e))) from e
 
-    def _read_until(self) -> bytes:
+    def _read_until(self, left: float) -> bytes:
+        """Bytes up to an LF, or what came within `left` seconds: the
+        port's own timeout is shortened for this read when clearly less is
+        left (on a real port that reconfigures it: not for every line)."""
+        port = self.serial
+        short = port.timeout is None or left < port.timeout - _TIMEOUT_GRACE
         try:
-            return self.serial.read_until(b"\n")
+            if not short:
+                return port.read_until(b"\n")
+            kept = port.timeout
+            port.timeout = left
+            try:
+                return port.read_until(b"\n")
+            finally:
+                port.timeout = kept
         except (serial.SerialException, OSError) as e:
             raise SerialError("%s: %s" % (self.url, os_reason(e))) from e
 
     def read_reply(self, timeout: Optional[float] = None) -> str:
-        """The next reply line without its CR LF; ReplyTimeout if none comes."""
+        """The next reply line without its CR LF; ReplyTimeout if none comes
+        within `timeout` seconds (default: the gateway's)."""
         deadline = time.monotonic() + (self.timeout if timeout is None else timeout)
         buf = bytearray()
         while not buf.endswith(b"\r\n"):
             left = deadline - time.monotonic()
             if left <= 0:
-                raise p.ReplyTimeout("no reply line (got %r)" % bytes(buf))
-            chunk = self._read_until()
+                raise p.ReplyTimeout("no reply line (got %r)" % _clip(bytes(buf)))
+            chunk = self._read_until(left)
             buf += chunk
             if buf.endswith(b"\n") and not buf.endswith(b"\r\n"):
                 raise p.ProtocolError("reply line not ended by CR LF: %r" % bytes(buf))
@@ -172,30 +234,89 @@ class Gateway:
                 out.append(e)
         return out
 
+    def sync_open(self) -> int:
+        """End whatever partial line the board holds (a terminal's `S AA 0`
+        without its Enter, bytes of a program at another rate) and drop
+        every line up to the replies of a `V` and a `C`; send() does this
+        before the gateway's first bytes. The partial line is ended by a
+        character no request may hold, then a CR, so the board refuses it
+        (an `ERROR xx`, dropped) and never runs it; on a clean line that is
+        an `ERROR 02`. The pair of replies, `V1.1` then the clock (`C` and
+        four digits, never an error), is known: a partial line's one reply
+        cannot be it, nor can stale replies of requests other than these.
+        Everything goes in one write (a handful of characters, within the
+        flow rule) and takes one round trip. ReplyTimeout if the pair does not come within
+        the gateway's timeout (no board, or a line that carries lines that
+        are not replies); the next send tries again. Returns the number of
+        lines dropped."""
+        self._write(SYNC_OPEN)
+        deadline = time.monotonic() + self.timeout
+        seen: List[str] = []
+        while True:
+            text = self._line_by(deadline, seen)
+            if seen and seen[-1] == flow.MARKER_REPLY and flow.SYNC_SECOND_REPLY.match(text):
+                break
+            seen.append(text)
+        self._synced = True
+        self._dirty = False
+        return len(seen) - 1
+
     def resync(self) -> int:
         """Bring the line in step: send the `V` marker and drop every line
-        up to its `V1.1`. Returns the number of lines dropped."""
+        up to its `V1.1` (the opening sync instead, if it is not done).
+        Returns the number of lines dropped. ReplyTimeout if no `V1.1` comes
+        within the gateway's timeout, whatever else comes."""
         self.resyncs += 1
-        self.send(p.encode_request(flow.MARKER))
-        dropped = 0
-        while self._read_line() != flow.MARKER_REPLY:
-            dropped += 1
+        if not self._synced:
+            return self.sync_open()
+        self._write(p.encode_request(flow.MARKER))
+        dropped = len(self._until_marker(time.monotonic() + self.timeout))
         self._dirty = False
         return dropped
 
     def in_step(self) -> None:
-        """Resynchronise first if a timeout left the line out of step or
-        bytes wait that nobody asked for (run() and transactions() do this
-        on their own)."""
-        if self._dirty or self._waiting():
+        """Resynchronise first if a timeout left the line out of step,
+        bytes wait that nobody asked for, or the opening sync is not done
+        (run() and transactions() do this on their own)."""
+        if not self._synced:
+            self.sync_open()
+        elif self._dirty or self._waiting():
             self.resync()
 
-    def _read_line(self) -> str:
+    def _line_by(self, deadline: float, seen: List[str]) -> str:
+        """The next line if it comes before `deadline`; else ReplyTimeout
+        (the line marked out of step) that says what came instead."""
+        left = deadline - time.monotonic()
+        try:
+            if left <= 0:
+                raise p.ReplyTimeout("no reply line")
+            return self._read_line(left)
+        except p.ReplyTimeout:
+            self._dirty = True
+            if not seen:
+                raise
+        raise p.ReplyTimeout(
+            "no V1.1 to the V marker within %g s: the line carries lines that are not"
+            " replies (%d lines, the last %r)" % (self.timeout, len(seen), _clip(seen[-1])))
+
+    def _until_marker(self, deadline: float, markers: int = 1) -> List[str]:
+        """Read up to the `markers`-th `V1.1`; every line before it (other
+        `V1.1`s included). ReplyTimeout at the deadline."""
+        seen: List[str] = []
+        while True:
+            text = self._line_by(deadline, seen)
+            if text == flow.MARKER_REPLY:
+                markers -= 1
+                if markers == 0:
+                    return seen
+            seen.append(text)
+
+    def _read_line(self, timeout: Optional[float] = None) -> str:
         """The next line; a line that is not even text comes back as it was
         (repr), so it is noise to every pattern. Timeouts mark the line out
         of step."""
         try:
-            return self.read_reply()
+            return self.read_reply(timeout)
         except p.ReplyTimeout:
             self._dirty = True
             raise
@@ -268,8 +389,7 @@ class Gateway:
                 # a reply too many: somewhere from unsure_from on, an extra
                 # line took a request's place; those results are not trusted
                 self.resyncs += 1
-                while self._read_line() != flow.MARKER_REPLY:
-                    pass
+                self._until_marker(time.monotonic() + self.timeout)
                 for i in range(unsure_from, n):
                     out[i] = p.ProtocolError(
                         "replies out of step from %r on (an extra line on the serial "
@@ -282,14 +402,7 @@ class Gateway:
         them to the requests still waiting, if they line up; otherwise
         those requests lost their replies (ProtocolError)."""
         markers_due = 1 + sum(1 for i in waiting if lines[i].strip(" ").upper().startswith("V"))
-        seen: List[str] = []
-        while True:
-            text = self._read_line()
-            if text == flow.MARKER_REPLY:
-                markers_due -= 1
-                if markers_due == 0:
-                    break
-            seen.append(text)
+        seen = self._until_marker(time.monotonic() + self.timeout, markers_due)
         candidates = [t for t in seen if any(flow.plausible(patterns[i], t) for i in waiting)]
         # the line that was noise came in the first waiting request's place:
         # an extra line (all replies follow) or its reply garbled (one fewer)

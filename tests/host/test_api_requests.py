@@ -21,23 +21,28 @@ def records_hex(board):
 
 def board_answers(board="m32d", addr=0xAA, table=()):
     """Answers of a board at addr: its introspection (from the map), the
-    V marker, and `table` (request -> reply); anything else ERROR 02."""
+    V marker, the clock, and `table` (request -> reply); anything else ERROR 02."""
     recs, n = records_hex(board)
     w, r = "%02X" % addr, "%02X" % (addr | 1)
     answers = {"S%s0000S%s01P" % (w, r): "SWAASR%02XP" % n,
                "S%s0001S%s%02XP" % (w, r, len(recs) // 2): "SWAASR%sP" % recs,
-               "V": "V1.1"}
+               "V": "V1.1", "C": "C0063"}
     answers.update(dict(table))
     return lambda line: answers.get(line, "ERROR 02")
 
 
 @pytest.fixture
 def fake(monkeypatch):
-    """fake(answer) -> (Gateway, FakeLine): a Gateway whose port is the fake."""
+    """fake(answer) -> (Gateway, FakeLine): a Gateway whose port is the fake,
+    its opening sync done (tests/host/test_line_contents.py) and left out
+    of line.written."""
     def make(answer):
-        line = FakeLine(answer)
+        line = FakeLine(lambda text: "C0063" if text == "C" else answer(text))
         monkeypatch.setattr("orfa.gateway.serial.serial_for_url", lambda url, **kw: line)
-        return Gateway("fake://", timeout=0.2), line
+        gw = Gateway("fake://", timeout=0.2)
+        gw.in_step()
+        line.forget()
+        return gw, line
     return make
 
 
