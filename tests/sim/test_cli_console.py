@@ -164,3 +164,21 @@ def test_make_demo_ends_on_ctrl_c_without_makes_interrupt_line():
     assert "V1.1" in text
     assert "Interrupt" not in text and "make:" not in text and "***" not in text, text
     assert os.WIFEXITED(status) or os.WTERMSIG(status) == signal.SIGINT, status
+
+
+def test_console_on_a_silent_port_says_so_per_request_and_goes_on():
+    """No board behind the port (a pty nobody answers): each request gets
+    one `host:` line within the timeout, the console reads on, exit 0."""
+    master, slave = pty.openpty()
+    try:
+        path = os.ttyname(slave)
+        r = subprocess.run([sys.executable, "-m", "orfa", "--port", path, "--timeout", "0.3",
+                            "console"], env=ENV, input="V\nL\n", capture_output=True,
+                           text=True, timeout=30)
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert len(lines) == 2 and all(line.startswith("host: ") for line in lines), r.stdout
+    assert "Traceback" not in r.stderr

@@ -62,16 +62,18 @@ def exchange(gw, line: str) -> Optional[str]:
     """Send one console line as it is; its reply, None when the board sends
     none (comment or empty line), or a `host: ...` line when the host
     cannot send it."""
-    if not expects_reply(line):
-        if line.strip(" "):                  # a comment: the board drops it too
-            gw.send(line.encode("ascii", "replace") + p.REQUEST_TERMINATOR.encode())
-        return None
     try:
-        data = line.encode("ascii")
-    except UnicodeEncodeError:
-        return "host: a request is ASCII text"
-    gw.send(data + p.REQUEST_TERMINATOR.encode())
-    try:
+        if not expects_reply(line):
+            if line.strip(" "):              # a comment: the board drops it too
+                gw.send(line.encode("ascii", "replace") + p.REQUEST_TERMINATOR.encode())
+            return None
+        try:
+            data = line.encode("ascii")
+        except UnicodeEncodeError:
+            return "host: a request is ASCII text"
+        # the first send also brings the line in step (a board silent or
+        # talking nonsense says so here, in time, and the console goes on)
+        gw.send(data + p.REQUEST_TERMINATOR.encode())
         return gw.read_reply()
     except p.ReplyTimeout as exc:
         return "host: %s" % exc
