@@ -130,7 +130,10 @@ def make_demo(*variables):
     """`make demo` on a pseudo-terminal, at its first prompt (-o setup:
     tools/setup.sh is not these tests' business)."""
     require_builds(["m32d"])
-    term = Pty(["make", "-o", "setup", "demo"] + list(variables), ROOT, dict(ENV, MAKEFLAGS=""))
+    # as a person's shell runs it: not as a sub-make of `make test` (make
+    # would print "Entering directory" for a MAKELEVEL above 0)
+    env = {k: v for k, v in ENV.items() if k not in ("MAKELEVEL", "MAKEFLAGS", "MFLAGS")}
+    term = Pty(["make", "-o", "setup", "demo"] + list(variables), ROOT, env)
     if not term.read_until(lambda out: b"orfa> " in out, 300):
         term.wait(1)
     return term
