@@ -185,9 +185,10 @@ fuses:
 	$(strip $(AVRDUDE_CMD) $(foreach f,$(BOARD_FUSES),-U $(subst :,:w:,$(f)):m))
 
 # --- simulator (host C, Debian's libsimavr) --------------------------------
-SIM_SRC := $(wildcard sim/*.c sim/parts/*.c)
-SIM_HDR := $(wildcard sim/*.h sim/parts/*.h boards/*/board.h)
-SIM_CFLAGS := -std=gnu99 -O2 -g -Wall -Wextra -Werror -I. -Isim -I/usr/include/simavr
+SIM_SRC := $(wildcard sim/*/*.c)
+SIM_HDR := $(wildcard sim/*/*.h boards/*/board.h)
+AVR_LIBC_INCLUDE ?= $(abspath $(dir $(shell avr-gcc -print-file-name=libc.a))../include)
+SIM_CFLAGS := -std=gnu99 -O2 -g -Wall -Wextra -Werror -I. -Isim -I/usr/include/simavr -idirafter $(AVR_LIBC_INCLUDE)
 SIM_LIBS := -lsimavr -lelf -lutil -lpthread -lm
 
 sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf build/sim-fw/twi_slave_echo_m128.elf

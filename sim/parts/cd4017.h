@@ -7,7 +7,7 @@
 #ifndef SIM_PARTS_CD4017_H
 #define SIM_PARTS_CD4017_H
 
-#include "signals.h"
+#include "harness/signals.h"
 
 typedef struct cd4017_t {
 	signal_t q[10];			/* "<name>q0".."<name>q9" */

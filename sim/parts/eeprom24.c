@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "parts/eeprom24.h"
+#include "parts/part.h"
 
 static int eeprom24_start(twi_dev_t *dev, uint8_t addr8)
 {
@@ -69,3 +70,28 @@ void eeprom24_init(eeprom24_t *e, uint8_t addr8)
 	e->dev.name = "eeprom24";
 	e->addr8 = addr8 & 0xfe;
 }
+
+/* --- descriptor ------------------------------------------------------------ */
+
+static int eeprom24_part_init(void *self, const part_env_t *env, const char *opts,
+			      const char **err)
+{
+	int wp = !strcmp(opts, "wp");
+
+	if (*opts && !wp) {
+		*err = "bad option (wp)";
+		return -1;
+	}
+	eeprom24_init(self, env->addr8);
+	((eeprom24_t *)self)->write_protect = (uint8_t)wp;
+	return 0;
+}
+
+const part_kind_t eeprom24_kind = {
+	.name = "eeprom24",
+	.attach = PART_I2C,
+	.options = "wp",
+	.about = "a 256-byte EEPROM like a 24C02 (wp: its WP pin high, data NACKed)",
+	.size = sizeof(eeprom24_t),
+	.init = eeprom24_part_init,
+};

@@ -9,7 +9,7 @@
 
 #include <stdint.h>
 
-#include "twi_bus.h"
+#include "periph/twi_bus.h"
 
 #define EEPROM24_SIZE 256
 #define EEPROM24_PAGE 8

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "parts/eeprom25.h"
+#include "parts/part.h"
 
 enum {
 	EE_WRSR = 0x01, EE_WRITE = 0x02, EE_READ = 0x03, EE_WRDI = 0x04,
@@ -135,3 +136,23 @@ void eeprom25_init(eeprom25_t *e, int mode, int lsb_first)
 	e->dev.dump = ee_dump;
 	spi_dev_byte_init(&e->dev);
 }
+
+/* --- descriptor ------------------------------------------------------------ */
+
+static int eeprom25_part_init(void *self, const part_env_t *env, const char *opts,
+			      const char **err)
+{
+	(void)opts;
+	(void)err;
+	eeprom25_init(self, env->mode, env->lsb_first);
+	return 0;
+}
+
+const part_kind_t eeprom25_kind = {
+	.name = "eeprom25",
+	.attach = PART_SPI,
+	.options = "",
+	.about = "a 128-byte SPI EEPROM like a 25LC010A",
+	.size = sizeof(eeprom25_t),
+	.init = eeprom25_part_init,
+};

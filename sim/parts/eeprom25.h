@@ -13,7 +13,7 @@
 #ifndef SIM_PARTS_EEPROM25_H
 #define SIM_PARTS_EEPROM25_H
 
-#include "spi.h"
+#include "periph/spi.h"
 
 #define EEPROM25_SIZE 128
 #define EEPROM25_PAGE 16

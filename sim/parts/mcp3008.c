@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "parts/mcp3008.h"
+#include "parts/part.h"
 
 static void mcp_select(spi_dev_t *d, uint64_t cycle)
 {
@@ -108,3 +109,23 @@ void mcp3008_init(mcp3008_t *m, int mode, int lsb_first, const uint32_t *mv,
 	m->vref = vref;
 	m->last_code = -1;
 }
+
+/* --- descriptor ------------------------------------------------------------ */
+
+static int mcp3008_part_init(void *self, const part_env_t *env, const char *opts,
+			     const char **err)
+{
+	(void)opts;
+	(void)err;
+	mcp3008_init(self, env->mode, env->lsb_first, env->adc_mv, env->avcc);
+	return 0;
+}
+
+const part_kind_t mcp3008_kind = {
+	.name = "mcp3008",
+	.attach = PART_SPI,
+	.options = "",
+	.about = "an 8-channel 10-bit SPI ADC like an MCP3008 (the board's analog inputs)",
+	.size = sizeof(mcp3008_t),
+	.init = mcp3008_part_init,
+};

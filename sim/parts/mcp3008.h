@@ -14,7 +14,7 @@
 #ifndef SIM_PARTS_MCP3008_H
 #define SIM_PARTS_MCP3008_H
 
-#include "spi.h"
+#include "periph/spi.h"
 
 typedef struct mcp3008_t {
 	spi_dev_t dev;			/* first */

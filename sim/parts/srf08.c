@@ -43,9 +43,17 @@
  *    byte that is not one of E0..FE ends the sequence and counts as an
  *    ordinary command; the light reading is 0 before the first ranging.
  */
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
+#include "parts/part.h"
 #include "parts/srf08.h"
+
+extern const part_kind_t srf08_kind;
 
 #define SRF08_STEP_MM 43u
 #define SRF08_ANN_SLOTS 32
@@ -277,3 +285,128 @@ void srf08_set_light(srf08_t *s, uint8_t level)
 {
 	s->light = level;
 }
+
+/* --- the control request `srf08`: what each SRF08 senses, its state ------- */
+
+#define SRF08_CTL_MAX_MM 100000u	/* 100 m: far beyond any range */
+#define SRF08_CTL_USAGE "srf08 ADDR [range MM [MM2] | light N]"
+
+/* Decimal 0..MAX. 0 or -1. */
+static int srf08_parse_dec(const char *s, uint32_t max, uint32_t *out)
+{
+	char *end;
+	unsigned long v;
+
+	if (!*s || *s == '-' || *s == '+') {
+		return -1;
+	}
+	errno = 0;
+	v = strtoul(s, &end, 10);
+	if (errno || *end || v > max) {
+		return -1;
+	}
+	*out = (uint32_t)v;
+	return 0;
+}
+
+/* The device answering at the 8-bit address in S ("E0" or "0xE0"), as the
+ * firmware sees it now (after an address change: the new one). */
+static srf08_t *srf08_find(const part_list_t *list, const char *s)
+{
+	char *end;
+	unsigned long v;
+
+	if (!*s || *s == '-' || *s == '+') {
+		return NULL;
+	}
+	v = strtoul(s, &end, 16);
+	if (*end || v > 0xff) {
+		return NULL;
+	}
+	for (int i = 0; i < list->n; i++) {
+		srf08_t *d = list->item[i].self;
+
+		if (list->item[i].kind == &srf08_kind && d->addr8 == v) {
+			return d;
+		}
+	}
+	return NULL;
+}
+
+static void srf08_control(const part_list_t *list, uint64_t now, int argc, char **argv,
+			  char *out, size_t cap)
+{
+	srf08_t *s;
+	uint32_t mm = 0, mm2 = 0, level;
+
+	if (argc < 2 || argc > 5) {
+		snprintf(out, cap, "ERR %s", SRF08_CTL_USAGE);
+		return;
+	}
+	s = srf08_find(list, argv[1]);
+	if (!s) {
+		snprintf(out, cap, "ERR no SRF08 at '%s' (give its 8-bit address in hex, E0)",
+			 argv[1]);
+		return;
+	}
+	if (argc == 2) {
+		snprintf(out, cap, "addr %02X range %" PRIu32 " %" PRIu32 " light %u"
+			 " gain %u rangereg %u busy %d rangings %" PRIu32,
+			 s->addr8, s->target_mm[0], s->target_mm[1], s->light, s->gain,
+			 s->range, srf08_busy(s, now), s->rangings);
+	} else if (!strcasecmp(argv[2], "range") && (argc == 4 || argc == 5)) {
+		if (srf08_parse_dec(argv[3], SRF08_CTL_MAX_MM, &mm) < 0 ||
+		    (argc == 5 && srf08_parse_dec(argv[4], SRF08_CTL_MAX_MM, &mm2) < 0)) {
+			snprintf(out, cap, "ERR srf08 ADDR range MM [MM2]: millimetres 0..%u,"
+				 " decimal (0: nothing there)", SRF08_CTL_MAX_MM);
+			return;
+		}
+		srf08_set_targets(s, mm, mm2);
+		snprintf(out, cap, "OK");
+	} else if (!strcasecmp(argv[2], "light") && argc == 4) {
+		if (srf08_parse_dec(argv[3], 255, &level) < 0) {
+			snprintf(out, cap, "ERR srf08 ADDR light N: N 0..255, decimal");
+			return;
+		}
+		srf08_set_light(s, (uint8_t)level);
+		snprintf(out, cap, "OK");
+	} else {
+		snprintf(out, cap, "ERR %s", SRF08_CTL_USAGE);
+	}
+}
+
+/* --- descriptor ------------------------------------------------------------ */
+
+/* The 16 addresses an SRF08 can be set to: E0, E2 .. FE. */
+static int srf08_addr_ok(uint8_t addr8)
+{
+	return addr8 >= 0xE0 && !(addr8 & 1);
+}
+
+static int srf08_part_init(void *self, const part_env_t *env, const char *opts,
+			   const char **err)
+{
+	if (*opts) {
+		*err = "no options";
+		return -1;
+	}
+	srf08_init(self, env->addr8, env->hz, env->bus);
+	return 0;
+}
+
+static const part_request_t srf08_requests[] = {
+	{ "srf08", "ADDR [range MM [MM2] | light N]", srf08_control },
+};
+
+const part_kind_t srf08_kind = {
+	.name = "srf08",
+	.attach = PART_I2C,
+	.options = "",
+	.about = "a Devantech SRF08 ultrasonic range finder (request srf08)",
+	.addr_ok = srf08_addr_ok,
+	.addrs = "0xE0, 0xE2 .. 0xFE",
+	.size = sizeof(srf08_t),
+	.init = srf08_part_init,
+	.requests = srf08_requests,
+	.nrequests = 1,
+};

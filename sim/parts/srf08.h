@@ -14,7 +14,7 @@
 
 #include <stdint.h>
 
-#include "twi_bus.h"
+#include "periph/twi_bus.h"
 
 #define SRF08_ADDR_DEFAULT 0xE0	/* as shipped */
 #define SRF08_LOCATIONS 36	/* 0..35: command/revision .. 17th echo */

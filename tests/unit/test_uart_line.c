@@ -1,12 +1,12 @@
 /*
- * The simulator's serial line (sim/uart_line.c): frames at a sender's bit
+ * The simulator's serial line (sim/periph/sim_uart_line.c): frames at a sender's bit
  * time decoded by a receiver at its own, the way the AVR's USART samples
  * (majority of three at each bit's middle, FE on a low stop bit).
  */
 #include <stdio.h>
 #include <string.h>
 
-#include "uart_line.h"
+#include "periph/sim_uart_line.h"
 
 #include "check.h"
 
@@ -31,24 +31,24 @@ static void emit(void *param, avr_cycle_count_t when, avr_cycle_count_t t0,
 	}
 }
 
-static uart_line_t line;
+static sim_uart_line_t line;
 
 /* Frames back to back from START at the sender's BIT; decoded at RX_BIT. */
 static void decode(const uint8_t *bytes, int n, uint32_t bit, uint32_t rx_bit,
 		   avr_cycle_count_t step, got_t *g)
 {
-	uart_dec_t d = { .cursor = 0 };
+	sim_uart_dec_t d = { .cursor = 0 };
 	avr_cycle_count_t start = 1000, end;
 
 	memset(g, 0, sizeof(*g));
-	uart_line_reset(&line);
+	sim_uart_line_reset(&line);
 	for (int i = 0; i < n; i++) {
-		uart_line_push(&line, start + (avr_cycle_count_t)i * 10 * bit, bit, bytes[i], 0);
+		sim_uart_line_push(&line, start + (avr_cycle_count_t)i * 10 * bit, bit, bytes[i], 0);
 	}
 	end = start + (avr_cycle_count_t)(n + 20) * 10 * (bit > rx_bit ? bit : rx_bit);
 	/* the same result whether run in one go or in small steps */
 	for (avr_cycle_count_t t = step ? step : end; ; t += step ? step : end) {
-		uart_dec_run(&d, &line, rx_bit, t < end ? t : end, emit, g);
+		sim_uart_dec_run(&d, &line, rx_bit, t < end ? t : end, emit, g);
 		if (t >= end) {
 			break;
 		}

@@ -1,0 +1,48 @@
+/*
+ * sim_boards.c: the list of boards (each described by its own board.h).
+ */
+#include <string.h>
+
+#include "boards/sim_boards.h"
+
+static const sim_board_desc_t *const sim_board_table[] = {
+	&sim_board_m32d,
+	&sim_board_m128s,
+};
+
+#define SIM_NBOARDS (sizeof(sim_board_table) / sizeof(sim_board_table[0]))
+
+const sim_board_desc_t *sim_board_find(const char *name)
+{
+	for (unsigned i = 0; i < SIM_NBOARDS; i++) {
+		if (strcmp(sim_board_table[i]->name, name) == 0) {
+			return sim_board_table[i];
+		}
+	}
+	return NULL;
+}
+
+const char *sim_board_names(void)
+{
+	static char names[64];
+
+	if (!names[0]) {
+		for (unsigned i = 0; i < SIM_NBOARDS; i++) {
+			if (i) {
+				strcat(names, "|");
+			}
+			strcat(names, sim_board_table[i]->name);
+		}
+	}
+	return names;
+}
+
+const sim_pin_t *sim_wiring_pin(const sim_wiring_t *w, sim_pin_fn_t fn, int index)
+{
+	for (int i = 0; i < w->npins; i++) {
+		if (w->pins[i].fn == fn && w->pins[i].index == index) {
+			return &w->pins[i];
+		}
+	}
+	return NULL;
+}

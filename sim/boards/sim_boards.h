@@ -1,0 +1,30 @@
+/*
+ * sim_boards.h: the boards the simulator knows: their names, MCU and
+ * wiring, each read from boards/<board>/board.h by sim/boards/<board>.c
+ * (one file per board, since every board header defines the same macro
+ * names), for the board model (board_model.h).
+ */
+#ifndef SIM_BOARDS_H
+#define SIM_BOARDS_H
+
+#include <stdint.h>
+
+#include "boards/sim_wiring.h"
+
+typedef struct sim_board_desc_t {
+	const char *name;	/* --board value: BOARD_ID, "m32d" */
+	const char *title;	/* BOARD_NAME, "OR-AVR-M32-D" */
+	const char *mcu;	/* BOARD_MCU_NAME, simavr's MCU name */
+	sim_wiring_t wiring;
+} sim_board_desc_t;
+
+extern const sim_board_desc_t sim_board_m32d;
+extern const sim_board_desc_t sim_board_m128s;
+
+/* The board called NAME, or NULL. */
+const sim_board_desc_t *sim_board_find(const char *name);
+
+/* "m32d|m128s", for usage messages. */
+const char *sim_board_names(void);
+
+#endif

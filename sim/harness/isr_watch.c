@@ -1,0 +1,83 @@
+/*
+ * isr_watch.c: interrupt handler durations.
+ */
+#include <string.h>
+
+#include "harness/isr_watch.h"
+
+/* Another vector's handler starts (1) or returns (0). */
+static void isr_watch_other(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+	isr_watch_t *w = param;
+	uint64_t now = w->avr->cycle;
+
+	(void)irq;
+	if (!w->inside) {
+		return;
+	}
+	if (value) {
+		if (w->other_depth++ == 0) {
+			w->other_since = now;
+		}
+	} else if (w->other_depth > 0 && --w->other_depth == 0) {
+		w->nested += now - w->other_since;
+	}
+}
+
+/* Every other vector, once: by the first run all peripherals (simavr's and
+ * the simulator's own) have registered theirs. */
+static void isr_watch_hook_others(isr_watch_t *w)
+{
+	avr_int_table_p t = &w->avr->interrupts;
+
+	w->others_hooked = 1;
+	for (int i = 0; i < t->vector_count; i++) {
+		if (t->vector[i] && t->vector[i] != w->vect) {
+			avr_irq_register_notify(&t->vector[i]->irq[AVR_INT_IRQ_RUNNING],
+						isr_watch_other, w);
+		}
+	}
+}
+
+static void isr_watch_running(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+	isr_watch_t *w = param;
+	uint64_t now = w->avr->cycle;
+
+	(void)irq;
+	if (value) {
+		if (!w->others_hooked) {
+			isr_watch_hook_others(w);
+		}
+		w->entered = now;
+		w->inside = 1;
+		w->other_depth = 0;
+		w->nested = 0;
+		return;
+	}
+	if (!w->inside) {
+		return;
+	}
+	w->inside = 0;
+	uint64_t took = now - w->entered - w->nested;
+	if (took > w->longest) {
+		w->longest = took;
+	}
+	w->count++;
+	w->total += took;
+}
+
+void isr_watch_init(isr_watch_t *w, avr_t *avr, avr_int_vector_t *vect)
+{
+	memset(w, 0, sizeof(*w));
+	w->avr = avr;
+	w->vect = vect;
+	avr_irq_register_notify(&vect->irq[AVR_INT_IRQ_RUNNING], isr_watch_running, w);
+}
+
+void isr_watch_clear(isr_watch_t *w)
+{
+	w->longest = 0;
+	w->count = 0;
+	w->total = 0;
+}

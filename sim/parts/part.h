@@ -1,0 +1,102 @@
+/*
+ * part.h: a kind of part as data. Every part the simulator can put around
+ * the boards has one descriptor (part_kind_t) in the registry (parts.c):
+ * its name, where it attaches (the I2C bus, or a board's SPI chip select),
+ * how it is made from its option's text, and the control requests it adds.
+ * The world and the boards hold lists of the parts made (part_list_t).
+ *
+ * A new I2C part is one file (its model and its descriptor) and one line in
+ * the registry; `--part KIND@ADDR[:OPTIONS]` then makes it and
+ * `orfa-sim --help` lists it.
+ *
+ * Only forward declarations here, so a part's model builds on its own (the
+ * SRF08's unit test) without simavr.
+ */
+#ifndef SIM_PARTS_PART_H
+#define SIM_PARTS_PART_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+struct twi_bus_t;
+
+/* Where a kind attaches. */
+typedef enum part_attach_t {
+	PART_I2C,		/* the world's I2C bus, at an 8-bit address */
+	PART_SPI,		/* a board's SPI bus, at a chip-select pin */
+} part_attach_t;
+
+/* What a part is made with. */
+typedef struct part_env_t {
+	struct twi_bus_t *bus;		/* I2C: the bus (its `cycle` is the time) */
+	uint32_t hz;			/* cycles per second */
+	uint8_t addr8;			/* I2C: its 8-bit address */
+	int mode, lsb_first;		/* SPI: the mode and bit order it speaks */
+	const uint32_t *adc_mv;		/* SPI: the board's 8 analog inputs, mV */
+	const uint32_t *avcc;		/* SPI: the board's AVCC, mV */
+} part_env_t;
+
+struct part_kind_t;
+
+/* One part made: its kind and its context struct, whose first member is
+ * the bus's view of it (twi_dev_t or spi_dev_t). */
+typedef struct part_t {
+	const struct part_kind_t *kind;
+	void *self;
+	uint8_t addr8;			/* I2C: the address it was made at */
+} part_t;
+
+#define PART_LIST_MAX 64
+
+typedef struct part_list_t {
+	part_t item[PART_LIST_MAX];
+	int n;
+} part_list_t;
+
+/* A control request a kind adds: `NAME ARGS`. FN answers ARGV (ARGV[0]
+ * is NAME) about the parts in LIST (of every kind: it picks its own) at
+ * cycle NOW with one line in OUT: "OK", a state, or "ERR ...". */
+typedef struct part_request_t {
+	const char *name;
+	const char *args;
+	void (*fn)(const part_list_t *list, uint64_t now, int argc, char **argv,
+		   char *out, size_t cap);
+} part_request_t;
+
+typedef struct part_kind_t {
+	const char *name;		/* KIND in the options: "eeprom24" */
+	part_attach_t attach;
+	const char *options;		/* its OPTIONS for --help: "wp", or "" */
+	const char *about;		/* one line for --help */
+	/* I2C: the addresses it can have (NULL: any even one), and their text */
+	int (*addr_ok)(uint8_t addr8);
+	const char *addrs;
+	/* Its context struct: SIZE bytes, zeroed, then set up by INIT from
+	 * ENV and OPTS (the option text after KIND@ADDR:, or ""; SPI: mode and
+	 * bit order are in ENV). INIT returns 0, or -1 with *ERR saying why. */
+	size_t size;
+	int (*init)(void *self, const part_env_t *env, const char *opts, const char **err);
+	const part_request_t *requests;
+	int nrequests;
+} part_kind_t;
+
+/* The registry: every kind, NULL-terminated. */
+extern const part_kind_t *const part_kinds[];
+
+/* The kind called NAME that attaches to ATTACH, or NULL. */
+const part_kind_t *part_kind_find(const char *name, part_attach_t attach);
+
+/* The names of the kinds that attach to ATTACH, joined by SEP. */
+const char *part_kind_names(part_attach_t attach, const char *sep, char *buf, size_t cap);
+
+/* A new part of KIND (part_kind_t.init) or NULL with *ERR saying why. */
+void *part_make(const part_kind_t *kind, const part_env_t *env, const char *opts,
+		const char **err);
+
+/* Add a made part to LIST. 0, or -1 when full. */
+int part_list_add(part_list_t *list, const part_kind_t *kind, void *self, uint8_t addr8);
+
+/* The part of KIND in LIST at ADDR8, or NULL. */
+const part_t *part_list_find(const part_list_t *list, const part_kind_t *kind, uint8_t addr8);
+
+#endif

@@ -1,0 +1,99 @@
+/*
+ * twi.h: the simulator's own model of the AVR TWI, replacing simavr 1.6's
+ * (TWINT not cleared by writing 1, wrong address-phase status codes, bit
+ * rate ignored: see docs/simulator.md, "What simavr 1.6 gets wrong"). It takes
+ * over TWBR/TWSR/TWAR/TWDR/TWCR after avr_init and drives a twi_bus_t.
+ *
+ * Master mode follows the datasheet (status codes 08..58, 38, F8; TWINT,
+ * TWEA, TWSTA, TWSTO, TWWC, TWEN, TWIE). Timing: SCL period
+ * P = 16 + 2*TWBR*4^TWPS cycles; START and STOP take P, a byte with its
+ * acknowledge 9P; TWINT rises at the end.
+ *
+ * Slave mode: every TWI is also a device on the bus (sim_twi_t.dev). With TWEN
+ * and TWEA set it acknowledges its TWAR address (general call not
+ * modelled) and gives the datasheet's slave codes 60/80/88/A0 (receiver)
+ * and A8/B8/C0/C8 (transmitter). Its TWINT rises at the cycle the master's
+ * operation completes (the end of the acknowledge bit, or the STOP /
+ * repeated START); while it is set the slave holds SCL low (twi_bus_hold)
+ * and the master's next operation waits until the firmware clears TWINT,
+ * then takes its normal time from that release (clock stretching).
+ *
+ * Lines (twi_bus.h): with TWEN off the board's SCL/SDA port pins drive the
+ * bus's wired-AND lines (sim_twi_wire_pins). A START waits while SDA is low; an
+ * operation waits while SCL is held low, and one under way when SCL is
+ * held ends one period after the release.
+ */
+#ifndef SIM_TWI_H
+#define SIM_TWI_H
+
+#include <stdint.h>
+
+#include "sim_avr.h"
+#include "sim_io.h"
+#include "sim_interrupts.h"
+
+#include "harness/isr_watch.h"
+#include "periph/sim_mcu.h"
+#include "periph/twi_bus.h"
+
+typedef enum sim_twi_op_t {
+	TWI_OP_NONE = 0,
+	TWI_OP_START,		/* START or repeated START */
+	TWI_OP_STOP,
+	TWI_OP_STOP_START,	/* TWSTO and TWSTA together */
+	TWI_OP_SLA,		/* address byte + ack */
+	TWI_OP_TX,		/* data byte out + ack */
+	TWI_OP_RX,		/* data byte in + master's ack */
+} sim_twi_op_t;
+
+typedef struct sim_twi_t {
+	avr_io_t io;			/* first: reset hook */
+	avr_t *avr;
+	const sim_mcu_twi_t *regs;
+	twi_bus_t *bus;
+	avr_int_vector_t vect_twi;
+	isr_watch_t isr;		/* how long the TWI interrupt runs */
+
+	uint8_t status;			/* TWSR bits 7..3 */
+	int owner;			/* this master holds the bus */
+	sim_twi_op_t op;			/* operation in progress (TWINT low) */
+	int op_ack;			/* RX: TWEA when the byte started */
+	avr_cycle_count_t op_periods;	/* its length in SCL periods */
+	avr_cycle_count_t op_end;	/* the cycle it completes (0: waits for SCL) */
+	twi_bus_master_t master;	/* the bus resumes a waiting operation here */
+
+	/* slave mode */
+	twi_dev_t dev;			/* this TWI as a device on the bus */
+	int addressed;			/* 0, or TWI_SLAVE_RX / TWI_SLAVE_TX */
+	int sl_ea;			/* TWEA when TWINT was last cleared */
+	uint8_t sl_tx;			/* TWDR when TWINT was last cleared (ST) */
+	int sl_pending;			/* a TWINT rise is scheduled */
+	uint8_t sl_status;		/* ... with this status */
+	int sl_has_data;		/* ... and this received byte */
+	uint8_t sl_data;
+	avr_cycle_count_t sl_at;	/* ... at this cycle */
+	uint8_t sl_addr;		/* TWAR address it answered (trace) */
+
+	/* SCL/SDA as port pins while TWEN is off (sim_twi_wire_pins) */
+	twi_pins_t pins;
+	int pins_wired;
+	uint8_t pin_scl, pin_sda;	/* bit numbers */
+	uint8_t pin_ddr, pin_port;	/* shadows of the port's DDR/PORT */
+} sim_twi_t;
+
+#define TWI_SLAVE_RX 1
+#define TWI_SLAVE_TX 2
+
+/* Take over the TWI described by REGS on AVR (after avr_init). */
+void sim_twi_init(sim_twi_t *t, avr_t *avr, const sim_mcu_twi_t *regs, twi_bus_t *bus);
+
+/* The TWI's lines are pins SCL and SDA of port PORT ('C'): while TWEN is
+ * off the firmware drives them as port pins (DDR 1 and PORT 0 pulls the
+ * line low; anything else releases it to the external pull-ups), and the
+ * bus's wired-AND lines hear it. 0, or -1 when the port is not found. */
+int sim_twi_wire_pins(sim_twi_t *t, char port, int scl, int sda);
+
+/* One SCL period in cycles with the current TWBR and TWPS. */
+avr_cycle_count_t sim_twi_scl_period(const sim_twi_t *t);
+
+#endif
