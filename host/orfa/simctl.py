@@ -294,6 +294,16 @@ class SimControl:
         return {"sda": int(w[1]), "scl": int(w[3]), "stuck": int(w[5]),
                 "hold_scl": int(w[7] == "on")}
 
+    def sense(self, addr: int, quantity: str, *values: float) -> None:
+        """What the part at 8-bit bus address `addr` senses: `quantity`
+        ("accel" X Y Z in m/s^2, "gyro" X Y Z in degrees/s, "field" X Y Z in
+        microtesla, "temp" T in degrees C, "pressure" P in Pa, an SRF08's
+        "range" MM [MM2] and "light" N), in physical units; the part reports
+        it in its registers as its datasheet says. SimControlError for a
+        quantity the part does not sense or a value outside its range."""
+        self.request("sense @%02X %s %s" % (addr, quantity,
+                                            " ".join(repr(float(v)) for v in values)))
+
     def srf08_range(self, addr: int, mm: int, mm2: Optional[int] = None) -> None:
         """What the SRF08 at 8-bit address `addr` sees at its next ping: a
         target `mm` millimetres away (0: none), optionally a second one."""

@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -664,6 +665,65 @@ static int req_i2c(control_req_ctx_t *q)
 	return 0;
 }
 
+/* `sense @ADDR QUANTITY V...`: what the part at bus address ADDR (8-bit,
+ * hex: @D0, @0xD0) senses, in physical units (part.h). */
+static int req_sense(control_req_ctx_t *q)
+{
+	char **argv = q->argv;
+	const char *a = argv[1];
+	uint64_t addr;
+	double v[8];
+	char err[160], *end;
+	int n = q->argc - 3;
+	const part_t *p;
+
+	if (*a == '@') {
+		a++;
+	}
+	if (!strncasecmp(a, "0x", 2)) {
+		a += 2;
+	}
+	addr = strtoull(a, &end, 16);
+	if (!*a || *end || addr > 0xFF) {
+		reply_printf(q->r, "ERR sense @ADDR QUANTITY V...: ADDR the part's 8-bit bus"
+			     " address in hex (@D0), not '%s'", argv[1]);
+		return 0;
+	}
+	p = q->c->parts ? part_list_at(q->c->parts, (uint8_t)(addr & 0xFE)) : NULL;
+	if (!p) {
+		reply_printf(q->r, "ERR sense: no part at %02X", (unsigned)addr);
+		return 0;
+	}
+	if (!p->kind->sense) {
+		reply_printf(q->r, "ERR sense: the %s at %02X senses nothing", p->kind->name,
+			     (unsigned)p->addr8);
+		return 0;
+	}
+	if (n > (int)(sizeof(v) / sizeof(v[0]))) {
+		reply_printf(q->r, "ERR sense: too many values");
+		return 0;
+	}
+	for (int i = 0; i < n; i++) {
+		v[i] = strtod(argv[3 + i], &end);
+		if (end == argv[3 + i] || *end || !isfinite(v[i])) {
+			reply_printf(q->r, "ERR sense: '%s' is not a number", argv[3 + i]);
+			return 0;
+		}
+	}
+	if (!part_sense_units(argv[2])) {
+		reply_printf(q->r, "ERR sense: no quantity '%s' (the %s at %02X senses: %s)",
+			     argv[2], p->kind->name, (unsigned)p->addr8, p->kind->senses);
+		return 0;
+	}
+	err[0] = 0;
+	if (p->kind->sense(p->self, q->c->avr->cycle, argv[2], v, n, err, sizeof(err)) < 0) {
+		reply_printf(q->r, "ERR sense: %s", err[0] ? err : "refused");
+		return 0;
+	}
+	reply_printf(q->r, "OK");
+	return 0;
+}
+
 static int req_help(control_req_ctx_t *q);
 
 /* Which boards a request reaches. */
@@ -671,6 +731,7 @@ enum {
 	CONTROL_ANY_BOARD,		/* the gateway, or a slave by @10 or 10/NAME */
 	CONTROL_NAMES_BOARD,		/* ... and its first argument may be 10/NAME */
 	CONTROL_GATEWAY,		/* the gateway's serial line only */
+	CONTROL_PART,			/* @ADDR names a part on the I2C bus, not a board */
 };
 
 /* The requests: name, arguments (the help line), the argument counts it
@@ -705,6 +766,7 @@ static const control_req_t control_reqs[] = {
 	{ "i2c", "[stuck N | hold-scl on|off]", 0, 3, CONTROL_ANY_BOARD, req_i2c },
 	{ "fault", "hang", 2, 2, CONTROL_ANY_BOARD, req_fault },
 	{ "reset", "external|power|brownout", 2, 2, CONTROL_ANY_BOARD, req_reset },
+	{ "sense", "@ADDR QUANTITY V...", 3, CONTROL_MAX_ARGS, CONTROL_PART, req_sense },
 	{ "help", "", 1, 1, CONTROL_ANY_BOARD, req_help },
 };
 
@@ -776,8 +838,14 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 		reply_printf(&r, "ERR too many arguments");
 		return 0;
 	}
-	/* `@10` as the first argument: the request is about slave board 10 */
-	if (argc >= 2 && argv[1][0] == '@') {
+	for (int i = 0; i < CONTROL_NREQS && !e; i++) {
+		if (!strcasecmp(argv[0], control_reqs[i].name)) {
+			e = &control_reqs[i];
+		}
+	}
+	/* `@10` as the first argument: the request is about slave board 10
+	 * (a part's request takes it as the part's bus address) */
+	if (argc >= 2 && argv[1][0] == '@' && !(e && e->boards == CONTROL_PART)) {
 		q.cb = control_board_find(c, argv[1] + 1);
 		if (!q.cb) {
 			reply_printf(&r, "ERR no board '%s' (slave boards: @ and the address, like @10)",
@@ -787,11 +855,6 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 		q.board_given = 1;
 		memmove(&argv[1], &argv[2], (size_t)(argc - 2) * sizeof(argv[0]));
 		argc--;
-	}
-	for (int i = 0; i < CONTROL_NREQS && !e; i++) {
-		if (!strcasecmp(argv[0], control_reqs[i].name)) {
-			e = &control_reqs[i];
-		}
 	}
 	/* A request naming a pin, signal or input may name a slave's: 10/A5. */
 	if (e && e->boards == CONTROL_NAMES_BOARD && argc >= 2 && strchr(argv[1], '/')) {

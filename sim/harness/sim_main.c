@@ -70,8 +70,9 @@ static void sim_usage_kinds(part_attach_t attach)
 		}
 		snprintf(name, sizeof(name), "%s%s%s%s", k->name, *k->options ? "[:" : "", k->options,
 			 *k->options ? "]" : "");
-		fprintf(stderr, "  %-14s %s%s%s\n", name, k->about, k->addrs ? "; at " : "",
-			k->addrs ? k->addrs : "");
+		fprintf(stderr, "  %-14s %s%s%s%s%s\n", name, k->about, k->addrs ? "; at " : "",
+			k->addrs ? k->addrs : "", k->senses ? "; senses " : "",
+			k->senses ? k->senses : "");
 	}
 }
 

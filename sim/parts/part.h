@@ -78,7 +78,21 @@ typedef struct part_kind_t {
 	int (*init)(void *self, const part_env_t *env, const char *opts, const char **err);
 	const part_request_t *requests;
 	int nrequests;
+	/* What it senses (NULL: nothing), set by the control request `sense
+	 * @ADDR QUANTITY V...`: QUANTITY ("accel", "gyro", "field", "temp",
+	 * "pressure", "range", ...) with its N values in physical units (m/s^2,
+	 * degrees/s, microtesla, degrees C, Pa, ...; part_sense_units), at
+	 * cycle NOW. 0, or -1 with ERR (CAP bytes) saying why: a quantity the
+	 * part does not sense, the wrong number of values, a value outside
+	 * the part's range. */
+	int (*sense)(void *self, uint64_t now, const char *quantity, const double *v, int n,
+		     char *err, size_t cap);
+	const char *senses;		/* its quantities for --help: "accel gyro temp" */
 } part_kind_t;
+
+/* The quantities `sense` knows and their units, for help and errors:
+ * "accel" -> "m/s^2", NULL for an unknown one. */
+const char *part_sense_units(const char *quantity);
 
 /* The registry: every kind, NULL-terminated. */
 extern const part_kind_t *const part_kinds[];
@@ -95,6 +109,9 @@ void *part_make(const part_kind_t *kind, const part_env_t *env, const char *opts
 
 /* Add a made part to LIST. 0, or -1 when full. */
 int part_list_add(part_list_t *list, const part_kind_t *kind, void *self, uint8_t addr8);
+
+/* The I2C part at ADDR8 in LIST, whatever its kind, or NULL. */
+const part_t *part_list_at(const part_list_t *list, uint8_t addr8);
 
 /* The part of KIND in LIST at ADDR8, or NULL. */
 const part_t *part_list_find(const part_list_t *list, const part_kind_t *kind, uint8_t addr8);

@@ -73,6 +73,32 @@ int part_list_add(part_list_t *list, const part_kind_t *kind, void *self, uint8_
 	return 0;
 }
 
+const part_t *part_list_at(const part_list_t *list, uint8_t addr8)
+{
+	for (int i = 0; i < list->n; i++) {
+		if (list->item[i].kind->attach == PART_I2C && list->item[i].addr8 == addr8) {
+			return &list->item[i];
+		}
+	}
+	return NULL;
+}
+
+const char *part_sense_units(const char *quantity)
+{
+	static const char *const units[][2] = {
+		{ "accel", "m/s^2" }, { "gyro", "degrees/s" }, { "field", "microtesla" },
+		{ "temp", "degrees C" }, { "pressure", "Pa" }, { "range", "mm" },
+		{ "light", "0..255" },
+	};
+
+	for (size_t i = 0; i < sizeof(units) / sizeof(units[0]); i++) {
+		if (strcmp(units[i][0], quantity) == 0) {
+			return units[i][1];
+		}
+	}
+	return NULL;
+}
+
 const part_t *part_list_find(const part_list_t *list, const part_kind_t *kind, uint8_t addr8)
 {
 	for (int i = 0; i < list->n; i++) {

@@ -394,6 +394,38 @@ static int srf08_part_init(void *self, const part_env_t *env, const char *opts,
 	return 0;
 }
 
+/* `sense @E0 range MM [MM2]` (millimetres, 0: nothing there), `sense @E0
+ * light N` (0..255): the same as the `srf08` request's. */
+static int srf08_sense(void *self, uint64_t now, const char *quantity, const double *v, int n,
+		       char *err, size_t cap)
+{
+	srf08_t *s = self;
+
+	(void)now;
+	if (!strcmp(quantity, "range") && (n == 1 || n == 2)) {
+		for (int i = 0; i < n; i++) {
+			if (v[i] < 0 || v[i] > SRF08_CTL_MAX_MM) {
+				snprintf(err, cap, "range MM [MM2]: 0..%u mm (0: nothing there)",
+					 SRF08_CTL_MAX_MM);
+				return -1;
+			}
+		}
+		srf08_set_targets(s, (uint32_t)(v[0] + 0.5), n == 2 ? (uint32_t)(v[1] + 0.5) : 0);
+		return 0;
+	}
+	if (!strcmp(quantity, "light") && n == 1) {
+		if (v[0] < 0 || v[0] > 255) {
+			snprintf(err, cap, "light N: 0..255");
+			return -1;
+		}
+		srf08_set_light(s, (uint8_t)(v[0] + 0.5));
+		return 0;
+	}
+	snprintf(err, cap, "an SRF08 senses range MM [MM2] and light N, not %s with %d value%s",
+		 quantity, n, n == 1 ? "" : "s");
+	return -1;
+}
+
 static const part_request_t srf08_requests[] = {
 	{ "srf08", "ADDR [range MM [MM2] | light N]", srf08_control },
 };
@@ -409,4 +441,6 @@ const part_kind_t srf08_kind = {
 	.init = srf08_part_init,
 	.requests = srf08_requests,
 	.nrequests = 1,
+	.sense = srf08_sense,
+	.senses = "range, light",
 };

@@ -11,6 +11,8 @@ SRF08 does not answer the bus (the gateway: ERROR 06, address not
 acknowledged). The simulator's speed of sound is 343.75 m/s.
 """
 
+import re
+
 import pytest
 
 from orfa.sim import BOARDS, SimBoard
@@ -202,3 +204,42 @@ def test_control_errors(srf):
     assert ctl.srf08(SRF)["range"] == (500, 900)
     assert ctl.request("srf08 0xE0 light 5") == "OK"
     assert ctl.srf08(SRF)["light"] == 5
+
+
+def test_sense_sets_what_the_srf08_sees(srf):
+    """The generic `sense @ADDR QUANTITY V...` reaches the same state as the
+    `srf08` request, and the ranger measures it."""
+    ctl = srf.ctl
+    assert ctl.request("sense @E0 range 1234") == "OK"
+    assert ctl.request("sense @0xE0 light 77") == "OK"
+    assert ctl.srf08(SRF)["range"] == (1234, 0) and ctl.srf08(SRF)["light"] == 77
+    assert srf.ask("S E0 00 51 P") == b"SWAAP\r\n"
+    ctl.wait(MS65)
+    assert srf.ask("S E0 01 S E1 03 P") == b"SWASR4D007BP\r\n"   # light 77, 123 cm
+    assert ctl.request("sense @E0 range 500 900") == "OK"
+    assert ctl.srf08(SRF)["range"] == (500, 900)
+
+
+@pytest.mark.parametrize("bad, says", [
+    ("sense @E0 accel 0 0 9.8", "an SRF08 senses range"),
+    ("sense @E0 range -1", "0..100000 mm"),
+    ("sense @E0 range 1 2 3", "an SRF08 senses range"),
+    ("sense @E0 light 256", "0..255"),
+    ("sense @E0 range x", "'x' is not a number"),
+    ("sense @E0 range nan", "'nan' is not a number"),
+    ("sense @E0 bogus 1", "no quantity 'bogus'"),
+    ("sense @E4 range 5", "no part at E4"),
+    ("sense @ZZ range 5", "ADDR the part's 8-bit bus address"),
+    ("sense @E0", "unknown request or wrong arguments"),
+])
+def test_sense_errors(srf, bad, says):
+    with pytest.raises(SimControlError, match="^ERR .*" + re.escape(says)):
+        srf.ctl.request(bad)
+    assert srf.ctl.srf08(SRF)["range"] == (0, 0)      # nothing changed
+
+
+def test_sense_from_python(srf):
+    srf.ctl.sense(SRF, "range", 2000, 800)
+    assert srf.ctl.srf08(SRF)["range"] == (2000, 800)
+    with pytest.raises(SimControlError, match="0..255"):
+        srf.ctl.sense(SRF, "light", 300)
