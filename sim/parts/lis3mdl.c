@@ -137,7 +137,10 @@ static void lis3mdl_sample(lis3mdl_t *l)
 
 static void lis3mdl_catch_up(lis3mdl_t *l, uint64_t now)
 {
-	if (part_ticker_take(&l->meas, l->hz, now)) {
+	uint64_t n = part_ticker_take(&l->meas, l->hz, now);
+
+	/* two samples or more: the last overwrote one nobody read (overrun) */
+	for (uint64_t i = n < 2 ? n : 2; i; i--) {
 		lis3mdl_sample(l);
 	}
 	if ((l->reg[LIS3MDL_CTRL_REG3] & 3) == LIS3MDL_MD_SINGLE && l->meas.limit &&
