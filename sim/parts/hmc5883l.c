@@ -46,7 +46,7 @@
 #include <string.h>
 
 #include "parts/part.h"
-#include "periph/twi_bus.h"
+#include "parts/regdev.h"
 
 enum {
 	HMC5883L_CRA = 0,
@@ -75,13 +75,8 @@ static const uint32_t hmc5883l_rate_mhz[8] = { 750, 1500, 3000, 7500, 15000, 300
 static const double hmc5883l_bias[3] = { 1.16, 1.16, 1.08 };
 
 typedef struct hmc5883l_t {
-	twi_dev_t dev;			/* first: the bus's view */
-	const twi_bus_t *bus;
-	uint32_t hz;
-	uint8_t addr8;
+	regdev_t rd;			/* first: the bus's view, the pointer */
 	uint8_t reg[3];			/* CRA, CRB, mode */
-	uint8_t ptr;
-	uint8_t selected, want_ptr;
 	int16_t out[3];			/* data registers: X, Z, Y */
 	int16_t pending[3];		/* a result held back by LOCK */
 	uint8_t has_pending, rdy, lock;
@@ -124,9 +119,10 @@ static void hmc5883l_measure(hmc5883l_t *h)
 	}
 }
 
-static void hmc5883l_catch_up(hmc5883l_t *h, uint64_t now)
+static void hmc5883l_catch_up(regdev_t *d, uint64_t now)
 {
-	uint64_t n = part_ticker_take(&h->meas, h->hz, now);
+	hmc5883l_t *h = (hmc5883l_t *)d;
+	uint64_t n = part_ticker_take(&h->meas, h->rd.hz, now);
 
 	if (n > 2) {
 		n = 2;		/* only the last two can differ (the gain rule) */
@@ -144,7 +140,7 @@ static void hmc5883l_catch_up(hmc5883l_t *h, uint64_t now)
 static void hmc5883l_schedule(hmc5883l_t *h, uint64_t now, uint32_t first_us)
 {
 	int md = h->reg[HMC5883L_MODE] & 3;
-	uint64_t first = now + part_us(h->hz, first_us);
+	uint64_t first = now + part_us(h->rd.hz, first_us);
 
 	if (md == 0) {
 		part_ticker_start(&h->meas, first, hmc5883l_rate_mhz[(h->reg[HMC5883L_CRA] >> 2) & 7],
@@ -167,16 +163,17 @@ static void hmc5883l_unlock(hmc5883l_t *h)
 
 static uint8_t hmc5883l_status(const hmc5883l_t *h)
 {
-	uint64_t next = part_ticker_next(&h->meas, h->hz);
-	uint64_t now = h->bus->cycle;
+	uint64_t next = part_ticker_next(&h->meas, h->rd.hz);
+	uint64_t now = h->rd.bus->cycle;
 	int writing = !h->lock && next != UINT64_MAX &&
-		      now + part_us(h->hz, HMC5883L_RDY_LOW_US) >= next;
+		      now + part_us(h->rd.hz, HMC5883L_RDY_LOW_US) >= next;
 
 	return (uint8_t)((h->rdy && !writing ? HMC5883L_RDY : 0) | (h->lock ? HMC5883L_LOCK : 0));
 }
 
-static uint8_t hmc5883l_reg_read(hmc5883l_t *h, uint8_t r)
+static uint8_t hmc5883l_reg_read(regdev_t *d, uint8_t r)
 {
+	hmc5883l_t *h = (hmc5883l_t *)d;
 	static const char id[3] = { 'H', '4', '3' };
 
 	if (r <= HMC5883L_MODE) {
@@ -208,14 +205,15 @@ static uint8_t hmc5883l_reg_read(hmc5883l_t *h, uint8_t r)
 	return 0;
 }
 
-static void hmc5883l_reg_write(hmc5883l_t *h, uint8_t r, uint8_t v)
+static void hmc5883l_reg_write(regdev_t *d, uint8_t r, uint8_t v)
 {
-	uint64_t now = h->bus->cycle;
+	hmc5883l_t *h = (hmc5883l_t *)d;
+	uint64_t now = h->rd.bus->cycle;
 
 	if (r > HMC5883L_MODE) {
 		return;		/* read-only or invalid: ignored */
 	}
-	hmc5883l_catch_up(h, now);
+	hmc5883l_catch_up(&h->rd, now);
 	h->reg[r] = v & hmc5883l_writable[r];
 	if (r == HMC5883L_CRA || r == HMC5883L_MODE) {
 		hmc5883l_unlock(h);
@@ -232,62 +230,12 @@ static uint8_t hmc5883l_next(uint8_t r)
 	return r >= HMC5883L_ID_END ? 0 : (uint8_t)(r + 1);
 }
 
-static int hmc5883l_start(twi_dev_t *dev, uint8_t addr8)
-{
-	hmc5883l_t *h = (hmc5883l_t *)dev;
-
-	h->selected = (addr8 & 0xfe) == h->addr8;
-	h->want_ptr = h->selected && !(addr8 & 1);
-	if (h->selected) {
-		hmc5883l_catch_up(h, h->bus->cycle);
-	}
-	return h->selected;
-}
-
-static int hmc5883l_write(twi_dev_t *dev, uint8_t byte)
-{
-	hmc5883l_t *h = (hmc5883l_t *)dev;
-
-	if (!h->selected) {
-		return 0;
-	}
-	if (h->want_ptr) {
-		h->want_ptr = 0;
-		h->ptr = byte;
-		return 1;
-	}
-	hmc5883l_reg_write(h, h->ptr, byte);
-	h->ptr = hmc5883l_next(h->ptr);
-	return 1;
-}
-
-static uint8_t hmc5883l_read(twi_dev_t *dev, int master_acks)
-{
-	hmc5883l_t *h = (hmc5883l_t *)dev;
-	uint8_t v;
-
-	(void)master_acks;
-	if (!h->selected) {
-		return 0xff;
-	}
-	v = hmc5883l_reg_read(h, h->ptr);
-	h->ptr = hmc5883l_next(h->ptr);
-	return v;
-}
-
-static void hmc5883l_stop(twi_dev_t *dev)
-{
-	hmc5883l_t *h = (hmc5883l_t *)dev;
-
-	h->selected = 0;
-	h->want_ptr = 0;
-}
-
-static const twi_dev_ops_t hmc5883l_ops = {
-	.start = hmc5883l_start,
-	.write = hmc5883l_write,
-	.read = hmc5883l_read,
-	.stop = hmc5883l_stop,
+static const regdev_ops_t hmc5883l_rd_ops = {
+	.catch_up = hmc5883l_catch_up,
+	.read = hmc5883l_reg_read,
+	.write = hmc5883l_reg_write,
+	.next = hmc5883l_next,
+	.ptr_mask = 0xFF,
 };
 
 /* --- descriptor ------------------------------------------------------------ */
@@ -306,11 +254,7 @@ static int hmc5883l_part_init(void *self, const part_env_t *env, const char *opt
 		*err = "no options";
 		return -1;
 	}
-	h->dev.ops = &hmc5883l_ops;
-	h->dev.name = "hmc5883l";
-	h->bus = env->bus;
-	h->hz = env->hz;
-	h->addr8 = env->addr8 & 0xfe;
+	regdev_init(&h->rd, env, "hmc5883l", &hmc5883l_rd_ops);
 	h->reg[HMC5883L_CRA] = 0x10;
 	h->reg[HMC5883L_CRB] = 0x20;
 	h->reg[HMC5883L_MODE] = HMC5883L_MD_SINGLE;
@@ -332,7 +276,7 @@ static int hmc5883l_sense(void *self, uint64_t now, const char *quantity, const 
 	if (part_sense_pick("an HMC5883L", hmc5883l_senses, 1, quantity, v, n, err, cap) < 0) {
 		return -1;
 	}
-	hmc5883l_catch_up(h, now);
+	hmc5883l_catch_up(&h->rd, now);
 	memcpy(h->field, v, sizeof(h->field));
 	return 0;
 }

@@ -49,7 +49,7 @@
 #include <string.h>
 
 #include "parts/part.h"
-#include "periph/twi_bus.h"
+#include "parts/regdev.h"
 
 enum {
 	LIS3MDL_WHO_AM_I = 0x0F,
@@ -78,7 +78,6 @@ enum {
 #define LIS3MDL_MD_OFF 0x03
 #define LIS3MDL_BLE 0x02
 #define LIS3MDL_BDU 0x40
-#define LIS3MDL_SUB_INC 0x80		/* SUB bit 7 */
 
 /* Reset values and the bits a master may write, by register. */
 static const uint8_t lis3mdl_reset[LIS3MDL_NREGS] = {
@@ -95,13 +94,8 @@ static const uint32_t lis3mdl_odr_mhz[8] = { 625, 1250, 2500, 5000, 10000, 20000
 static const uint32_t lis3mdl_fast_mhz[4] = { 1000000, 560000, 300000, 155000 };
 
 typedef struct lis3mdl_t {
-	twi_dev_t dev;			/* first: the bus's view */
-	const twi_bus_t *bus;
-	uint32_t hz;
-	uint8_t addr8;
+	regdev_t rd;			/* first: the bus's view, the pointer */
 	uint8_t reg[LIS3MDL_NREGS];	/* control registers as written */
-	uint8_t ptr;
-	uint8_t selected, want_ptr;
 	int16_t out[3], temp_out;
 	uint8_t status;
 	uint8_t bytes_read;		/* output bytes read, bit per byte, an axis's
@@ -135,9 +129,10 @@ static void lis3mdl_sample(lis3mdl_t *l)
 	}
 }
 
-static void lis3mdl_catch_up(lis3mdl_t *l, uint64_t now)
+static void lis3mdl_catch_up(regdev_t *d, uint64_t now)
 {
-	uint64_t n = part_ticker_take(&l->meas, l->hz, now);
+	lis3mdl_t *l = (lis3mdl_t *)d;
+	uint64_t n = part_ticker_take(&l->meas, l->rd.hz, now);
 
 	/* two samples or more: the last overwrote one nobody read (overrun) */
 	for (uint64_t i = n < 2 ? n : 2; i; i--) {
@@ -164,7 +159,7 @@ static void lis3mdl_schedule(lis3mdl_t *l, uint64_t now)
 		part_ticker_stop(&l->meas);
 		return;
 	}
-	part_ticker_start(&l->meas, now + ((uint64_t)l->hz * 1000u + mhz - 1) / mhz, mhz,
+	part_ticker_start(&l->meas, now + ((uint64_t)l->rd.hz * 1000u + mhz - 1) / mhz, mhz,
 			  (r3 & 3) == LIS3MDL_MD_SINGLE ? 1 : 0);
 }
 
@@ -201,8 +196,9 @@ static uint8_t lis3mdl_out_byte(lis3mdl_t *l, uint8_t r)
 	return high ? (uint8_t)(w >> 8) : (uint8_t)w;
 }
 
-static uint8_t lis3mdl_reg_read(lis3mdl_t *l, uint8_t r)
+static uint8_t lis3mdl_reg_read(regdev_t *d, uint8_t r)
 {
+	lis3mdl_t *l = (lis3mdl_t *)d;
 	if (r == LIS3MDL_WHO_AM_I) {
 		return LIS3MDL_ID;
 	}
@@ -217,14 +213,15 @@ static uint8_t lis3mdl_reg_read(lis3mdl_t *l, uint8_t r)
 	return r < LIS3MDL_NREGS ? l->reg[r] : 0;
 }
 
-static void lis3mdl_reg_write(lis3mdl_t *l, uint8_t r, uint8_t v)
+static void lis3mdl_reg_write(regdev_t *d, uint8_t r, uint8_t v)
 {
-	uint64_t now = l->bus->cycle;
+	lis3mdl_t *l = (lis3mdl_t *)d;
+	uint64_t now = l->rd.bus->cycle;
 
 	if (r >= LIS3MDL_NREGS || !lis3mdl_writable[r]) {
 		return;
 	}
-	lis3mdl_catch_up(l, now);
+	lis3mdl_catch_up(&l->rd, now);
 	if (r == LIS3MDL_CTRL_REG2 && (v & LIS3MDL_SOFT_RST)) {
 		lis3mdl_reset_regs(l);
 		return;
@@ -244,62 +241,12 @@ static uint8_t lis3mdl_next(uint8_t r)
 	return r == LIS3MDL_OUT_Z_H ? LIS3MDL_OUT_X_L : (uint8_t)((r + 1) & 0x7F);
 }
 
-static int lis3mdl_start(twi_dev_t *dev, uint8_t addr8)
-{
-	lis3mdl_t *l = (lis3mdl_t *)dev;
-
-	l->selected = (addr8 & 0xfe) == l->addr8;
-	l->want_ptr = l->selected && !(addr8 & 1);
-	if (l->selected) {
-		lis3mdl_catch_up(l, l->bus->cycle);
-	}
-	return l->selected;
-}
-
-static int lis3mdl_write(twi_dev_t *dev, uint8_t byte)
-{
-	lis3mdl_t *l = (lis3mdl_t *)dev;
-
-	if (!l->selected) {
-		return 0;
-	}
-	if (l->want_ptr) {
-		l->want_ptr = 0;
-		l->ptr = byte & (uint8_t)~LIS3MDL_SUB_INC;
-		return 1;
-	}
-	lis3mdl_reg_write(l, l->ptr, byte);
-	l->ptr = lis3mdl_next(l->ptr);
-	return 1;
-}
-
-static uint8_t lis3mdl_read(twi_dev_t *dev, int master_acks)
-{
-	lis3mdl_t *l = (lis3mdl_t *)dev;
-	uint8_t v;
-
-	(void)master_acks;
-	if (!l->selected) {
-		return 0xff;
-	}
-	v = lis3mdl_reg_read(l, l->ptr);
-	l->ptr = lis3mdl_next(l->ptr);
-	return v;
-}
-
-static void lis3mdl_stop(twi_dev_t *dev)
-{
-	lis3mdl_t *l = (lis3mdl_t *)dev;
-
-	l->selected = 0;
-	l->want_ptr = 0;
-}
-
-static const twi_dev_ops_t lis3mdl_ops = {
-	.start = lis3mdl_start,
-	.write = lis3mdl_write,
-	.read = lis3mdl_read,
-	.stop = lis3mdl_stop,
+static const regdev_ops_t lis3mdl_rd_ops = {
+	.catch_up = lis3mdl_catch_up,
+	.read = lis3mdl_reg_read,
+	.write = lis3mdl_reg_write,
+	.next = lis3mdl_next,
+	.ptr_mask = 0x7F,		/* SUB bit 7 ignored: the silicon */
 };
 
 /* --- descriptor ------------------------------------------------------------ */
@@ -318,11 +265,7 @@ static int lis3mdl_part_init(void *self, const part_env_t *env, const char *opts
 		*err = "no options";
 		return -1;
 	}
-	l->dev.ops = &lis3mdl_ops;
-	l->dev.name = "lis3mdl";
-	l->bus = env->bus;
-	l->hz = env->hz;
-	l->addr8 = env->addr8 & 0xfe;
+	regdev_init(&l->rd, env, "lis3mdl", &lis3mdl_rd_ops);
 	l->temp = 25.0;
 	lis3mdl_reset_regs(l);
 	return 0;
@@ -343,7 +286,7 @@ static int lis3mdl_sense(void *self, uint64_t now, const char *quantity, const d
 	if (i < 0) {
 		return -1;
 	}
-	lis3mdl_catch_up(l, now);
+	lis3mdl_catch_up(&l->rd, now);
 	memcpy(i == 0 ? l->field : &l->temp, v, (size_t)n * sizeof(*v));
 	return 0;
 }

@@ -52,7 +52,7 @@
 #include <string.h>
 
 #include "parts/part.h"
-#include "periph/twi_bus.h"
+#include "parts/regdev.h"
 
 enum {
 	MPU6050_SELF_TEST_X = 0x0D,
@@ -113,13 +113,8 @@ static const double mpu6050_gyro_lsb[4] = { 131.0, 65.5, 32.8, 16.4 };
 static const uint32_t mpu6050_wake_mhz[4] = { 1250, 5000, 20000, 40000 };
 
 typedef struct mpu6050_t {
-	twi_dev_t dev;			/* first: the bus's view */
-	const twi_bus_t *bus;		/* its `cycle` is the time of an event */
-	uint32_t hz;
-	uint8_t addr8;
+	regdev_t rd;			/* first: the bus's view, the pointer */
 	uint8_t reg[MPU6050_NREGS];	/* the R/W registers as written */
-	uint8_t ptr;			/* register address */
-	uint8_t selected, want_ptr;
 	int16_t accel_out[3], temp_out, gyro_out[3];	/* the sensor registers */
 	uint8_t int_status;
 	part_ticker_t sampler;		/* the sample clock */
@@ -152,9 +147,10 @@ static void mpu6050_sample(mpu6050_t *m)
 }
 
 /* The samples due by cycle NOW: the last of them is in the registers. */
-static void mpu6050_catch_up(mpu6050_t *m, uint64_t now)
+static void mpu6050_catch_up(regdev_t *d, uint64_t now)
 {
-	if (part_ticker_take(&m->sampler, m->hz, now)) {
+	mpu6050_t *m = (mpu6050_t *)d;
+	if (part_ticker_take(&m->sampler, m->rd.hz, now)) {
 		mpu6050_sample(m);
 	}
 }
@@ -178,7 +174,7 @@ static void mpu6050_clock(mpu6050_t *m, uint64_t now)
 		mhz = (dlpf == 0 || dlpf == 7 ? 8000000u : 1000000u) /
 		      (1u + m->reg[MPU6050_SMPLRT_DIV]);
 	}
-	part_ticker_start(&m->sampler, now + ((uint64_t)m->hz * 1000u + mhz - 1) / mhz, mhz, 0);
+	part_ticker_start(&m->sampler, now + ((uint64_t)m->rd.hz * 1000u + mhz - 1) / mhz, mhz, 0);
 }
 
 static void mpu6050_reset(mpu6050_t *m)
@@ -193,8 +189,9 @@ static void mpu6050_reset(mpu6050_t *m)
 	part_ticker_stop(&m->sampler);
 }
 
-static uint8_t mpu6050_reg_read(mpu6050_t *m, uint8_t r)
+static uint8_t mpu6050_reg_read(regdev_t *d, uint8_t r)
 {
+	mpu6050_t *m = (mpu6050_t *)d;
 	uint8_t v;
 
 	if (r >= MPU6050_ACCEL_XOUT_H && r <= MPU6050_GYRO_ZOUT_L) {
@@ -218,14 +215,15 @@ static uint8_t mpu6050_reg_read(mpu6050_t *m, uint8_t r)
 	return v;
 }
 
-static void mpu6050_reg_write(mpu6050_t *m, uint8_t r, uint8_t v)
+static void mpu6050_reg_write(regdev_t *d, uint8_t r, uint8_t v)
 {
-	uint64_t now = m->bus->cycle;
+	mpu6050_t *m = (mpu6050_t *)d;
+	uint64_t now = m->rd.bus->cycle;
 
 	if (r >= MPU6050_NREGS || !mpu6050_rw[r]) {
 		return;
 	}
-	mpu6050_catch_up(m, now);
+	mpu6050_catch_up(&m->rd, now);
 	if (r == MPU6050_PWR_MGMT_1 && (v & MPU6050_DEVICE_RESET)) {
 		mpu6050_reset(m);
 		return;
@@ -245,56 +243,12 @@ static void mpu6050_reg_write(mpu6050_t *m, uint8_t r, uint8_t v)
 	}
 }
 
-static int mpu6050_start(twi_dev_t *dev, uint8_t addr8)
-{
-	mpu6050_t *m = (mpu6050_t *)dev;
-
-	m->selected = (addr8 & 0xfe) == m->addr8;
-	m->want_ptr = m->selected && !(addr8 & 1);
-	if (m->selected) {
-		/* the sensor registers change only between transfers */
-		mpu6050_catch_up(m, m->bus->cycle);
-	}
-	return m->selected;
-}
-
-static int mpu6050_write(twi_dev_t *dev, uint8_t byte)
-{
-	mpu6050_t *m = (mpu6050_t *)dev;
-
-	if (!m->selected) {
-		return 0;
-	}
-	if (m->want_ptr) {
-		m->want_ptr = 0;
-		m->ptr = byte;
-		return 1;
-	}
-	mpu6050_reg_write(m, m->ptr++, byte);
-	return 1;
-}
-
-static uint8_t mpu6050_read(twi_dev_t *dev, int master_acks)
-{
-	mpu6050_t *m = (mpu6050_t *)dev;
-
-	(void)master_acks;
-	return m->selected ? mpu6050_reg_read(m, m->ptr++) : 0xff;
-}
-
-static void mpu6050_stop(twi_dev_t *dev)
-{
-	mpu6050_t *m = (mpu6050_t *)dev;
-
-	m->selected = 0;
-	m->want_ptr = 0;
-}
-
-static const twi_dev_ops_t mpu6050_ops = {
-	.start = mpu6050_start,
-	.write = mpu6050_write,
-	.read = mpu6050_read,
-	.stop = mpu6050_stop,
+static const regdev_ops_t mpu6050_rd_ops = {
+	.catch_up = mpu6050_catch_up,
+	.read = mpu6050_reg_read,
+	.write = mpu6050_reg_write,
+	.next = NULL,
+	.ptr_mask = 0xFF,
 };
 
 /* --- descriptor ------------------------------------------------------------ */
@@ -313,11 +267,7 @@ static int mpu6050_part_init(void *self, const part_env_t *env, const char *opts
 		*err = "no options";
 		return -1;
 	}
-	m->dev.ops = &mpu6050_ops;
-	m->dev.name = "mpu6050";
-	m->bus = env->bus;
-	m->hz = env->hz;
-	m->addr8 = env->addr8 & 0xfe;
+	regdev_init(&m->rd, env, "mpu6050", &mpu6050_rd_ops);
 	m->temp = 25.0;
 	mpu6050_reset(m);
 	return 0;
@@ -339,7 +289,7 @@ static int mpu6050_sense(void *self, uint64_t now, const char *quantity, const d
 	if (i < 0) {
 		return -1;
 	}
-	mpu6050_catch_up(m, now);	/* samples before NOW saw the old values */
+	mpu6050_catch_up(&m->rd, now);	/* samples before NOW saw the old values */
 	memcpy(i == 0 ? m->accel : i == 1 ? m->gyro : &m->temp, v, (size_t)n * sizeof(*v));
 	return 0;
 }
