@@ -78,14 +78,24 @@ static uint8_t status_now(void)
 	return st;
 }
 
+/* Selects `reg` for a check at file:line, which fails if no driver maps it. */
+static bool select_at(const char *file, int line, uint8_t reg)
+{
+	if (regmap_select(reg)) {
+		return true;
+	}
+	char what[40];
+	snprintf(what, sizeof what, "register %02X not mapped", reg);
+	check_at(file, line, 0, what);
+	return false;
+}
+
 void write_at(const char *file, int line, uint8_t reg, const char *hex, reg_status_t status)
 {
 	uint8_t data[256];
 	unsigned n = parse_hex(hex, data, sizeof data);
 	char what[700];
-	if (!regmap_select(reg)) {
-		snprintf(what, sizeof what, "register %02X not mapped", reg);
-		check_at(file, line, 0, what);
+	if (!select_at(file, line, reg)) {
 		return;
 	}
 	reg_status_t got = regmap_write(data, (uint8_t)n);
@@ -102,9 +112,7 @@ void read_at(const char *file, int line, uint8_t reg, uint8_t n, const char *hex
 	unsigned wn = parse_hex(hex, want, sizeof want);
 	memset(got, 0xEE, sizeof got);
 	char what[1200], g[800];
-	if (!regmap_select(reg)) {
-		snprintf(what, sizeof what, "register %02X not mapped", reg);
-		check_at(file, line, 0, what);
+	if (!select_at(file, line, reg)) {
 		return;
 	}
 	reg_status_t r = read_n(got, n);
@@ -121,9 +129,7 @@ void unreadable_at(const char *file, int line, uint8_t reg, uint8_t n)
 	uint8_t got[256];
 	memset(got, 0xEE, sizeof got);
 	char what[200];
-	if (!regmap_select(reg)) {
-		snprintf(what, sizeof what, "register %02X not mapped", reg);
-		check_at(file, line, 0, what);
+	if (!select_at(file, line, reg)) {
 		return;
 	}
 	reg_status_t r = read_n(got, n);
