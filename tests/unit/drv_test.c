@@ -194,8 +194,8 @@ void same_at(const char *file, int line, const snap_t *before)
 	free(now);
 }
 
-void refused_at(const char *file, int line, uint8_t reg, reg_status_t status,
-		const char *const *hex)
+void refused_writes_at(const char *file, int line, uint8_t reg, reg_status_t status,
+		       const char *const *hex)
 {
 	snap_t *before = malloc(sizeof *before);
 	snap_take(before);
