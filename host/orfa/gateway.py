@@ -497,12 +497,16 @@ class Gateway:
     # --- the sys driver and the status register, by address ----------------------
     # Shorthands for scripts that hold a Gateway: each is the Board's call
     # (orfa.board) for that address (None: the gateway itself).
+    #: What board() makes: orfa.board.Board, which sets itself here when it
+    #: is imported (the board layer sits above this one; importing orfa
+    #: imports it).
+    board_class: Optional[Callable[["Gateway", Optional[int]], object]] = None
+
     def board(self, addr: Optional[int] = None):
         """The Board at addr (None: the gateway's own drivers), kept per address."""
-        from .board import Board                 # board.py imports this module
         key = self.local if addr is None else addr & 0xFE
         if key not in self._boards:
-            self._boards[key] = Board(self, None if key == self.local else key)
+            self._boards[key] = self.board_class(self, None if key == self.local else key)
         return self._boards[key]
 
     def reset_cause(self, addr: Optional[int] = None) -> FrozenSet[str]:

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 from . import locate
+from .errors import SimError
 from .gateway import Gateway
 from .protocol import AUTOBAUD_PREAMBLE, DEFAULT_BAUD, F_CPU, autobaud_wait_s
 from .simctl import SimControl
@@ -35,10 +36,6 @@ sim_path = locate.sim_path
 firmware_path = locate.firmware_path
 slave_firmware_path = locate.slave_firmware_path
 missing_builds = locate.missing_builds
-
-
-class SimError(RuntimeError):
-    """The simulator could not be started or died."""
 
 
 class TraceEvent(NamedTuple):

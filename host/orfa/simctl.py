@@ -10,6 +10,7 @@ import socket
 import time
 from typing import Dict, List, Optional, Tuple, Union
 
+from .errors import SimControlError
 
 #: Bytes one `rx` request carries at most here: its hex fits a request line
 #: (1023 characters) with any cycle.
@@ -21,10 +22,6 @@ def parse_edges(reply: str) -> List[Tuple[int, int]]:
     if reply == "-":
         return []
     return [(int(c), int(lv)) for c, lv in (item.split(":") for item in reply.split())]
-
-
-class SimControlError(RuntimeError):
-    """The simulator refused a request (its ``ERR ...`` text)."""
 
 
 class SimControl:

@@ -10,7 +10,7 @@ import os
 from typing import Iterator, List, Optional
 
 from .. import protocol as p
-from ..errors import explain  # noqa: F401 (the commands' one-line errors)
+from ..errors import UsageError, explain  # noqa: F401 (the commands' errors, one line each)
 from ..gateway import Gateway, os_reason
 from ..sim import BOARDS, SimBoard, SimError
 
@@ -22,10 +22,6 @@ ADDRESS_RULE = ("Addresses are the protocol's 8-bit form (0xA0, 0x10, the gatewa
                 " own 0xAA: even, bit 0 is the R/W bit), as in requests and everywhere"
                 " else in ORFA; with --7bit they are i2c-tools' 7-bit form (0x50, 0x08,"
                 " 0x55), 8-bit = 7-bit << 1.")
-
-
-class UsageError(Exception):
-    """A mistake on the command line found after parsing: exit status 2."""
 
 
 def number(text: str) -> int:
@@ -134,9 +130,54 @@ def open_gateway(url: str, args) -> Gateway:
         raise UsageError("cannot open %s: %s" % (url, os_reason(exc, errno=False))) from None
 
 
+def slave_spec(text: str):
+    """`BOARD:ADDR[:ELF]` -> (board, addr, elf or None: the board's slave build)."""
+    parts = text.split(":", 2)
+    if len(parts) < 2 or parts[0] not in BOARDS:
+        raise argparse.ArgumentTypeError(
+            "%r: BOARD:ADDR[:ELF] with BOARD one of %s" % (text, ", ".join(BOARDS)))
+    try:
+        addr = int(parts[1], 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0x10" % text) from None
+    _check_device_address(text, addr)
+    return (parts[0], addr, parts[2] if len(parts) == 3 and parts[2] else None)
+
+
+def eeprom_spec(text: str) -> int:
+    """`ADDR` of --eeprom, checked as --slave's is."""
+    try:
+        addr = int(text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0xA0" % text) from None
+    _check_device_address(text, addr)
+    return addr
+
+
+def _check_device_address(text: str, addr: int) -> None:
+    """A simulated device's 8-bit bus address: even, outside the addresses
+    I2C reserves, and not the gateway's own (its requests never reach the bus)."""
+    if addr & 1 or not 0x10 <= addr <= 0xEE:
+        raise argparse.ArgumentTypeError("%r: ADDR must be even, 0x10..0xEE" % text)
+    if addr == p.DEFAULT_LOCAL_ADDRESS:
+        raise argparse.ArgumentTypeError("%r: 0x%02X is the gateway's own address (its"
+                                         " requests never reach the bus)" % (text, addr))
+
+
+def adc_spec(text: str):
+    """`CH=MV` -> (channel, millivolts)."""
+    ch, sep, mv = text.partition("=")
+    try:
+        pair = (int(ch, 0), int(mv, 0))
+    except ValueError:
+        pair = None
+    if not sep or pair is None or not 0 <= pair[0] <= 7 or pair[1] < 0:
+        raise argparse.ArgumentTypeError("%r: CH=MV with CH 0-7 (3=1200)" % text)
+    return pair
+
+
 def add_sim_devices(parser, suppress: bool = False) -> None:
     """The simulated board's devices: for `sim`, and for --sim."""
-    from .simulate import adc_spec, eeprom_spec, slave_spec
     default = argparse.SUPPRESS if suppress else None
     parser.add_argument("--eeprom", type=eeprom_spec, action="append", default=default or [],
                         metavar="ADDR",

@@ -11,7 +11,7 @@ import os
 import re
 import shlex
 import sys
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 from .. import boardmap, vcd, waves
 from .. import plot as drawing
@@ -186,11 +186,12 @@ def _from_file(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]
 
 
 def _run_commands(port: str, args) -> None:
-    from . import main
+    """The --do commands, each as `orfa --port PORT COMMAND` (args.run: the
+    command's main, handed down by add_parsers)."""
     for line in args.do or ():
         argv = ["--port", port, "--baud", str(args.baud)] + shlex.split(line)
         try:
-            rc = main(argv)
+            rc = args.run(argv)
         except SystemExit as exc:            # argparse's usage error, already told
             rc = exc.code if isinstance(exc.code, int) else 2
         if rc:
@@ -376,7 +377,8 @@ def cmd_plot(args) -> int:
     return 0
 
 
-def add_parsers(sub, common) -> None:
+def add_parsers(sub, common, run: Callable[[List[str]], int]) -> None:
+    """`orfa plot`; `run(argv)` runs an orfa command line (its --do)."""
     cmd = sub.add_parser(
         "plot", parents=[common],
         help="draw waveforms from a VCD or a live simulated board",
@@ -411,4 +413,4 @@ def add_parsers(sub, common) -> None:
                      help="the board the VCD or socket is of (default: told by its pins)")
     cmd.add_argument("-v", "--verbose", action="store_true",
                      help="also print every pulse's width")
-    cmd.set_defaults(func=cmd_plot)
+    cmd.set_defaults(func=cmd_plot, run=run)

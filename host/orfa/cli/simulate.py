@@ -11,53 +11,8 @@ import sys
 from .. import protocol as p
 from ..sim import BOARDS, SimError
 from .common import UsageError, add_sim_devices, baud_rate, sim_board
+from .common import adc_spec, eeprom_spec, slave_spec  # noqa: F401 (here before)
 from .console import run_console
-
-
-def slave_spec(text: str):
-    """`BOARD:ADDR[:ELF]` -> (board, addr, elf or None: the board's slave build)."""
-    parts = text.split(":", 2)
-    if len(parts) < 2 or parts[0] not in BOARDS:
-        raise argparse.ArgumentTypeError(
-            "%r: BOARD:ADDR[:ELF] with BOARD one of %s" % (text, ", ".join(BOARDS)))
-    try:
-        addr = int(parts[1], 0)
-    except ValueError:
-        raise argparse.ArgumentTypeError("%r: ADDR like 0x10" % text) from None
-    _check_device_address(text, addr)
-    return (parts[0], addr, parts[2] if len(parts) == 3 and parts[2] else None)
-
-
-def eeprom_spec(text: str) -> int:
-    """`ADDR` of --eeprom, checked as --slave's is."""
-    try:
-        addr = int(text, 0)
-    except ValueError:
-        raise argparse.ArgumentTypeError("%r: ADDR like 0xA0" % text) from None
-    _check_device_address(text, addr)
-    return addr
-
-
-def _check_device_address(text: str, addr: int) -> None:
-    """A simulated device's 8-bit bus address: even, outside the addresses
-    I2C reserves, and not the gateway's own (its requests never reach the bus)."""
-    if addr & 1 or not 0x10 <= addr <= 0xEE:
-        raise argparse.ArgumentTypeError("%r: ADDR must be even, 0x10..0xEE" % text)
-    if addr == p.DEFAULT_LOCAL_ADDRESS:
-        raise argparse.ArgumentTypeError("%r: 0x%02X is the gateway's own address (its"
-                                         " requests never reach the bus)" % (text, addr))
-
-
-def adc_spec(text: str):
-    """`CH=MV` -> (channel, millivolts)."""
-    ch, sep, mv = text.partition("=")
-    try:
-        pair = (int(ch, 0), int(mv, 0))
-    except ValueError:
-        pair = None
-    if not sep or pair is None or not 0 <= pair[0] <= 7 or pair[1] < 0:
-        raise argparse.ArgumentTypeError("%r: CH=MV with CH 0-7 (3=1200)" % text)
-    return pair
 
 
 def _raise_interrupt(*_):

@@ -20,26 +20,9 @@ from typing import Callable, Dict, List, Optional, Sequence
 from .. import protocol as p
 from ..board import Board
 from ..clients.adc import CHANNELS as ADC_CHANNELS, REFERENCES as ADC_REFERENCES
-from ..errors import explain
+from ..errors import ControlError, NotFound, Refused, explain  # noqa: F401 (dash.web's)
 from ..gateway import Gateway
 from . import snapshot
-
-
-class ControlError(ValueError):
-    """A control request that is wrong in itself (a field missing or out of
-    range): the page gets the message, the board is not asked."""
-
-
-class NotFound(KeyError):
-    """No board at that address on this dashboard, or no such control."""
-
-    def __str__(self) -> str:
-        return self.args[0]
-
-
-class Refused(Exception):
-    """The board did not do what a control asked (it refused, or a line
-    belongs to another function)."""
 
 
 class Dashboard:
