@@ -193,10 +193,9 @@ class Gateway:
         return self.read_reply()
 
     def pipeline(self, lines: Sequence[str]) -> List[str]:
-        """Send every request in one write, then read one reply per request."""
-        data = b"".join(p.encode_request(line) for line in lines)
-        self.send(data)
-        return [self.read_reply() for _ in lines]
+        """run(lines), by its earlier name: the requests pipelined within the
+        flow rule (it once wrote them all at once, past the rule)."""
+        return self.run(lines)
 
     # --- batches: many requests in flight (docs/protocol.md, "Flow") -----------------
     def run(self, lines: Sequence[str]) -> List[str]:

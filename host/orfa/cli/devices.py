@@ -13,6 +13,7 @@ from .. import boardmap
 from .. import protocol as p
 from ..board import Board
 from ..clients.adc import CHANNELS as ADC_CHANNELS, VREF
+from ..clients.motor import DUTY_RANGE, is_duty
 from ..clients.servo import ServoRange
 from .common import (UsageError, address, byte, connect, explain, hex_bytes, number,
                      interval, show_address, table, volts)
@@ -194,8 +195,8 @@ def _duty(text: str) -> int:
         duty = int(text, 0)
     except ValueError:
         duty = None
-    if duty is None or not -255 <= duty <= 255:
-        raise UsageError("duty %r: -255..255 (sign = direction, 0 or stop: stop)" % text)
+    if not is_duty(duty):
+        raise UsageError("duty %r: %s (sign = direction, 0 or stop: stop)" % (text, DUTY_RANGE))
     return duty
 
 
@@ -389,11 +390,11 @@ def add_parsers(sub, common) -> None:
     cmd = sub.add_parser(
         "motor", parents=[common], help="motor duty and direction",
         description="motor: both motors' duty; motor N: motor N's (1 or 2); motor N"
-                    " DUTY: set it, -255..255 (the sign is the direction, 0 or stop"
+                    " DUTY: set it, " + DUTY_RANGE + " (the sign is the direction, 0 or stop"
                     " stops it); motor stop: both stop.",
         epilog="example: orfa motor 1 -128; orfa motor stop")
     cmd.add_argument("n", nargs="?", metavar="N", help="1 or 2, or stop (both)")
-    cmd.add_argument("duty", nargs="?", metavar="DUTY", help="-255..255, or stop")
+    cmd.add_argument("duty", nargs="?", metavar="DUTY", help=DUTY_RANGE + ", or stop")
     cmd.set_defaults(func=cmd_motor)
 
     cmd = sub.add_parser(

@@ -20,6 +20,7 @@ from typing import Callable, Dict, List, Optional, Sequence
 from .. import protocol as p
 from ..board import Board
 from ..clients.adc import CHANNELS as ADC_CHANNELS, REFERENCES as ADC_REFERENCES
+from ..clients.motor import DUTY_RANGE, is_duty
 from ..errors import ControlError, NotFound, Refused, explain  # noqa: F401 (dash.web's)
 from ..gateway import Gateway
 from . import snapshot
@@ -273,11 +274,13 @@ def set_servo(board: Board, info: Dict, body: Dict) -> Dict[str, object]:
 
 
 def set_motor(board: Board, info: Dict, body: Dict) -> Dict[str, object]:
-    """{"motor": N, "duty": -255..255} (the sign is the direction)."""
+    """{"motor": N, "duty": -255..255} (the sign is the direction; clients.motor.is_duty)."""
     _check_keys(body, ("motor", "duty"), "motor")
     motor = board.motor
     n = _number(body, "motor", 1, motor.count, "motor")
-    duty = _number(body, "duty", -255, 255, "motor")
+    duty = _number(body, "duty", -math.inf, math.inf, "motor")
+    if not is_duty(duty):
+        raise ControlError("motor: duty %d is outside %s" % (duty, DUTY_RANGE))
     motor.set(n, duty)
     return {"motor": n, "duty": duty}
 
