@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import inspect
 import math
 import os
 from typing import Iterator, List, Optional
@@ -242,6 +243,30 @@ def connect(args) -> Iterator[Gateway]:
                          % (PORT_ENV, "|".join(BOARDS)))
     with open_gateway(url, args) as gw:
         yield gw
+
+
+def arg(*names, **options):
+    """One argument of command(): arg("--all", action="store_true", help=...)."""
+    return names, options
+
+
+def command(sub, parents, func, *arguments, **fill) -> argparse.ArgumentParser:
+    """Add the command `func` runs, named after it (cmd_scan: `scan`), to the
+    subparsers `sub`, with `arguments` (arg(...)), and return its parser.
+    The function's docstring says the rest: its first line is the help, its
+    last paragraph the epilog (the examples), the paragraphs between them
+    the description, where `{NAME}` stands for fill[NAME] ({ADDRESS_RULE}:
+    ADDRESS_RULE)."""
+    paragraphs = inspect.cleandoc(func.__doc__).split("\n\n")
+    description = " ".join(paragraphs[1:-1])
+    for name, text in dict(fill, ADDRESS_RULE=ADDRESS_RULE).items():
+        description = description.replace("{%s}" % name, str(text))
+    cmd = sub.add_parser(func.__name__[len("cmd_"):], parents=list(parents),
+                         help=paragraphs[0], description=description, epilog=paragraphs[-1])
+    for names, options in arguments:
+        cmd.add_argument(*names, **options)
+    cmd.set_defaults(func=func)
+    return cmd
 
 
 def hex_bytes(data: bytes) -> str:

@@ -10,7 +10,7 @@ import sys
 
 from .. import protocol as p
 from ..sim import BOARDS, SimError
-from .common import UsageError, add_sim_devices, baud_rate, sim_board
+from .common import UsageError, add_sim_devices, arg, baud_rate, command, sim_board
 from .common import adc_spec, eeprom_spec, slave_spec  # noqa: F401 (here before)
 from .console import run_console
 
@@ -28,6 +28,19 @@ def _link(target, path: str) -> None:
 
 
 def cmd_sim(args) -> int:
+    """run a simulated board or robot, print its port
+
+    Run build/sim/orfa-sim on a board's gateway firmware (with --slave: a
+    robot, the slave boards on its I2C bus) and print the path of its
+    serial port on the first line (with --control, the control socket's on
+    the second). Runs until Ctrl-C or SIGTERM (exit 0), or with --terminal
+    for a console on the board until the end of its input (then the lines
+    say what they are: `serial port: PATH`). Bus addresses are the
+    protocol's 8-bit form. docs/simulator.md describes the devices and the
+    control socket.
+
+    example: orfa sim --board m32d --eeprom 0xA0 --slave m128s:0x10 --terminal
+    """
     control = args.control is not None or args.autobaud
     extra = []
     if args.trace:
@@ -67,19 +80,8 @@ def cmd_sim(args) -> int:
 
 
 def add_parsers(sub, common) -> None:
-    cmd = sub.add_parser(
-        "sim", help="run a simulated board or robot, print its port",
-        description="Run build/sim/orfa-sim on a board's gateway firmware (with --slave:"
-                    " a robot, the slave boards on its I2C bus) and print the path of"
-                    " its serial port on the first line (with --control, the control"
-                    " socket's on the second). Runs until Ctrl-C or SIGTERM (exit 0),"
-                    " or with --terminal for a console on the board until the end of"
-                    " its input (then the lines say what they are: `serial port:"
-                    " PATH`). Bus addresses are the protocol's 8-bit form."
-                    " docs/simulator.md describes the devices and the control socket.",
-        epilog="example: orfa sim --board m32d --eeprom 0xA0 --slave m128s:0x10 --terminal")
-    cmd.add_argument("--board", choices=BOARDS, default="m32d",
-                     help="the gateway's board (default %(default)s)")
+    cmd = command(sub, [], cmd_sim, arg("--board", choices=BOARDS, default="m32d",
+                                        help="the gateway's board (default %(default)s)"))
     add_sim_devices(cmd)
     cmd.add_argument("--firmware", help="ELF to run (default: build/<board>-gate/orfa.elf)")
     cmd.add_argument("--control", nargs="?", const="", metavar="PATH",
@@ -93,4 +95,3 @@ def add_parsers(sub, common) -> None:
     cmd.add_argument("--autobaud", action="store_true",
                      help="the console opens with the BAUD=auto preamble (eight CRs,"
                           " 20 ms of simulated quiet)")
-    cmd.set_defaults(func=cmd_sim)
