@@ -20,6 +20,7 @@ from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Sequence
 from . import boardmap
 from . import boards
 from . import protocol as p
+from .closing import Closing
 from .errors import NOT_ERRORS, NoDriverError, Status, register_error
 from .gateway import Gateway
 
@@ -56,7 +57,7 @@ class Op:
         return "write" if self.kind == "w" else "read"
 
 
-class Board:
+class Board(Closing):
     """One ORFA board (the gateway itself, or a slave behind it)."""
 
     def __init__(self, gateway: Gateway, addr: Optional[int] = None):
@@ -80,12 +81,6 @@ class Board:
     def close(self) -> None:
         if self._owns_gateway:
             self.gateway.close()
-
-    def __enter__(self) -> "Board":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     def __repr__(self) -> str:
         return "<Board 0x%02X%s>" % (self.addr, " (gateway)" if self.is_local else "")

@@ -81,45 +81,26 @@ class OrfaError(Exception):
 # --- the protocol's ERROR replies and other replies --------------------------
 
 class _ReplyError(OrfaError):
-    """An `ERROR xx` reply: each subclass names its code; its docstring is
-    the map's text of the code."""
-
-    def __init_subclass__(cls, **kw):
-        super().__init_subclass__(**kw)
-        if cls.__doc__ is None:
-            cls.__doc__ = "ERROR %02X (%s): %s." % (cls.code, cls.code.name, cls.code.text)
+    """An `ERROR xx` reply (one subclass per code, from _reply_error)."""
 
 
-class InternalError(_ReplyError):
-    code = ErrorCode.INTERNAL
+def _reply_error(name: str, code: ErrorCode) -> Type[_ReplyError]:
+    """The class of `code`'s reply, its docstring the map's text of the code."""
+    doc = "ERROR %02X (%s): %s." % (code, code.name, code.text)
+    return type(name, (_ReplyError,), {"code": code, "__doc__": doc, "__module__": __name__})
 
 
-class UnknownCommandError(_ReplyError):
-    code = ErrorCode.COMMAND
-
-
-class HexError(_ReplyError):
-    code = ErrorCode.HEX
-
-
-class DataError(_ReplyError):
-    code = ErrorCode.DATA
+InternalError = _reply_error("InternalError", ErrorCode.INTERNAL)
+UnknownCommandError = _reply_error("UnknownCommandError", ErrorCode.COMMAND)
+HexError = _reply_error("HexError", ErrorCode.HEX)
+DataError = _reply_error("DataError", ErrorCode.DATA)
+IncompleteError = _reply_error("IncompleteError", ErrorCode.NO_P)
+AddressNackError = _reply_error("AddressNackError", ErrorCode.ADDR_NACK)
+DataNackError = _reply_error("DataNackError", ErrorCode.DATA_NACK)
 
 
 class LimitError(DataError, ValueError):
     """Refused on the host: the board would answer ERROR 04 (over a limit)."""
-
-
-class IncompleteError(_ReplyError):
-    code = ErrorCode.NO_P
-
-
-class AddressNackError(_ReplyError):
-    code = ErrorCode.ADDR_NACK
-
-
-class DataNackError(_ReplyError):
-    code = ErrorCode.DATA_NACK
 
 
 #: The class of each code's `ERROR xx` reply (tests/host/test_boardmap.py

@@ -15,6 +15,7 @@ import serial
 from . import boardmap
 from . import flow
 from . import protocol as p
+from .closing import Closing
 from .errors import SerialError
 
 #: i2cdetect's default range of 7-bit addresses (the others are reserved)
@@ -90,7 +91,7 @@ def _clip(text, size: int = 60):
 _STATUS_REGISTER = boardmap.load(boardmap.BOARDS[0]).reg("intro", "STATUS")
 
 
-class Gateway:
+class Gateway(Closing):
     """An ORFA gateway on one serial port; a context manager.
 
     autobaud=True sends the preamble of a BAUD=auto firmware (eight CRs, then
@@ -129,15 +130,9 @@ class Gateway:
         self._write(p.AUTOBAUD_PREAMBLE)
         (wait or time.sleep)(p.autobaud_wait_s(self.serial.baudrate))
 
-    # --- lifetime -----------------------------------------------------------
+    # --- lifetime (a context manager: Closing) -------------------------------
     def close(self) -> None:
         self.serial.close()
-
-    def __enter__(self) -> "Gateway":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     # --- lines ----------------------------------------------------------------
     def send(self, data: bytes) -> None:

@@ -224,34 +224,29 @@ def check_error(reply: Union[str, bytes]) -> str:
     return text
 
 
-def parse_version(reply: Union[str, bytes]) -> str:
+def _parse(reply: Union[str, bytes], pattern: str, what: str) -> "re.Match[str]":
+    """The match of a reply to one of V, X, L, C (or the error it is)."""
     text = check_error(reply)
-    m = re.match(r"V(\d+\.\d+)\Z", text)
+    m = re.match(pattern + r"\Z", text)
     if m is None:
-        raise ProtocolError("not a version reply: %r" % text)
-    return m.group(1)
+        raise ProtocolError("not a %s reply: %r" % (what, text))
+    return m
+
+
+def parse_version(reply: Union[str, bytes]) -> str:
+    return _parse(reply, r"V(\d+\.\d+)", "version").group(1)
 
 
 def parse_clear(reply: Union[str, bytes]) -> None:
-    text = check_error(reply)
-    if text != "X":
-        raise ProtocolError("not a clear reply: %r" % text)
+    _parse(reply, "X", "clear")
 
 
 def parse_local_address(reply: Union[str, bytes]) -> int:
-    text = check_error(reply)
-    m = re.match(r"L([0-9A-F]{2})\Z", text)
-    if m is None:
-        raise ProtocolError("not a local address reply: %r" % text)
-    return int(m.group(1), 16)
+    return int(_parse(reply, "L([0-9A-F]{2})", "local address").group(1), 16)
 
 
 def parse_clock(reply: Union[str, bytes]) -> int:
-    text = check_error(reply)
-    m = re.match(r"C([0-9A-F]{4})\Z", text)
-    if m is None:
-        raise ProtocolError("not a clock reply: %r" % text)
-    return int(m.group(1), 16)
+    return int(_parse(reply, "C([0-9A-F]{4})", "clock").group(1), 16)
 
 
 _FRAME_RE = re.compile(r"SW(A*)|SR((?:[0-9A-F]{2})+)")
