@@ -219,7 +219,7 @@ class SMBus:
                 parts.append((msg.addr, int(msg.len)))
             else:
                 parts.append((msg.addr, ctypes.string_at(msg.buf, msg.len) if msg.len else b""))
-        got = iter(self._transfer(parts, "i2c_rdwr of %d messages" % len(parts),
+        got = iter(self._transfer(parts, "i2c_rdwr with %d i2c_msg" % len(parts),
                                   "carries at most %d bytes written or %d read in one"
                                   " message, fewer in several" % (MAX_WRITE, MAX_READ)))
         for msg in i2c_msgs:
