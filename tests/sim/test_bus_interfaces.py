@@ -251,3 +251,22 @@ def test_smbus_missing_device_and_refused_byte(bench):
         assert e.value.errno == errno.EIO
         bus.write_byte_data(EEPROM, AREA + 29, 0x24)            # and the bus goes on
         assert bus.read_byte_data(EEPROM, AREA + 29) == 0x24
+
+
+# --- docs/sensors.md ----------------------------------------------------------------------------
+
+def test_docs_examples_print_what_the_docs_show(capsys):
+    """docs/sensors.md's runnable examples (the simulated ones, each
+    followed by "prints"), run: each prints what the page says."""
+    import re
+    from pathlib import Path
+    need("adafruit_bus_device.i2c_device", "adafruit-circuitpython-busdevice")
+    need("smbus2", "smbus2")
+    require_builds(["m32d"])
+    require_slave("m128s", SLAVE << 1)
+    text = (Path(__file__).resolve().parents[2] / "docs" / "sensors.md").read_text()
+    examples = re.findall(r"```python\n((?:(?!```).)*)```\n\nprints\n\n```\n(.*?)```", text, re.S)
+    assert len(examples) == 2
+    for code, shown in examples:
+        exec(compile(code, "docs/sensors.md", "exec"), {})
+        assert capsys.readouterr().out == shown
