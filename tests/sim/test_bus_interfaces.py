@@ -4,8 +4,9 @@ at A0 (0x50), a write-protected one at A6 (0x53) and an SRF08 at E0
 (0x70). The EEPROM written and read through both interfaces and through
 Adafruit's I2CDevice, checked on the bus trace (one transaction, a
 repeated START); a slave board's introspection through smbus and
-adafruit_register; what a missing device and a refused byte raise. The
-scripted line: tests/host/test_bus_interfaces.py."""
+adafruit_register; what a missing device and a refused byte raise, and
+the errors Adafruit's and Pimoroni's drivers make of them when their
+sensor is not there. The scripted line: tests/host/test_bus_interfaces.py."""
 
 import errno
 import subprocess
@@ -168,6 +169,30 @@ def test_adafruit_register_reads_a_slave_boards_introspection(bench, i2c):
     i2c.try_lock()
     i2c.readfrom_into(SLAVE, buf)
     assert bytes(buf) == records("m128s")[6:12]
+
+
+@pytest.mark.parametrize("module, package, make, address", [
+    ("adafruit_mpu6050", "adafruit-circuitpython-mpu6050", lambda m, i2c: m.MPU6050(i2c), 0x68),
+    ("adafruit_lis3mdl", "adafruit-circuitpython-lis3mdl", lambda m, i2c: m.LIS3MDL(i2c), 0x1C),
+    ("adafruit_bmp280", "adafruit-circuitpython-bmp280",
+     lambda m, i2c: m.Adafruit_BMP280_I2C(i2c), 0x77),
+])
+def test_adafruit_drivers_find_no_sensor_on_this_bus(i2c, module, package, make, address):
+    """No such sensor on this robot's bus: each driver's own error, from
+    the I2CDevice probe's OSErrors."""
+    driver = need(module, package)
+    i2c.unlock()
+    with pytest.raises(ValueError, match="No I2C device at address: 0x%x$" % address):
+        make(driver, i2c)
+
+
+def test_pimoroni_bmp280_finds_no_sensor_on_this_bus(bench):
+    """Pimoroni's driver takes the SMBus as i2c_dev; no BMP280 at 0x76:
+    its own error, from the OSError of the register read."""
+    BMP280 = need("bmp280", "bmp280").BMP280
+    with SMBus(bench.gw) as bus:
+        with pytest.raises(RuntimeError, match="Unable to find bmp280 on 0x76, IOError"):
+            BMP280(i2c_dev=bus).setup()
 
 
 def test_adafruit_24lc32():
