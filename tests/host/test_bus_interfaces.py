@@ -7,8 +7,8 @@ import errno
 
 import pytest
 
-from fake_line import FakeLine
-from orfa import Gateway, MAX_REPLY_CHARS, MAX_REQUEST_CHARS
+from fake_line import FakeLine, synced_gateway
+from orfa import MAX_REPLY_CHARS, MAX_REQUEST_CHARS
 from orfa.busio import I2C
 from orfa.smbus import SMBus
 
@@ -42,11 +42,7 @@ def fake(monkeypatch):
     out of line.written; requests the table lacks answer ERROR 02."""
     def make(table=TABLE):
         line = FakeLine(answers(table))
-        monkeypatch.setattr("orfa.gateway.serial.serial_for_url", lambda url, **kw: line)
-        gw = Gateway("fake://", timeout=0.2)
-        gw.in_step()
-        line.forget()
-        return gw, line
+        return synced_gateway(monkeypatch, line), line
     return make
 
 

@@ -13,7 +13,7 @@ import subprocess
 
 import pytest
 
-from conftest import Bench, require_builds, require_slave, running
+from conftest import require_builds, require_slave, running
 from orfa import boardmap
 from orfa.busio import I2C
 from orfa.sim import SimBoard, sim_path
