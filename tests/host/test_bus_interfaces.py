@@ -405,3 +405,48 @@ def test_smbus_open_and_close(fake):
     assert bus.read_byte_data(0x50, 0x10) == 0x5A
     bus.close()
     assert not line.is_open
+
+
+# --- Adafruit's 24LC32 driver on a scripted 24LC32 ------------------------------------------
+
+class Eeprom24lc32:
+    """A 4 KB EEPROM at A8 with two-byte word addresses, as a scripted
+    gateway answers for it (compact transaction requests only)."""
+
+    def __init__(self):
+        self.mem = bytearray(b"\xff" * 4096)
+
+    def __call__(self, line):
+        if line in ("V", "C"):
+            return {"V": "V1.1", "C": "C0063"}[line]
+        if line == "SA8P":
+            return "SWP"
+        if line.startswith("SA8") and "S" not in line[1:-1]:          # a write
+            data = bytes.fromhex(line[3:-1])
+            at = (data[0] << 8 | data[1]) & 0xFFF
+            self.mem[at:at + len(data) - 2] = data[2:]
+            return "SW" + "A" * len(data) + "P"
+        if line.startswith("SA8") and line[7:10] == "SA9":            # address, then read
+            at, n = int(line[3:7], 16) & 0xFFF, int(line[10:12], 16)
+            return "SWAASR" + self.mem[at:at + n].hex().upper() + "P"
+        return "ERROR 06"
+
+
+def test_adafruit_24lc32_on_a_scripted_eeprom(fake):
+    """Adafruit's driver unchanged: a byte written per request with its
+    two-byte word address, a slice read in one request, a slice over the
+    limit refused."""
+    EEPROM_I2C = pytest.importorskip(
+        "adafruit_24lc32", reason="adafruit-circuitpython-24lc32 is not installed"
+        " (tools/setup.sh installs it)").EEPROM_I2C
+    gw, line = fake()
+    line.answer = Eeprom24lc32()
+    eeprom = EEPROM_I2C(I2C(gw), address=0x54)
+    eeprom[0x0123:0x0126] = [1, 2, 3]
+    assert eeprom[0x0122:0x0127] == b"\xff\x01\x02\x03\xff"
+    # the probe; the driver reads the slice first (it writes only what
+    # differs), then one byte per request; the read back
+    assert line.written == ["SA8P", "SA80123SA903P", "SA8012301P", "SA8012402P", "SA8012503P",
+                            "SA80122SA905P"]
+    with pytest.raises(ValueError, match="reads at most 60 after 2 written"):
+        eeprom[0:61]

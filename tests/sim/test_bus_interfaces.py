@@ -201,7 +201,9 @@ def test_adafruit_24lc32():
     request."""
     EEPROM_I2C = need("adafruit_24lc32", "adafruit-circuitpython-24lc32").EEPROM_I2C
     require_builds(["m32d"])
-    usage = subprocess.run([str(sim_path()), "--help"], capture_output=True, text=True).stdout
+    r = subprocess.run([str(sim_path()), "--help"], capture_output=True, text=True)
+    usage = r.stdout + r.stderr
+    assert "eeprom24" in usage, usage                   # the list of parts is where it is looked for
     if "24lc32" not in usage:
         pytest.skip("orfa-sim has no 24lc32 part yet (--part 24lc32@0xA8; the parts of issue 18)")
     sim = SimBoard("m32d", trace=False, extra_args=("--part", "24lc32@0xA8"))
