@@ -17,7 +17,7 @@ import os
 from typing import List, NamedTuple, Sequence, Tuple, Union
 
 from . import protocol as p
-from . import AddressNackError, DataNackError, LimitError, ReplyTimeout
+from .errors import AddressNackError, DataNackError, LimitError, ReplyTimeout
 from .gateway import Gateway
 
 #: One frame of a transfer: (7-bit address, bytes to write) or
