@@ -1,7 +1,7 @@
 """orfa.busio.I2C and orfa.smbus.SMBus on a scripted gateway
 (fake_line.FakeLine): the exact request each call sends, what the reply
 becomes, the OSErrors of refusals, buffer slices, the same buffer in and
-out, and the limits of one request. The simulated bus: tests/sim/test_bus_interfaces.py."""
+out, and the limits of one request. The simulated bus: tests/sim/test_busio_smbus.py."""
 
 import errno
 
