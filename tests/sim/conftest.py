@@ -25,6 +25,9 @@ EEPROM_WP = 0xA6         # write-protected 24C02: acknowledges its address and
                          # the word address, not the data bytes
 #: Wall-clock seconds a reply may take (the simulator runs faster than real time).
 REPLY_TIMEOUT = 5.0
+#: The table of sensor readings (test_sensor_drivers.py: the value set, the
+#: value a driver returned), printed at the end of the run.
+SENSOR_READINGS = pytest.StashKey[list]()
 
 
 def require_builds(boards=BOARDS):
@@ -533,3 +536,12 @@ def pytest_collection_modifyitems(config, items):
             if item.nodeid.startswith(prefix) and param in item.nodeid:
                 item.add_marker(pytest.mark.xfail(reason=reason, strict=strict))
                 break
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    """The sensor drivers' readings of this run, with or without -s."""
+    rows = config.stash.get(SENSOR_READINGS, [])
+    if rows:
+        terminalreporter.section("sensor readings (build/sensor-readings.txt)")
+        for row in rows:
+            terminalreporter.write_line(row)
