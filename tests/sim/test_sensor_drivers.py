@@ -259,7 +259,8 @@ def test_mpu6050_acceleration(robot, mpu, note, range_name, lsb_per_g, accel):
 
 
 @pytest.mark.parametrize("range_name, lsb_per_dps, gyro", [
-    ("RANGE_500_DPS", 65.5, (10.0, 123.4, -5.0)),
+    ("RANGE_500_DPS", 65.5, (10.0, 123.4, -5.0)),      # the driver's default
+    ("RANGE_250_DPS", 131, (-5.0, 0.5, 249.0)),
     ("RANGE_2000_DPS", 16.4, (-1500.0, 250.5, 1990.0)),
 ])
 def test_mpu6050_gyro(robot, mpu, note, range_name, lsb_per_dps, gyro):
@@ -269,7 +270,8 @@ def test_mpu6050_gyro(robot, mpu, note, range_name, lsb_per_dps, gyro):
     -327 (read here as the driver does, GYRO_ZOUT at 47), and the driver's
     arithmetic is exact on it: radians(-327 / 65.5) = -0.0871332 rad/s,
     half an LSB (0.000133 rad/s) from -0.0872665. Half an LSB is what the
-    range resolves; neither the part, the driver nor the sample is off."""
+    range resolves; neither the part, the driver nor the sample is off. At
+    +-250 (131 per degree/s) -5 degrees/s is a code of its own: exact."""
     mpu6050 = need("adafruit_mpu6050", "adafruit-circuitpython-mpu6050")
     mpu.gyro_range = getattr(mpu6050.GyroRange, range_name)
     robot.ctl.sense(MPU, "gyro", *gyro)
