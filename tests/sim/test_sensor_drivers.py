@@ -70,6 +70,8 @@ def raw(value: float, per_unit: float, lo: int = -32768, hi: int = 32767) -> int
 # --- the readings table -----------------------------------------------------------------
 
 def fmt(values) -> str:
+    if isinstance(values, str):
+        return values
     if isinstance(values, (tuple, list)):
         return ", ".join(fmt(v) for v in values)
     return "%.6g" % values
@@ -365,3 +367,153 @@ def test_hmc5883l_overflow(robot):
         bus.write_byte_data(HMC7, 0x01, 0 << 5)
         hmc_measure(robot, bus)
         assert hmc_measure(robot, bus) == [-4096, raw(-0.3, 1370), raw(0.1, 1370)]
+
+
+# --- BMP280: adafruit_bmp280 (busio) and Pimoroni's bmp280 (smbus) --------------------------------
+
+def bmp_calibration(read) -> list:
+    """dig_T1 .. dig_P9 (0x88..0x9F, little-endian; T1 and P1 unsigned)."""
+    return list(struct.unpack("<HhhHhhhhhhhh", read(0x88, 24)))
+
+
+def bmp_codes(read):
+    """(adc_P, adc_T): 20 bits each at F7..F9 and FA..FC, high byte first."""
+    d = read(0xF7, 6)
+    return ((d[0] << 12 | d[1] << 4 | d[2] >> 4), (d[3] << 12 | d[4] << 4 | d[5] >> 4))
+
+
+def bmp_t_fine(adc_t: float, cal) -> float:
+    """The datasheet's compensation (section 8.1, the double version):
+    t_fine; degrees C = t_fine / 5120."""
+    t1, t2, t3 = cal[:3]
+    return (adc_t / 16384.0 - t1 / 1024.0) * t2 + \
+        (adc_t / 131072.0 - t1 / 8192.0) ** 2 * t3
+
+
+def bmp_pa(adc_p: float, t_fine: float, cal) -> float:
+    """Pa of ADC_P at T_FINE (datasheet section 8.1, the double version)."""
+    p1, p2, p3, p4, p5, p6, p7, p8, p9 = cal[3:]
+    var1 = t_fine / 2.0 - 64000.0
+    var2 = var1 * var1 * p6 / 32768.0
+    var2 = var2 + var1 * p5 * 2.0
+    var2 = var2 / 4.0 + p4 * 65536.0
+    var1 = (p3 * var1 * var1 / 524288.0 + p2 * var1) / 524288.0
+    var1 = (1.0 + var1 / 32768.0) * p1
+    p = (1048576.0 - adc_p - var2 / 4096.0) * 6250.0 / var1
+    return p + (p9 * p * p / 2147483648.0 + p8 * p / 32768.0 + p7) / 16.0
+
+
+def bmp_check(read, celsius, pa, t_step, p_step, int_t_fine):
+    """The part holds the codes nearest to CELSIUS and PA at the resolution
+    in use (codes T_STEP, P_STEP apart: 16 + oversampling bits with the
+    filter off, 20 with it): within half the step to a neighbour, as the
+    datasheet's formulas (t_fine an integer there) give them back. The
+    values the driver must return from those codes, with its own t_fine
+    (INT_T_FINE: truncated as the datasheet's int32, or not), and one LSB
+    of each, in degrees C and Pa."""
+    cal = bmp_calibration(read)
+    adc_p, adc_t = bmp_codes(read)
+    assert adc_t % t_step == 0 and adc_p % p_step == 0, (adc_t, adc_p)
+    temps = [bmp_t_fine(adc_t + k * t_step, cal) / 5120 for k in (-1, 0, 1)]
+    t_lsb = max(abs(temps[2] - temps[1]), abs(temps[1] - temps[0]))
+    assert abs(temps[1] - celsius) <= t_lsb / 2
+    t_fine = int(bmp_t_fine(adc_t, cal))
+    press = [bmp_pa(adc_p + k * p_step, t_fine, cal) for k in (-1, 0, 1)]
+    p_lsb = max(abs(press[2] - press[1]), abs(press[1] - press[0]))
+    assert abs(press[1] - pa) <= p_lsb / 2
+    driver_t_fine = t_fine if int_t_fine else bmp_t_fine(adc_t, cal)
+    return driver_t_fine / 5120, bmp_pa(adc_p, driver_t_fine, cal), t_lsb, p_lsb
+
+
+BMP_SENSED = [(21.5, 98765.4), (-5.25, 101325.0)]
+
+
+@pytest.fixture(scope="module")
+def bmp_adafruit(i2c):
+    need_part("bmp280")
+    adafruit_bmp280 = need("adafruit_bmp280", "adafruit-circuitpython-bmp280")
+    return adafruit_bmp280.Adafruit_BMP280_I2C(i2c)          # 0x77: EE
+
+
+@pytest.mark.parametrize("celsius, pa", BMP_SENSED)
+def test_adafruit_bmp280(robot, i2c, bmp_adafruit, note, celsius, pa):
+    """The driver's defaults: forced mode (a measurement per reading, its
+    end polled in the status register), temperature x2 (17 bits), pressure
+    x16 (20 bits), no filter. Its own arithmetic: t_fine truncated to an
+    integer (as the datasheet's int32), the temperature t_fine / 5120 (the
+    datasheet's double version divides before truncating): up to 1/5120
+    degrees C more."""
+    bmp = bmp_adafruit
+    robot.ctl.sense(BMP_ADA, "temp", celsius)
+    robot.ctl.sense(BMP_ADA, "pressure", pa)
+    t, p = bmp.temperature, bmp.pressure
+    bmp.sea_level_pressure = 1013.25
+    altitude = bmp.altitude
+    want_t, want_p, t_lsb, p_lsb = bmp_check(lambda r, n: read_reg(i2c, BMP_ADA >> 1, r, n),
+                                             celsius, pa, 8, 1, int_t_fine=True)
+    assert t == pytest.approx(want_t, rel=1e-12) and abs(t - celsius) <= t_lsb / 2 + 1 / 5120
+    assert p == pytest.approx(want_p / 100, rel=1e-12) and abs(p * 100 - pa) <= p_lsb
+    # altitude: 44330 (1 - (p / sea level)^0.1903), the slope times a pressure LSB
+    exact = 44330 * (1 - (pa / 101325) ** 0.1903)
+    slope = 44330 * 0.1903 * (pa / 101325) ** (0.1903 - 1) / 101325        # m per Pa
+    assert altitude == pytest.approx(44330 * (1 - (p / 1013.25) ** 0.1903), rel=1e-12)
+    assert abs(altitude - exact) <= slope * p_lsb
+    note("adafruit_bmp280", "temperature (degrees C)", celsius, t, t_lsb)
+    note("adafruit_bmp280", "pressure (hPa)", pa / 100, p, p_lsb / 100)
+    note("adafruit_bmp280", "altitude (m), sea_level_pressure 1013.25", exact, altitude,
+         slope * p_lsb)
+
+
+@pytest.fixture(scope="module")
+def bmp_pimoroni(robot):
+    need_part("bmp280")
+    BMP280 = need("bmp280", "bmp280").BMP280
+    bus = SMBus(robot.gw)
+    bmp = BMP280(i2c_dev=bus)                                # 0x76: EC
+    bmp.setup()
+    yield bmp
+    bus.close()
+
+
+@pytest.mark.parametrize("celsius, pa", BMP_SENSED)
+def test_pimoroni_bmp280_through_smbus(robot, bmp_pimoroni, note, celsius, pa):
+    """Pimoroni's driver takes the SMBus as i2c_dev; its setup: normal mode,
+    x16 both, filter 2 (so 20 bits), 500 ms standby: a measurement each
+    565.5 ms of simulated time, two let run. Its own arithmetic: t_fine
+    not truncated, for the temperature and the pressure alike."""
+    robot.ctl.sense(BMP_PIM, "temp", celsius)
+    robot.ctl.sense(BMP_PIM, "pressure", pa)
+    robot.ctl.wait(ms(2 * 565.5))
+    t, hpa = bmp_pimoroni.get_temperature(), bmp_pimoroni.get_pressure()
+    with SMBus(robot.gw) as bus:
+        want_t, want_p, t_lsb, p_lsb = bmp_check(
+            lambda r, n: bytes(bus.read_i2c_block_data(BMP_PIM >> 1, r, n)),
+            celsius, pa, 1, 1, int_t_fine=False)
+    assert t == pytest.approx(want_t, rel=1e-12) and abs(t - celsius) <= t_lsb
+    assert hpa == pytest.approx(want_p / 100, rel=1e-12) and abs(hpa * 100 - pa) <= p_lsb
+    note("Pimoroni bmp280 (SMBus)", "temperature (degrees C)", celsius, t, t_lsb)
+    note("Pimoroni bmp280 (SMBus)", "pressure (hPa)", pa / 100, hpa, p_lsb / 100)
+
+
+# --- 24LC32: adafruit_24lc32 ------------------------------------------------------------------------
+
+def test_adafruit_24lc32_bytes_and_slices(i2c, note):
+    """The driver writes byte by byte (a two-byte word address, the byte,
+    5 ms of its own sleep for the write cycle) and reads a slice in one
+    transfer: the last byte, a slice across a 32-byte page boundary, and
+    the longest slice one request reads (60 bytes after the two address
+    bytes; one more is orfa.busio's ValueError, never two transfers)."""
+    need_part("24lc32")
+    EEPROM_I2C = need("adafruit_24lc32", "adafruit-circuitpython-24lc32").EEPROM_I2C
+    eeprom = EEPROM_I2C(i2c, address=EE32 >> 1)
+    assert len(eeprom) == 4096
+    eeprom[0x0FFF] = 0xA5
+    assert eeprom[0x0FFF] == b"\xa5"
+    eeprom[0x003E:0x0042] = [0x10, 0x20, 0x30, 0x40]
+    assert eeprom[0x003E:0x0042] == b"\x10\x20\x30\x40"
+    assert eeprom[0x0000:0x003C] == b"\xff" * 0x3C            # erased, as shipped
+    with pytest.raises(ValueError, match="reads at most 60 after 2 written"):
+        eeprom[0x0000:0x003D]
+    note("adafruit_24lc32", "eeprom[0x0FFF]", "0xA5", "0x%02X" % eeprom[0x0FFF][0], "")
+    note("adafruit_24lc32", "eeprom[0x003E:0x0042]", "10 20 30 40",
+         eeprom[0x003E:0x0042].hex(" "), "")
