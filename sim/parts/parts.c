@@ -7,12 +7,16 @@
 #include "parts/part.h"
 
 extern const part_kind_t eeprom24_kind, srf08_kind, eeprom25_kind, mcp3008_kind;
+extern const part_kind_t bmp280_kind;
+extern const part_kind_t ee24lc32_kind;
 
 const part_kind_t *const part_kinds[] = {
 	&eeprom24_kind,
 	&srf08_kind,
 	&eeprom25_kind,
 	&mcp3008_kind,
+	&bmp280_kind,
+	&ee24lc32_kind,
 	NULL,
 };
 
