@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from orfa.sim import SimBoard
+from orfa.sim import SimBoard, part_kinds
 from orfa.simctl import SimControlError
 
 from conftest import Bench, require_builds, running
@@ -493,3 +493,16 @@ def test_what_only_the_part_knows_is_one_line(part, says):
     result = subprocess.run([sys.executable, "-m", "orfa", "--sim", "m32d", "--part", part,
                              "version"], capture_output=True, text=True, timeout=60, env=ENV)
     assert (result.returncode, result.stdout, result.stderr) == (2, "", says)
+
+
+def test_an_unknown_part_names_the_kinds():
+    """The kinds are the simulator's own (`orfa-sim --help` lists them)."""
+    require_builds(["m32d"])
+    kinds = part_kinds()
+    assert {"eeprom24", "srf08", "bmp280", "24lc32"} <= set(kinds)
+    result = subprocess.run([sys.executable, "-m", "orfa", "--sim", "m32d", "--part",
+                             "bmp380@0xEC", "version"], capture_output=True, text=True,
+                            timeout=60, env=ENV)
+    assert (result.returncode, result.stdout, result.stderr) == (
+        2, "", "orfa: error: argument --part: 'bmp380@0xEC': no part 'bmp380' (the"
+               " simulator's: %s) (orfa --help)\n" % ", ".join(kinds))

@@ -136,12 +136,17 @@ def open_gateway(url: str, args) -> Gateway:
 
 def add_sim_devices(parser, suppress: bool = False) -> None:
     """The simulated board's devices: for `sim`, and for --sim."""
-    from .simulate import adc_spec, eeprom_spec, slave_spec
+    from .simulate import adc_spec, eeprom_spec, part_spec, slave_spec
     default = argparse.SUPPRESS if suppress else None
     parser.add_argument("--eeprom", type=eeprom_spec, action="append", default=default or [],
                         metavar="ADDR",
                         help="a 24C02-like EEPROM at the 8-bit bus address ADDR (0xA0;"
                              " even, 0x10..0xEE, not the gateway's 0xAA), repeatable")
+    parser.add_argument("--part", type=part_spec, action="append", default=default or [],
+                        metavar="KIND@ADDR[:OPTIONS]",
+                        help="a part of KIND on the I2C bus at the 8-bit ADDR, checked as"
+                             " --eeprom's (bmp280@0xEC, 24lc32@0xA8:wp; `orfa-sim --help`"
+                             " lists the kinds), repeatable")
     parser.add_argument("--slave", type=slave_spec, action="append", default=default or [],
                         metavar="BOARD:ADDR[:ELF]",
                         help="a slave board on the bus at the 8-bit ADDR (even, 0x10..0xEE,"
@@ -161,14 +166,16 @@ def sim_board(board: str, args, **kw) -> SimBoard:
     """A SimBoard with the devices of args (not started); two devices at
     one address are a UsageError."""
     seen = {}
+    parts = getattr(args, "part", None) or ()
     for opt, addr in ([("--eeprom", a) for a in getattr(args, "eeprom", None) or ()]
+                      + [("--part", q[1]) for q in parts]
                       + [("--slave", s[1]) for s in getattr(args, "slave", None) or ()]):
         if addr in seen:
             raise UsageError("%s 0x%02X: %s put a device there already"
                              % (opt, addr, seen[addr]))
         seen[addr] = opt
     return SimBoard(board, eeproms=getattr(args, "eeprom", None) or (),
-                    slaves=getattr(args, "slave", None) or (),
+                    slaves=getattr(args, "slave", None) or (), parts=parts,
                     adc=dict(getattr(args, "adc", None) or ()),
                     spi=getattr(args, "spi", None) or (), **kw)
 
@@ -178,7 +185,8 @@ def connect(args) -> Iterator[Gateway]:
     """The Gateway of --port URL (or $ORFA_PORT), or of a board --sim starts
     for this one command (stopped when the command ends). An explicit --sim
     wins over $ORFA_PORT; --port and --sim both given is a usage error."""
-    devices = [opt for opt in ("eeprom", "slave", "adc", "spi") if getattr(args, opt, None)]
+    devices = [opt for opt in ("eeprom", "part", "slave", "adc", "spi")
+               if getattr(args, opt, None)]
     if args.sim is None and devices:
         raise UsageError("--%s describes a simulated board: give --sim BOARD too" % devices[0])
     if args.sim is not None:
@@ -187,7 +195,7 @@ def connect(args) -> Iterator[Gateway]:
         try:
             sim = sim_board(args.sim, args, trace=False, control=args.autobaud).start()
         except (SimError, ValueError) as exc:
-            raise UsageError(str(exc)) from None
+            raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
         try:
             # the preamble's quiet passes in simulated time, not on the wall clock
             with sim.gateway(args.baud, autobaud=args.autobaud, timeout=args.timeout) as gw:

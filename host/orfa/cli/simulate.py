@@ -9,7 +9,7 @@ import signal
 import sys
 
 from .. import protocol as p
-from ..sim import BOARDS, SimError
+from ..sim import BOARDS, SimError, part_kinds
 from .common import UsageError, add_sim_devices, baud_rate, sim_board
 from .console import run_console
 
@@ -36,6 +36,25 @@ def eeprom_spec(text: str) -> int:
         raise argparse.ArgumentTypeError("%r: ADDR like 0xA0" % text) from None
     _check_device_address(text, addr)
     return addr
+
+
+def part_spec(text: str):
+    """`KIND@ADDR[:OPTIONS]` of --part -> (kind, addr, options); ADDR checked
+    as --eeprom's, KIND against the simulator's kinds."""
+    kind, at, rest = text.partition("@")
+    addr_text, _, opts = rest.partition(":")
+    kinds = part_kinds()
+    if not at or not kind:
+        raise argparse.ArgumentTypeError("%r: KIND@ADDR[:OPTIONS] like bmp280@0xEC" % text)
+    if kinds and kind not in kinds:
+        raise argparse.ArgumentTypeError("%r: no part %r (the simulator's: %s)"
+                                         % (text, kind, ", ".join(kinds)))
+    try:
+        addr = int(addr_text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0xEC" % text) from None
+    _check_device_address(text, addr)
+    return (kind, addr, opts)
 
 
 def _check_device_address(text: str, addr: int) -> None:
@@ -83,7 +102,7 @@ def cmd_sim(args) -> int:
         board = sim_board(args.board, args, trace=False, firmware=args.firmware,
                           control=control, extra_args=extra).start()
     except (SimError, ValueError) as exc:
-        raise UsageError(str(exc)) from None
+        raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
     link = None
     signal.signal(signal.SIGTERM, _raise_interrupt)
     # for a program, the bare paths (`port=$(orfa sim | head -1)`); with
