@@ -136,6 +136,38 @@ class PartBench(Bench):
     def twi(self, since: int, kind: str):
         return [(e.cycle, e.fields) for e in self.events(since, ["twi " + kind])]
 
+    def edge(self, start: str, started, probe: str, probed, duration: int, margin: int = 60):
+        """Probes around the end of something `duration` cycles long that the
+        request line `start` begins at the cycle started(mark) finds in the
+        trace. The request line `probe` is put on the serial line so that its
+        bus event (probed(mark): (cycle, outcome)) lands `margin` cycles
+        before the end, then in a second round `margin` cycles after (the
+        firmware's main loop adds some tens of cycles of jitter to a request
+        line's way to the bus). [(cycle - end, outcome, the two replies)]."""
+        ctl = self.ctl
+        mark = self.mark()
+        t = ctl.time() + LEAD
+        self.rx(t, start)
+        self.read_lines(1)
+        start_lag = started(mark) - t
+        ctl.wait(duration)
+        mark = self.mark()
+        t = ctl.time() + LEAD
+        self.rx(t, probe)
+        self.read_lines(1)
+        probe_lag = probed(mark)[0] - t
+        rounds = []
+        for offset in (-margin, margin):
+            ctl.wait(duration)
+            mark = self.mark()
+            t = ctl.time() + LEAD
+            self.rx(t, start)
+            self.rx(t + start_lag + duration + offset - probe_lag, probe)
+            replies = self.read_lines(2)
+            cycle, outcome = probed(mark)
+            rounds.append((cycle - started(mark) - duration, outcome, replies))
+        return rounds
+
     def rd(self, dev: int, reg: bytes, count: int) -> bytes:
         """Write the register/word address, repeated START, read `count`."""
         reply = self.ask("S %02X %s S %02X %02X P" % (dev, reg.hex(" "), dev | 1, count))
@@ -275,38 +307,18 @@ def test_forced_mode_timing_and_status(parts, osrs_t, osrs_p, t_meas):
     registers. Polls are put on the serial line at chosen cycles so that
     their reads land just before and just after the end, whatever the wall
     clock does."""
-    ctl = parts.ctl
     assert meas_cycles(osrs_t, osrs_p) == t_meas
     ctrl = (osrs_t << 5) | (osrs_p << 2)
-    start_req = "S EC F4 %02X P" % (ctrl | 1)
-    poll = "S EC F3 S ED 01 S EC F3 S ED 01 P"     # two reads of status, 4 bytes apart
-    # calibrate: cycles from a request's first byte on the line to its bus event
-    mark = parts.mark()
-    t = ctl.time() + LEAD
-    parts.rx(t, start_req)
-    assert parts.read_lines(1) == b"SWAAP\r\n"
-    cmd_lag = parts.twi(mark, "write")[-1][0] - t
-    ctl.wait(t_meas)
-    mark = parts.mark()
-    t = ctl.time() + LEAD
-    parts.rx(t, poll)
-    assert parts.read_lines(1) == b"SWASR00SWASR00P\r\n"
-    (first, _), (second, _) = parts.twi(mark, "read")
-    poll_lag, gap = first - t, second - first
-
     parts.ctl.sense(BARO, "temp", 30)
-    mark = parts.mark()
-    t = ctl.time() + LEAD
-    parts.rx(t, start_req)
-    end = t + cmd_lag + t_meas
-    parts.rx(end - gap // 2 - poll_lag, poll)           # the reads straddle the end
-    replies = parts.read_lines(2)
-    start = [c for c, f in parts.twi(mark, "write") if f == ("%02X" % (ctrl | 1), "ack")]
-    reads = parts.twi(mark, "read")
-    assert len(start) == 1 and len(reads) == 2, reads
-    for cycle, (value, _) in reads:
-        assert (value == "08") == (cycle < start[0] + t_meas), (cycle, start, reads)
-    assert replies == b"SWAAP\r\n" + b"SWASR08SWASR00P\r\n"
+    rounds = parts.edge("S EC F4 %02X P" % (ctrl | 1),
+                        lambda mark: parts.twi(mark, "write")[1][0],   # the F4 value
+                        "S EC F3 S ED 01 P", lambda mark: parts.twi(mark, "read")[-1],
+                        t_meas)
+    (before, status_before, replies_before), (after, status_after, replies_after) = rounds
+    assert -150 < before < 0 <= after < 150, rounds
+    assert (status_before, status_after) == (("08", "nack"), ("00", "nack"))
+    assert replies_before == b"SWAAP\r\nSWASR08P\r\n"
+    assert replies_after == b"SWAAP\r\nSWASR00P\r\n"
     assert parts.baro(0xF4, 1) == bytes([ctrl])           # back to sleep
     assert abs(temp_double(adc20(parts.baro(0xFA, 3)))[0] - 30) < 0.003
 
@@ -396,34 +408,27 @@ def test_write_cycle_is_not_acknowledged_for_twc(parts):
     just after. Its neighbour at AC answers all along. The requests are
     put on the serial line at chosen cycles (as in test_srf08.py)."""
     ctl = parts.ctl
-    write, probe = "S A8 03 00 5A P", "S A8 P"
-    # calibrate: cycles from a request's first byte to its STOP / address
-    mark = parts.mark()
-    t = ctl.time() + LEAD
-    parts.rx(t, write)
-    assert parts.read_lines(1) == b"SWAAAP\r\n"
-    stop_lag = parts.twi(mark, "stop")[0][0] - t
-    ctl.wait(TWC)
-    mark = parts.mark()
-    t = ctl.time() + LEAD
-    parts.rx(t, probe)
-    assert parts.read_lines(1) == b"SWP\r\n"
-    probe_lag = parts.twi(mark, "addr")[-1][0] - t
 
-    mark = parts.mark()
+    def stop(mark):
+        return parts.twi(mark, "stop")[0][0]
+
+    def probed(mark):
+        return [(c, f[1]) for c, f in parts.twi(mark, "addr") if f[0] == "A8"][-1]
+
+    rounds = parts.edge("S A8 03 00 5A P", stop, "S A8 P", probed, TWC)
+    (before, ack_before, replies_before), (after, ack_after, replies_after) = rounds
+    assert -150 < before < 0 <= after < 150, rounds
+    assert (ack_before, ack_after) == ("nack", "ack")
+    assert replies_before == b"SWAAAP\r\nERROR 06\r\n"
+    assert replies_after == b"SWAAAP\r\nSWP\r\n"
+    # early in the cycle: the neighbour answers, the chip does not
+    ctl.wait(TWC)
     t = ctl.time() + LEAD
-    parts.rx(t, "S A8 03 01 A5 P")
-    done = t + stop_lag + TWC
-    parts.rx(t + stop_lag + 3000, "S AC P")
-    for at in (done - 2500, done + 2500):           # a probe line takes 4480 cycles
-        parts.rx(at - probe_lag, probe)
-    replies = parts.read_lines(4)
-    stop = parts.twi(mark, "stop")[0][0]
-    addrs = [(c, f[1]) for c, f in parts.twi(mark, "addr") if f[0] == "A8"]
-    assert len(addrs) == 3, addrs
-    for cycle, ack in addrs[1:]:
-        assert (ack == "ack") == (cycle >= stop + TWC), (cycle, stop, addrs)
-    assert replies == b"SWAAAP\r\n" + b"SWP\r\n" + b"ERROR 06\r\n" + b"SWP\r\n"
+    end = parts.rx(t, "S A8 03 01 A5 P")
+    end = parts.rx(end + 2000, "S AC P")
+    parts.rx(end + 2000, "S A8 P")
+    assert parts.read_lines(3) == b"SWAAAP\r\nSWP\r\nERROR 06\r\n"
+    ctl.wait(TWC)
     assert ee_read(parts, 0x300, 2) == b"\x5A\xA5"
 
 
