@@ -13,10 +13,7 @@
 /* The link-loss failsafe stops both motors. */
 #define DRV_motor_SAFE() drv_motor_safe()
 
-void drv_motor_init(void);
-reg_status_t drv_motor_write(uint8_t reg, const uint8_t *data, uint8_t len);
-reg_status_t drv_motor_check(uint8_t reg, const uint8_t *data, uint8_t len);
-uint8_t drv_motor_read(uint8_t reg, uint8_t *dst, uint8_t max);
+REGMAP_DRIVER_API(motor);
 /* PWM1 and PWM2 0, as a host's write of 00 00 to PWM1 (directions kept). */
 void drv_motor_safe(void);
 

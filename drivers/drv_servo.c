@@ -150,15 +150,18 @@ uint8_t drv_servo_read(uint8_t reg, uint8_t *dst, uint8_t max)
 
 void drv_servo_safe(void)
 {
-	/* Through the host's own path, a [ch][00][00] write for each channel
-	 * that pulses: servo_write_sp() and servo_hw_apply() keep their one
-	 * caller each (inlined there),
-	 * no buffer of 16 triples sits on the stack (this may be inlined into
-	 * the main loop), and the failsafe is exactly a host's writes. */
+	/*
+	 * Each pulsing channel is turned off by the write a host would send,
+	 * [ch][00][00] to SP, so the failsafe does exactly what those writes
+	 * do; a width of 0 is always accepted. One channel at a time, so no
+	 * buffer of 16 triples sits on the main loop's stack. Going through
+	 * drv_servo_write() leaves servo_write_sp() and servo_hw_apply() with
+	 * one caller each, which the compiler inlines them into.
+	 */
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
 		if (servo.width[ch]) {
 			const uint8_t off[3] = { ch, 0, 0 };
-			(void)drv_servo_write(SERVO_REG_SP, off, sizeof off);  /* width 0: always taken */
+			(void)drv_servo_write(SERVO_REG_SP, off, sizeof off);
 		}
 	}
 }

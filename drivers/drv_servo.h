@@ -18,10 +18,7 @@
 /* The link-loss failsafe turns every channel off (limp). */
 #define DRV_servo_SAFE() drv_servo_safe()
 
-void drv_servo_init(void);
-reg_status_t drv_servo_write(uint8_t reg, const uint8_t *data, uint8_t len);
-reg_status_t drv_servo_check(uint8_t reg, const uint8_t *data, uint8_t len);
-uint8_t drv_servo_read(uint8_t reg, uint8_t *dst, uint8_t max);
+REGMAP_DRIVER_API(servo);
 /* Every channel's width 0 (no pulses, line low), as a host's writes of
  * [ch][00][00] for each would. */
 void drv_servo_safe(void);

@@ -22,9 +22,6 @@
 /* The link-loss failsafe leaves it as it is. */
 #define DRV_spi_SAFE() ((void)0)
 
-void drv_spi_init(void);
-reg_status_t drv_spi_write(uint8_t reg, const uint8_t *data, uint8_t len);
-reg_status_t drv_spi_check(uint8_t reg, const uint8_t *data, uint8_t len);
-uint8_t drv_spi_read(uint8_t reg, uint8_t *dst, uint8_t max);
+REGMAP_DRIVER_API(spi);
 
 #endif

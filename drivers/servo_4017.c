@@ -77,10 +77,10 @@ typedef struct {
 	uint16_t frame;                             /* frame length, ticks */
 	uint8_t units;                              /* ETIMSK bits of the running counters */
 	uint8_t com3, com1;                         /* their COM bits (set on match) */
-} servo_sched_t;
+} frame_plan_t;
 
 static struct {
-	servo_sched_t sched[2];
+	frame_plan_t sched[2];
 	volatile uint8_t cur;
 	volatile uint8_t pending;
 	volatile uint8_t running;
@@ -88,16 +88,17 @@ static struct {
 	uint16_t t3_offset;                     /* TCNT3 - TCNT1 */
 	volatile uint8_t *rst_port;             /* the reset line's PORT register */
 	uint8_t rst_mask;
-} s4;
-
-/* A compare unit's COM bits: 0 off (the pin follows PORT: low), 2 clear,
- * 3 set on match; flipping the low bit turns set into clear and back. */
+} pulses;
 
 /*
  * Counter c's compare unit made a rising edge: the counter moved on. Bring
  * the clock low, pass the off outputs that follow, program the next rise
  * from this one (so a late interrupt never changes a width) or rest.
  * Inlined into each compare vector with its unit's registers as constants.
+ *
+ * A compare unit's COM bits: 0 off (the pin follows PORT: low), 2 clear,
+ * 3 set on match; flipping the low bit (`flip`) turns set into clear and
+ * back.
  */
 static inline __attribute__((always_inline)) void
 servo_rise(uint8_t c, volatile uint16_t *ocr, volatile uint16_t *tcnt, volatile uint8_t *tccr,
@@ -107,8 +108,8 @@ servo_rise(uint8_t c, volatile uint16_t *ocr, volatile uint16_t *tcnt, volatile 
 
 	*tccr ^= flip;          /* set -> clear */
 	*focr = foc;            /* clock low */
-	const servo_step_t *e = s4.next[c];
-	s4.next[c] = e + 1;
+	const servo_step_t *e = pulses.next[c];
+	pulses.next[c] = e + 1;
 	uint8_t steps = e->steps;
 	uint16_t dur = e->dur;
 	for (uint8_t k = steps & (uint8_t)~SERVO_REST; k; k--) {
@@ -146,20 +147,20 @@ ISR(TIMER1_COMPC_vect) { servo_rise(3, &OCR1C, &TCNT1, &TCCR1A, COM1C0, &TCCR1C,
 ISR(TIMER1_COMPA_vect)
 {
 	uint16_t f = OCR1A;
-	if (s4.pending) {
-		s4.cur ^= 1;
-		s4.pending = 0;
+	if (pulses.pending) {
+		pulses.cur ^= 1;
+		pulses.pending = 0;
 	}
-	const servo_sched_t *s = &s4.sched[s4.cur];
+	const frame_plan_t *s = &pulses.sched[pulses.cur];
 	/* Counters 0-2 count on Timer3, counter 3 on Timer1. An idle unit's
 	 * OCR is written too: with its COM bits off it does nothing. */
-	uint16_t f3 = f + s4.t3_offset;
+	uint16_t f3 = f + pulses.t3_offset;
 	OCR3A = f3 + s->first[0];
 	OCR3B = f3 + s->first[1];
 	OCR3C = f3 + s->first[2];
 	OCR1C = f + s->first[3];
 	for (uint8_t c = 0; c < SERVO_COUNTERS; c++) {
-		s4.next[c] = s->step[c];
+		pulses.next[c] = s->step[c];
 	}
 	TCCR3A = (uint8_t)((TCCR3A & (uint8_t)~COM3_ALL) | s->com3);
 	TCCR1A = (uint8_t)((TCCR1A & (uint8_t)~COM1C_ALL) | s->com1);
@@ -169,24 +170,24 @@ ISR(TIMER1_COMPA_vect)
 	ETIMSK = (uint8_t)((ETIMSK & (uint8_t)~UNITS_ALL) | s->units);
 	/* Reset pulse, well before the first clock: CD4017 needs 0.3 us at
 	 * 5 V; this is about 2.5 us. */
-	*s4.rst_port |= s4.rst_mask;
+	*pulses.rst_port |= pulses.rst_mask;
 	__builtin_avr_delay_cycles(16);
 	if (!s->units) {
 		/* Nothing pulses: counters held in reset, interrupts off. */
-		s4.running = 0;
+		pulses.running = 0;
 		TIMSK &= (uint8_t)~_BV(OCIE1A);
 		return;
 	}
-	*s4.rst_port &= (uint8_t)~s4.rst_mask;
+	*pulses.rst_port &= (uint8_t)~pulses.rst_mask;
 	OCR1A = f + s->frame;
 }
 
 void servo_hw_init(void)
 {
-	s4.running = 0;
-	s4.pending = 0;
-	s4.cur = 0;
-	s4.sched[0].units = 0;
+	pulses.running = 0;
+	pulses.pending = 0;
+	pulses.cur = 0;
+	pulses.sched[0].units = 0;
 	/* Clock lines low, reset held high: all outputs quiet. */
 	for (uint8_t c = 0; c < SERVO_COUNTERS; c++) {
 		uint8_t pin = board_pin(BF_SERVO_CLK, c);
@@ -196,10 +197,10 @@ void servo_hw_init(void)
 	}
 	uint8_t rst = board_pin(BF_SERVO_RST, 0);
 	pins_claim(rst, PIN_SERVO_CLK);
-	s4.rst_port = mcu_port(PIN_PORT(rst)).port;
-	s4.rst_mask = PIN_MASK(rst);
-	port_io_write(PIN_PORT(rst), s4.rst_mask, s4.rst_mask);
-	port_io_dir(PIN_PORT(rst), s4.rst_mask, s4.rst_mask);
+	pulses.rst_port = mcu_port(PIN_PORT(rst)).port;
+	pulses.rst_mask = PIN_MASK(rst);
+	port_io_write(PIN_PORT(rst), pulses.rst_mask, pulses.rst_mask);
+	port_io_dir(PIN_PORT(rst), pulses.rst_mask, pulses.rst_mask);
 	/* Timer1 and Timer3: normal mode, clk/8, started together. */
 	SFIOR = _BV(TSM) | _BV(PSR321);
 	TCCR1A = 0;
@@ -214,7 +215,7 @@ void servo_hw_init(void)
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 		uint16_t t1 = TCNT1;
 		uint16_t t3 = TCNT3;
-		s4.t3_offset = t3 - t1;
+		pulses.t3_offset = t3 - t1;
 	}
 }
 
@@ -236,8 +237,8 @@ void servo_hw_release(uint8_t ch)
 }
 
 /* Timer ticks for a width in microseconds, rounded to the nearest: us x
- * 0.9216 as a 16.16 product, a 16 x 16-bit multiply (the 32-bit division
- * it replaces took about 600 cycles a channel). For every width up to
+ * 0.9216 as a 16.16 product. A 16 x 16-bit multiply, not a 32-bit division
+ * (about 600 cycles a channel, 32 channels a plan); for every width up to
  * 2500 us it gives what (us x 9216 + 5000) / 10000 gives. */
 #define SERVO_TICKS_PER_US_Q16 ((uint16_t)((SERVO_TICK_HZ * 65536ULL + 500000ULL) / 1000000ULL))
 static uint16_t servo_ticks_of(uint16_t us)
@@ -248,7 +249,7 @@ static uint16_t servo_ticks_of(uint16_t us)
 /* Plans counter c: its hardware rises, the off outputs passed after each
  * and the ticks between rises. Returns the last rise's time, or 0 when no
  * channel of the counter is on. */
-static uint16_t servo_plan(servo_sched_t *s, uint8_t c, const uint16_t *widths_us)
+static uint16_t counter_plan(frame_plan_t *s, uint8_t c, const uint16_t *widths_us)
 {
 	servo_step_t *e = s->step[c];
 	uint16_t t = SERVO_LEAD + c * SERVO_STAGGER;
@@ -290,8 +291,8 @@ static uint16_t servo_plan(servo_sched_t *s, uint8_t c, const uint16_t *widths_u
 
 void servo_hw_apply(const uint16_t *widths_us)
 {
-	s4.pending = 0;  /* the frame interrupt must not take it half written */
-	servo_sched_t *s = &s4.sched[s4.cur ^ 1];
+	pulses.pending = 0;  /* the frame interrupt must not take it half written */
+	frame_plan_t *s = &pulses.sched[pulses.cur ^ 1];
 	static const __flash uint8_t unit[SERVO_COUNTERS] = {
 		_BV(OCIE3A), _BV(OCIE3B), _BV(OCIE3C), _BV(OCIE1C),
 	};
@@ -304,7 +305,7 @@ void servo_hw_apply(const uint16_t *widths_us)
 	s->com3 = 0;
 	s->com1 = 0;
 	for (uint8_t c = 0; c < SERVO_COUNTERS; c++) {
-		uint16_t last = servo_plan(s, c, widths_us + c * SERVO_SLOTS);
+		uint16_t last = counter_plan(s, c, widths_us + c * SERVO_SLOTS);
 		if (last) {
 			s->units |= unit[c];
 			if (c < 3) {
@@ -319,11 +320,11 @@ void servo_hw_apply(const uint16_t *widths_us)
 	}
 	s->frame = frame;
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		if (s4.running) {
-			s4.pending = 1;
+		if (pulses.running) {
+			pulses.pending = 1;
 		} else if (s->units) {
-			s4.cur ^= 1;
-			s4.running = 1;
+			pulses.cur ^= 1;
+			pulses.running = 1;
 			OCR1A = TCNT1 + 256;
 			TIMSK |= _BV(OCIE1A);
 		}

@@ -1,15 +1,17 @@
 /*
- * Servo pulses on ordinary port pins (M32-D: one pin per channel), as
- * servo_plan.c schedules them. Every edge is written by the Timer2 compare interrupt at an exact CPU cycle: Timer2
- * (clk/8) wakes the interrupt about SERVO_LEAD cycles early (more than any
- * other interrupt plus this one's entry can delay it), the interrupt waits on
- * Timer2 until the edge is SERVO_FINE cycles away and then on Timer0 (clk/1,
- * free running) for the edge's cycle. The edges' error is the few cycles of
- * that last loop, whatever else the firmware is doing.
+ * Servo pulses on ordinary port pins (M32-D: one pin per channel), on the
+ * schedule servo_plan.c makes. The Timer2 compare interrupt writes every
+ * edge at its exact CPU cycle, in three steps: Timer2 (clk/8) wakes it
+ * about SERVO_LEAD cycles early, more than any other interrupt plus this
+ * one's entry can delay it; it waits on Timer2 until the edge is SERVO_FINE
+ * cycles away; then it waits on Timer0 (clk/1, free running) for the edge's
+ * cycle. An edge is off by no more than the few cycles of that last loop,
+ * whatever else the firmware is doing.
  *
- * The schedule (edges sorted by time) is built in the main loop when widths
- * change, into the buffer the interrupt is not using, and taken over at the
- * next frame boundary: a frame never mixes old and new widths.
+ * The main loop plans a new schedule (edges in time order) when widths
+ * change, into the buffer the interrupt is not running, and the interrupt
+ * takes it over at the next frame boundary: a frame never mixes old and
+ * new widths.
  */
 #include "drivers/servo_hw.h"
 
@@ -38,7 +40,7 @@ static struct {
 	uint32_t frame;              /* Timer0 cycle of the frame's start */
 	uint32_t target;             /* Timer0 cycle of the next edge */
 	uint8_t t0_offset;           /* TCNT0 - 8 * TCNT2, measured at start */
-} sv;
+} pulses;
 
 /* Each channel's pin (PIN_ID), from the board's pin map. */
 static uint8_t servo_pin[SERVO_CHANNELS];
@@ -48,23 +50,29 @@ static const __flash uint8_t port_addr[] = {
 };
 static const __flash uint8_t line_mask[8] = { 1, 2, 4, 8, 16, 32, 64, 128 };
 
-/* Timer2 ticks (8 cycles) as a 16-bit count: edges are never more than a
- * frame (18432 ticks) ahead, so 16-bit differences order them. Called with
- * interrupts off (the compare interrupt, a locked block): an overflow the
- * overflow interrupt has not counted yet is counted here and its flag
- * cleared. (Counting it only while TCNT2 < 128 lost it once the compare
- * interrupt ran 1024 cycles past it; then every wait in the interrupt saw
- * its edge recede by 256 ticks a wrap and never ended.) */
-/* Timer2 is the time base's and this driver's (its compare unit, OCR2). */
+/* Timer2 is shared: the time base (firmware/clock.c) runs it and counts
+ * its overflows, this driver uses its compare unit (OCR2). */
 _Static_assert(BOARD_CLOCK_TIMER == 2, "servo_pins.c plans edges on the time base's Timer2");
 
+/*
+ * Now in Timer2 ticks (8 cycles) as a 16-bit count: edges are never more
+ * than a frame (18432 ticks) ahead, so 16-bit differences order them.
+ *
+ * Called with interrupts off (in the compare interrupt or a locked block),
+ * so an overflow may be pending that the overflow interrupt has not
+ * counted: it is counted here and its flag cleared. The flag is looked at
+ * whatever TCNT2 reads, because the compare interrupt can run more than
+ * half a wrap past an overflow while it waits in place for close edges. An
+ * overflow left uncounted would make the edge every wait is for recede by
+ * 256 ticks a wrap, and the wait would never end.
+ */
 static uint16_t servo_ticks(void)
 {
 	uint8_t t = TCNT2;
 	if (TIFR & _BV(TOV2)) {
 		TIFR = _BV(TOV2);  /* a 1 clears that flag only */
 		clock_wraps++;
-		t = TCNT2;         /* surely after the overflow */
+		t = TCNT2;         /* again: the first read may be from before the overflow */
 	}
 	return (uint16_t)(clock_wraps << 8 | t);
 }
@@ -75,42 +83,43 @@ static int16_t servo_ticks_to(uint32_t cycle)
 	return (int16_t)((uint16_t)(cycle >> 3) - servo_ticks());
 }
 
-/* Arms Timer2 to wake SERVO_LEAD cycles before sv.target; false if that is
+/* Arms Timer2 to wake SERVO_LEAD cycles before pulses.target; false if that is
  * too close: the caller then waits for the edge in place. The compare fires
  * once per Timer2 wrap; the interrupt ignores the wraps before the edge's. */
 static bool servo_arm(void)
 {
-	if (servo_ticks_to(sv.target) < SERVO_NEAR / 8) {
+	if (servo_ticks_to(pulses.target) < SERVO_NEAR / 8) {
 		return false;
 	}
-	OCR2 = (uint8_t)((sv.target - SERVO_LEAD) >> 3);
+	OCR2 = (uint8_t)((pulses.target - SERVO_LEAD) >> 3);
 	return true;
 }
 
 ISR(TIMER2_COMP_vect)
 {
-	if (!sv.running || servo_ticks_to(sv.target) > SERVO_NEAR / 8) {
+	if (!pulses.running || servo_ticks_to(pulses.target) > SERVO_NEAR / 8) {
 		return;  /* an earlier wrap, or a stale flag */
 	}
 	for (;;) {
-		const servo_sched_t *s = &sv.sched[sv.active];
-		uint8_t e = s->edge[sv.next].code;
+		const servo_sched_t *s = &pulses.sched[pulses.active];
+		uint8_t e = s->edge[pulses.next].code;
 		uint8_t pin = servo_pin[e & SERVO_CHAN];
 		volatile uint8_t *reg = (volatile uint8_t *)(uint16_t)port_addr[PIN_PORT(pin)];
 		uint8_t mask = line_mask[pin & 7];
-		uint8_t lo = (uint8_t)(sv.target + sv.t0_offset);
+		uint8_t lo = (uint8_t)(pulses.target + pulses.t0_offset);
 		uint8_t and_mask = (e & SERVO_FALL) ? (uint8_t)~mask : 0xFF;
 		uint8_t or_mask = (e & SERVO_FALL) ? 0 : mask;
-		uint16_t fine_from = (uint16_t)((sv.target - SERVO_FINE) >> 3);
+		uint16_t fine_from = (uint16_t)((pulses.target - SERVO_FINE) >> 3);
 
-		/* Near the edge on Timer2, then to its cycle on Timer0; the write
-		 * takes the same instructions for rising and falling edges. */
-		/* Already past the edge (it should not happen): make it now rather
-		 * than wait for Timer0 to come round again. */
+		/* Wait on Timer2 until SERVO_FINE cycles before the edge, then on
+		 * Timer0 for its cycle. An edge already past (the lead time should
+		 * prevent it) is written at once, not after Timer0 comes round
+		 * again. */
 		if ((int16_t)(fine_from - servo_ticks()) > -(SERVO_FINE / 8)) {
 			while ((int16_t)(fine_from - servo_ticks()) > 0) {
 			}
-			/* 4 cycles a turn (C made it 8): edges within 3 cycles. */
+			/* In assembly for 4 cycles a turn, so the write comes within
+			 * 3 cycles of the edge's cycle (the loop in C takes 8). */
 			__asm__ __volatile__(
 				"1:	in __tmp_reg__, %[tcnt]\n"
 				"	sub __tmp_reg__, %[lo]\n"
@@ -118,24 +127,26 @@ ISR(TIMER2_COMP_vect)
 				:
 				: [tcnt] "I" (_SFR_IO_ADDR(TCNT0)), [lo] "r" (lo));
 		}
+		/* The same instructions for a rise and a fall: both come equally
+		 * long after the wait. */
 		*reg = (uint8_t)((*reg & and_mask) | or_mask);
 
-		if (++sv.next == s->n) {
+		if (++pulses.next == s->n) {
 			/* Frame done: take a newer schedule over, start the next. */
-			sv.next = 0;
-			sv.frame += SERVO_FRAME;
-			if (sv.pending) {
-				sv.active ^= 1;
-				sv.pending = 0;
-				s = &sv.sched[sv.active];
+			pulses.next = 0;
+			pulses.frame += SERVO_FRAME;
+			if (pulses.pending) {
+				pulses.active ^= 1;
+				pulses.pending = 0;
+				s = &pulses.sched[pulses.active];
 				if (s->n == 0) {
-					sv.running = 0;
+					pulses.running = 0;
 					TIMSK &= (uint8_t)~_BV(OCIE2);
 					return;
 				}
 			}
 		}
-		sv.target = sv.frame + servo_cycle(&s->edge[sv.next]);
+		pulses.target = pulses.frame + servo_cycle(&s->edge[pulses.next]);
 		if (servo_arm()) {
 			return;
 		}
@@ -147,10 +158,10 @@ void servo_hw_init(void)
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
 		servo_pin[ch] = board_pin(BF_SERVO, ch);
 	}
-	sv.running = 0;
-	sv.pending = 0;
-	sv.active = 0;
-	sv.sched[0].n = 0;
+	pulses.running = 0;
+	pulses.pending = 0;
+	pulses.active = 0;
+	pulses.sched[0].n = 0;
 	/* Timer0 counts every cycle; Timer2 counts every 8th, run free by
 	 * the time base (firmware/clock.c), which counts its overflows. */
 	TCCR0 = _BV(CS00);
@@ -160,7 +171,7 @@ void servo_hw_init(void)
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 		uint8_t t0 = TCNT0;
 		uint8_t t2 = TCNT2;
-		sv.t0_offset = (uint8_t)(t0 - (uint8_t)(t2 << 3));
+		pulses.t0_offset = (uint8_t)(t0 - (uint8_t)(t2 << 3));
 	}
 }
 
@@ -190,25 +201,25 @@ void servo_hw_apply(const uint16_t *widths_us)
 	uint8_t newer;
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 		/* The interrupt must not take the buffer half written. */
-		newer = sv.pending;
-		sv.pending = 0;
+		newer = pulses.pending;
+		pulses.pending = 0;
 	}
 	/* The last plan: the buffer not taken over yet, else the running one. */
-	servo_sched_t *s = &sv.sched[sv.active ^ 1];
-	servo_plan(s, newer ? s : &sv.sched[sv.active], widths_us);
+	servo_sched_t *s = &pulses.sched[pulses.active ^ 1];
+	servo_plan(s, newer ? s : &pulses.sched[pulses.active], widths_us);
 	uint8_t n = s->n;
 
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		if (sv.running) {
-			sv.pending = 1;
+		if (pulses.running) {
+			pulses.pending = 1;
 		} else if (n) {
 			/* Start: the first frame begins a little from now. */
-			sv.active ^= 1;
-			sv.next = 0;
-			sv.frame = ((uint32_t)servo_ticks() << 3) + 4096;
-			sv.target = sv.frame + servo_cycle(&s->edge[0]);
+			pulses.active ^= 1;
+			pulses.next = 0;
+			pulses.frame = ((uint32_t)servo_ticks() << 3) + 4096;
+			pulses.target = pulses.frame + servo_cycle(&s->edge[0]);
 			servo_arm();
-			sv.running = 1;
+			pulses.running = 1;
 			/* (A stale compare flag needs no clearing: the interrupt it
 			 * wakes finds its edge far and returns.) */
 			TIMSK |= _BV(OCIE2);

@@ -26,7 +26,7 @@ _Static_assert(SERVO_SLOT >= SERVO_SHIFT * SERVO_MOVES, "only channel 0 can move
 static struct {
 	int8_t move[SERVO_CHANNELS];     /* each channel's place: SERVO_SHIFTs off its slot */
 	uint16_t us[SERVO_CHANNELS];     /* width as last planned; 0 = off */
-} pl;
+} placed;
 
 /* Frame offset of each channel's pulse start. */
 static const ORFA_FLASH uint32_t slot_start[SERVO_CHANNELS] = {
@@ -160,11 +160,11 @@ static __attribute__((noinline)) uint32_t servo_move(const servo_edge_t *e, uint
 	}
 	uint32_t r = slot_start[ch];
 	if (m >= -SERVO_MOVES && m <= SERVO_MOVES) {
-		pl.move[ch] = (int8_t)m;
+		placed.move[ch] = (int8_t)m;
 		r += (int16_t)(m * SERVO_SHIFT);
 	} else {
 		/* No clear place: where it was, among edges it may be near. */
-		r += (int16_t)(pl.move[ch] * SERVO_SHIFT);
+		r += (int16_t)(placed.move[ch] * SERVO_SHIFT);
 		at[0] = servo_count(e, n, (int32_t)r);
 		at[1] = servo_count(e, n, (int32_t)(r + w));
 	}
@@ -197,7 +197,7 @@ void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *wid
 	uint8_t changed[SERVO_CHANNELS];
 
 	const uint16_t *now = widths_us;
-	uint16_t *was = pl.us;
+	uint16_t *was = placed.us;
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, now++, was++) {
 		changed[ch] = *now != *was;
 		*was = *now;
@@ -209,10 +209,10 @@ void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *wid
 	 * now in s, then into the order: the edges after its fall move up two
 	 * places, those between its edges one. */
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		if (!changed[ch] || !pl.us[ch]) {
+		if (!changed[ch] || !placed.us[ch]) {
 			continue;
 		}
-		uint16_t w = servo_cycles(pl.us[ch]);
+		uint16_t w = servo_cycles(placed.us[ch]);
 		uint8_t at[2];
 		uint32_t r = servo_move(e, n, ch, w, at);
 		uint8_t i = at[0], j = at[1];

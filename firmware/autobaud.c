@@ -93,7 +93,7 @@ static struct {
 	uint8_t rate;		/* index + 1 of the rate in use */
 	volatile uint8_t lost;	/* set by the receive interrupt */
 	uint8_t fe_run;
-} ab;
+} autobaud;
 
 /* Wait up to 65535 iterations (53 ms) for RXD to fall, then count the
  * iterations of runs, low and high in turn, into the ring RUN of
@@ -252,8 +252,8 @@ static void ab_listen(uint8_t ubrr)
 		/* |=: the transmitter's UDRIE may be set (a reply going out). */
 		MCU_UCSRB |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
 		/* Framing errors seen so far were at the old rate. */
-		ab.lost = 0;
-		ab.fe_run = 0;
+		autobaud.lost = 0;
+		autobaud.fe_run = 0;
 	}
 }
 
@@ -261,9 +261,9 @@ static void ab_deaf(void)
 {
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 		MCU_UCSRB &= (uint8_t)~(_BV(RXEN) | _BV(RXCIE));
-		ab.lost = 0;
+		autobaud.lost = 0;
 	}
-	ab.state = AB_DETECT;
+	autobaud.state = AB_DETECT;
 }
 
 /* Record the line once, until it is quiet (AB_QUIET), or 53 ms without an
@@ -308,7 +308,7 @@ static uint8_t ab_scan(uint8_t *heard)
 
 void uart_init(void)
 {
-	ab.state = AB_DETECT;
+	autobaud.state = AB_DETECT;
 }
 
 uint8_t uart_line_poll(void)
@@ -316,19 +316,19 @@ uint8_t uart_line_poll(void)
 	uint8_t r;
 	uint8_t heard;
 
-	if (ab.lost) {
+	if (autobaud.lost) {
 		ab_deaf();
 	}
-	if (ab.state == AB_TALK) {
+	if (autobaud.state == AB_TALK) {
 		return 0;
 	}
-	if (ab.state == AB_FRESH) {
+	if (autobaud.state == AB_FRESH) {
 		/* Until a request proves the rate, the pin is still watched
 		 * (the receiver runs on): a preamble at another rate after a
 		 * wrong lock (noise that looked like one) moves the rate. The
 		 * bytes the receiver takes meanwhile wait in the ring. */
 		r = ab_scan(&heard);
-		if (r == 0 || r == ab.rate) {
+		if (r == 0 || r == autobaud.rate) {
 			return 0;
 		}
 	} else {
@@ -339,8 +339,8 @@ uint8_t uart_line_poll(void)
 	if (r == 0) {
 		return 1;	/* quiet for 53 ms: round the main loop */
 	}
-	ab.rate = r;
-	ab.state = AB_FRESH;
+	autobaud.rate = r;
+	autobaud.state = AB_FRESH;
 	ab_listen(ab_rates[r - 1].ubrr);
 	return 1;
 }
@@ -348,15 +348,15 @@ uint8_t uart_line_poll(void)
 void uart_line_rx(void)
 {
 	if (!(MCU_UCSRA & _BV(FE))) {
-		ab.fe_run = 0;
-	} else if (ab.state != AB_TALK || ++ab.fe_run >= AB_FE_RUN) {
-		ab.lost = 1;
+		autobaud.fe_run = 0;
+	} else if (autobaud.state != AB_TALK || ++autobaud.fe_run >= AB_FE_RUN) {
+		autobaud.lost = 1;
 	}
 }
 
 void uart_line_confirm(void)
 {
-	if (ab.state == AB_FRESH) {
-		ab.state = AB_TALK;
+	if (autobaud.state == AB_FRESH) {
+		autobaud.state = AB_TALK;
 	}
 }

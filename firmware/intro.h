@@ -11,9 +11,6 @@
 #define DRV_intro_MAJOR 1
 #define DRV_intro_MINOR 0
 
-void drv_intro_init(void);
-reg_status_t drv_intro_write(uint8_t reg, const uint8_t *data, uint8_t len);
-reg_status_t drv_intro_check(uint8_t reg, const uint8_t *data, uint8_t len);
-uint8_t drv_intro_read(uint8_t reg, uint8_t *dst, uint8_t max);
+REGMAP_DRIVER_API(intro);
 
 #endif

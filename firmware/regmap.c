@@ -62,24 +62,25 @@ static const ORFA_FLASH uint8_t regmap_records[][REGMAP_RECORD_LEN] = {
 	REGMAP_RECORD(DRV_sys_UID, DRV_sys_MAJOR, DRV_sys_MINOR, REGMAP_START_sys, DRV_sys_NREGS),
 };
 
-/* rm.entry when no register is selected (after an unmapped one). */
+/* selected.entry when no register is selected (after an unmapped one). */
 #define REGMAP_NO_ENTRY 0xFF
 _Static_assert(REGMAP_NDRIVERS < REGMAP_NO_ENTRY, "a driver index is never 0xFF");
 
+/* The register that reads and writes go to, and how the last one ended. */
 static struct {
 	uint8_t reg;     /* selected register */
 	uint8_t entry;   /* its driver's index in regmap_table, or REGMAP_NO_ENTRY */
 	uint8_t status;  /* result of the last write or read that reached a driver */
-} rm;
+} selected;
 
 void regmap_init(void)
 {
 	for (uint8_t i = 0; i < REGMAP_NDRIVERS; i++) {
 		regmap_table[i].init();
 	}
-	rm.reg = REGMAP_INTRO_REG;
-	rm.entry = 0;
-	rm.status = REG_OK;
+	selected.reg = REGMAP_INTRO_REG;
+	selected.entry = 0;
+	selected.status = REG_OK;
 }
 
 bool regmap_select(uint8_t reg)
@@ -87,70 +88,70 @@ bool regmap_select(uint8_t reg)
 	if (reg >= REGMAP_END) {
 		/* Nothing is selected now: a read gives nothing rather than
 		 * the register selected before, and the status says 08. */
-		rm.entry = REGMAP_NO_ENTRY;
-		rm.status = REG_NO_REGISTER;
+		selected.entry = REGMAP_NO_ENTRY;
+		selected.status = REG_NO_REGISTER;
 		return false;
 	}
 	uint8_t i = 0;
 	while (i + 1 < REGMAP_NDRIVERS && regmap_starts[i + 1] <= reg) {
 		i++;
 	}
-	rm.reg = reg;
-	rm.entry = i;
+	selected.reg = reg;
+	selected.entry = i;
 	return true;
 }
 
 reg_status_t regmap_check(const uint8_t *data, uint8_t len)
 {
-	if (rm.entry == REGMAP_NO_ENTRY) {
+	if (selected.entry == REGMAP_NO_ENTRY) {
 		return REG_NO_REGISTER;
 	}
-	if (rm.reg == REGMAP_STATUS_REG) {
+	if (selected.reg == REGMAP_STATUS_REG) {
 		return REG_NOT_WRITABLE;
 	}
-	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
-	return e->check((uint8_t)(rm.reg - regmap_starts[rm.entry]), data, len);
+	const ORFA_FLASH regmap_entry_t *e = &regmap_table[selected.entry];
+	return e->check((uint8_t)(selected.reg - regmap_starts[selected.entry]), data, len);
 }
 
 reg_status_t regmap_write(const uint8_t *data, uint8_t len)
 {
 	reg_status_t st;
 
-	if (rm.entry == REGMAP_NO_ENTRY) {
+	if (selected.entry == REGMAP_NO_ENTRY) {
 		st = REG_NO_REGISTER;
-	} else if (rm.reg == REGMAP_STATUS_REG) {
+	} else if (selected.reg == REGMAP_STATUS_REG) {
 		st = REG_NOT_WRITABLE;
 	} else {
-		const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
-		st = e->write((uint8_t)(rm.reg - regmap_starts[rm.entry]), data, len);
+		const ORFA_FLASH regmap_entry_t *e = &regmap_table[selected.entry];
+		st = e->write((uint8_t)(selected.reg - regmap_starts[selected.entry]), data, len);
 	}
-	rm.status = st;
+	selected.status = st;
 	return st;
 }
 
 void regmap_read_start(void)
 {
-	if (rm.reg != REGMAP_STATUS_REG && rm.entry != REGMAP_NO_ENTRY) {
-		rm.status = REG_OK;
+	if (selected.reg != REGMAP_STATUS_REG && selected.entry != REGMAP_NO_ENTRY) {
+		selected.status = REG_OK;
 	}
 }
 
 uint8_t regmap_read(uint8_t *dst, uint8_t max)
 {
-	if (rm.entry == REGMAP_NO_ENTRY) {
+	if (selected.entry == REGMAP_NO_ENTRY) {
 		return 0;  /* nothing selected: nothing to read, the status keeps 08 */
 	}
-	if (rm.reg == REGMAP_STATUS_REG) {
+	if (selected.reg == REGMAP_STATUS_REG) {
 		/* Reading the status leaves it as it is. */
 		for (uint8_t i = 0; i < max; i++) {
-			dst[i] = rm.status;
+			dst[i] = selected.status;
 		}
 		return max;
 	}
-	const ORFA_FLASH regmap_entry_t *e = &regmap_table[rm.entry];
-	uint8_t got = e->read((uint8_t)(rm.reg - regmap_starts[rm.entry]), dst, max);
+	const ORFA_FLASH regmap_entry_t *e = &regmap_table[selected.entry];
+	uint8_t got = e->read((uint8_t)(selected.reg - regmap_starts[selected.entry]), dst, max);
 	if (got == 0) {  /* (a driver gives at most max: tests/unit checks each) */
-		rm.status = REG_NOT_READABLE;
+		selected.status = REG_NOT_READABLE;
 		return 0;
 	}
 	return got;
@@ -166,12 +167,12 @@ void regmap_safe(void)
 
 reg_status_t regmap_status(void)
 {
-	return (reg_status_t)rm.status;
+	return (reg_status_t)selected.status;
 }
 
 void regmap_set_status(reg_status_t status)
 {
-	rm.status = status;
+	selected.status = status;
 }
 
 uint8_t regmap_driver_count(void)

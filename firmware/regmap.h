@@ -39,17 +39,19 @@ typedef enum {
 /*
  * A driver `name` (listed in ORFA_DRIVER_LIST) provides, in its header:
  *   DRV_name_UID, DRV_name_MAJOR, DRV_name_MINOR, DRV_name_NREGS
- *   void drv_name_init(void);
- *   reg_status_t drv_name_write(uint8_t reg, const uint8_t *data, uint8_t len);
+ *   REGMAP_DRIVER_API(name), which declares its four functions:
+ *   drv_name_init()
+ *       sets the driver up at power-on
+ *   drv_name_write(reg, data, len)
  *       applies all of `data` or nothing; REG_OK or why not
- *   reg_status_t drv_name_check(uint8_t reg, const uint8_t *data, uint8_t len);
+ *   drv_name_check(reg, data, len)
  *       the first `len` bytes of a write still coming in, data[len - 1] just
  *       arrived: REG_OK, or why no write that starts so can be taken
  *       (whatever follows). Looks at the newest byte only, changes nothing,
  *       and is quick: a TWI slave asks it in its interrupt, to refuse the
  *       byte after (docs/registers.md, "On a slave board"). drv_name_write
  *       decides in the end.
- *   uint8_t drv_name_read(uint8_t reg, uint8_t *dst, uint8_t max);
+ *   drv_name_read(reg, dst, max)
  *       puts up to `max` bytes of the register's data at `dst` and returns
  *       how many; 0 means the register cannot be read. The regmap asks again
  *       when a read frame wants more bytes than one answer gave.
@@ -64,6 +66,11 @@ typedef enum {
  *       says which, so none is forgotten.
  * `reg` is the register's offset inside the driver's range.
  */
+#define REGMAP_DRIVER_API(name) \
+	void drv_##name##_init(void); \
+	reg_status_t drv_##name##_write(uint8_t reg, const uint8_t *data, uint8_t len); \
+	reg_status_t drv_##name##_check(uint8_t reg, const uint8_t *data, uint8_t len); \
+	uint8_t drv_##name##_read(uint8_t reg, uint8_t *dst, uint8_t max)
 
 /* Calls every driver's init; selects register 0x00; status OK. */
 void regmap_init(void);

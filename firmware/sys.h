@@ -50,9 +50,6 @@ extern volatile uint8_t sys_heard;
  * one byte test. */
 void sys_poll(void);
 
-void drv_sys_init(void);
-reg_status_t drv_sys_write(uint8_t reg, const uint8_t *data, uint8_t len);
-reg_status_t drv_sys_check(uint8_t reg, const uint8_t *data, uint8_t len);
-uint8_t drv_sys_read(uint8_t reg, uint8_t *dst, uint8_t max);
+REGMAP_DRIVER_API(sys);
 
 #endif

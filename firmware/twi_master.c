@@ -110,6 +110,15 @@ static bool twi_wait(void)
 	return twi_wait_for(_BV(TWINT), _BV(TWINT));
 }
 
+/* Sends a byte (an address or data) and waits for its acknowledgement
+ * (or its absence); false on timeout, as twi_wait(). */
+static bool twi_send(uint8_t byte)
+{
+	TWDR = byte;
+	TWCR = _BV(TWINT) | _BV(TWEN);
+	return twi_wait();
+}
+
 twi_result_t twi_start(uint8_t addr8)
 {
 	twi_fence_wait();
@@ -121,9 +130,7 @@ twi_result_t twi_start(uint8_t addr8)
 		return twi_abandon();
 	}
 	twi.open = 1;
-	TWDR = addr8;
-	TWCR = _BV(TWINT) | _BV(TWEN);
-	if (!twi_wait()) {
+	if (!twi_send(addr8)) {
 		return TWI_FAIL;
 	}
 	switch (TW_STATUS) {
@@ -141,9 +148,7 @@ twi_result_t twi_start(uint8_t addr8)
 
 twi_result_t twi_write(uint8_t byte)
 {
-	TWDR = byte;
-	TWCR = _BV(TWINT) | _BV(TWEN);
-	if (!twi_wait()) {
+	if (!twi_send(byte)) {
 		return TWI_FAIL;
 	}
 	switch (TW_STATUS) {

@@ -121,25 +121,26 @@ static sg_event_t take_digit(sg_parser_t *p, uint8_t d)
 	return take_byte(p, b);
 }
 
+/* A one-letter command: V and X take nothing more (ST_DONE), L and C
+ * optional bytes (ST_ARGS). */
+static sg_event_t begin_line_command(sg_parser_t *p, uint8_t cmd, uint8_t state)
+{
+	p->cmd = cmd;
+	p->state = state;
+	return SG_MORE;
+}
+
 static sg_event_t begin_command(sg_parser_t *p, uint8_t c)
 {
 	switch (c | 0x20) {
 	case 'v':
-		p->cmd = SG_CMD_VERSION;
-		p->state = ST_DONE;
-		return SG_MORE;
+		return begin_line_command(p, SG_CMD_VERSION, ST_DONE);
 	case 'x':
-		p->cmd = SG_CMD_CLEAR;
-		p->state = ST_DONE;
-		return SG_MORE;
+		return begin_line_command(p, SG_CMD_CLEAR, ST_DONE);
 	case 'l':
-		p->cmd = SG_CMD_LOCAL;
-		p->state = ST_ARGS;
-		return SG_MORE;
+		return begin_line_command(p, SG_CMD_LOCAL, ST_ARGS);
 	case 'c':
-		p->cmd = SG_CMD_CLOCK;
-		p->state = ST_ARGS;
-		return SG_MORE;
+		return begin_line_command(p, SG_CMD_CLOCK, ST_ARGS);
 	case 's':
 		p->cmd = SG_CMD_I2C;
 		p->reply_len = 1;  /* the closing "P" */

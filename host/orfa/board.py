@@ -15,13 +15,30 @@ and reads raise the RegisterError of the status register's reason
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Dict, FrozenSet, Iterable, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Sequence, Tuple
 
 from . import boardmap
 from . import boards
 from . import protocol as p
+from .closing import Closing
 from .errors import NOT_ERRORS, NoDriverError, Status, register_error
 from .gateway import Gateway
+
+
+#: The driver clients by driver name: board.servo is CLIENTS["servo"](board).
+#: The clients sit above the board (each is a layer of register accesses
+#: over it): orfa.clients adds them here when it is imported, as orfa does.
+CLIENTS: Dict[str, Callable[["Board"], object]] = {}
+
+
+class _Client:
+    """board.<driver>: Board.client(<driver>) as an attribute."""
+
+    def __set_name__(self, owner, name: str) -> None:
+        self.name = name
+
+    def __get__(self, board, owner=None):
+        return self if board is None else board.client(self.name)
 
 
 @dataclass(frozen=True)
@@ -40,7 +57,7 @@ class Op:
         return "write" if self.kind == "w" else "read"
 
 
-class Board:
+class Board(Closing):
     """One ORFA board (the gateway itself, or a slave behind it)."""
 
     def __init__(self, gateway: Gateway, addr: Optional[int] = None):
@@ -64,12 +81,6 @@ class Board:
     def close(self) -> None:
         if self._owns_gateway:
             self.gateway.close()
-
-    def __enter__(self) -> "Board":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     def __repr__(self) -> str:
         return "<Board 0x%02X%s>" % (self.addr, " (gateway)" if self.is_local else "")
@@ -268,33 +279,22 @@ class Board:
         self.write("sys", "FAILSAFE", [ms >> 8, ms & 0xFF])
 
     # --- driver clients -------------------------------------------------------
-    def _client(self, name: str, factory):
+    def client(self, name: str):
+        """The client of driver `name` (CLIENTS), made once; NoDriverError
+        if the board has no such driver."""
         if name not in self._clients:
-            self._record(name)            # NoDriverError if the board has none
-            self._clients[name] = factory(self)
+            self._record(name)
+            self._clients[name] = CLIENTS[name](self)
         return self._clients[name]
 
-    @property
-    def gpio(self):
-        from .clients.gpio import Gpio
-        return self._client("gpio", Gpio)
+    gpio = _Client()
+    servo = _Client()
+    motor = _Client()
+    adc = _Client()
+    spi = _Client()
 
-    @property
-    def servo(self):
-        from .clients.servo import Servo
-        return self._client("servo", Servo)
 
-    @property
-    def motor(self):
-        from .clients.motor import Motor
-        return self._client("motor", Motor)
-
-    @property
-    def adc(self):
-        from .clients.adc import Adc
-        return self._client("adc", Adc)
-
-    @property
-    def spi(self):
-        from .clients.spi import Spi
-        return self._client("spi", Spi)
+# The board sits above the gateway (docs: host/README.md, "Layers"), so the
+# Gateway's board shorthands (gw.board(addr), gw.reset_cause(addr)) make
+# their Boards with this class, handed down rather than imported upwards.
+Gateway.board_class = Board

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import List, Optional, Sequence
 
 from . import boardmap, ihex
-from .protocol import OrfaError
+from .errors import FlashError
 from .locate import firmware_dirs, firmware_path
 
 PROGRAMMER = "usbasp"
@@ -33,10 +33,6 @@ SLAVE_ADDR = 0x10
 EXIT_SETUP = 2
 #: Exit status when avrdude ran and failed.
 EXIT_AVRDUDE = 1
-
-
-class FlashError(OrfaError):
-    """Flashing cannot start: no avrdude, no firmware, an unreadable file."""
 
 
 def board_map(board: str) -> boardmap.BoardMap:

@@ -15,6 +15,7 @@ import serial
 from . import boardmap
 from . import flow
 from . import protocol as p
+from .closing import Closing
 from .errors import SerialError
 
 #: i2cdetect's default range of 7-bit addresses (the others are reserved)
@@ -90,7 +91,7 @@ def _clip(text, size: int = 60):
 _STATUS_REGISTER = boardmap.load(boardmap.BOARDS[0]).reg("intro", "STATUS")
 
 
-class Gateway:
+class Gateway(Closing):
     """An ORFA gateway on one serial port; a context manager.
 
     autobaud=True sends the preamble of a BAUD=auto firmware (eight CRs, then
@@ -129,15 +130,9 @@ class Gateway:
         self._write(p.AUTOBAUD_PREAMBLE)
         (wait or time.sleep)(p.autobaud_wait_s(self.serial.baudrate))
 
-    # --- lifetime -----------------------------------------------------------
+    # --- lifetime (a context manager: Closing) -------------------------------
     def close(self) -> None:
         self.serial.close()
-
-    def __enter__(self) -> "Gateway":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     # --- lines ----------------------------------------------------------------
     def send(self, data: bytes) -> None:
@@ -193,10 +188,9 @@ class Gateway:
         return self.read_reply()
 
     def pipeline(self, lines: Sequence[str]) -> List[str]:
-        """Send every request in one write, then read one reply per request."""
-        data = b"".join(p.encode_request(line) for line in lines)
-        self.send(data)
-        return [self.read_reply() for _ in lines]
+        """run(lines), by its earlier name: the requests pipelined within the
+        flow rule (it once wrote them all at once, past the rule)."""
+        return self.run(lines)
 
     # --- batches: many requests in flight (docs/protocol.md, "Flow") -----------------
     def run(self, lines: Sequence[str]) -> List[str]:
@@ -497,12 +491,16 @@ class Gateway:
     # --- the sys driver and the status register, by address ----------------------
     # Shorthands for scripts that hold a Gateway: each is the Board's call
     # (orfa.board) for that address (None: the gateway itself).
+    #: What board() makes: orfa.board.Board, which sets itself here when it
+    #: is imported (the board layer sits above this one; importing orfa
+    #: imports it).
+    board_class: Optional[Callable[["Gateway", Optional[int]], object]] = None
+
     def board(self, addr: Optional[int] = None):
         """The Board at addr (None: the gateway's own drivers), kept per address."""
-        from .board import Board                 # board.py imports this module
         key = self.local if addr is None else addr & 0xFE
         if key not in self._boards:
-            self._boards[key] = Board(self, None if key == self.local else key)
+            self._boards[key] = self.board_class(self, None if key == self.local else key)
         return self._boards[key]
 
     def reset_cause(self, addr: Optional[int] = None) -> FrozenSet[str]:

@@ -14,6 +14,8 @@ import re
 import struct
 from typing import Iterable, List, Optional, Tuple
 
+from .errors import ElfError
+
 #: avr-gcc's address of the data space in an ELF: flash lies below it.
 AVR_DATA_BASE = 0x800000
 #: ELF machine number of the AVR.
@@ -23,10 +25,6 @@ PT_LOAD = 1
 RECORD_BYTES = 16
 
 Segment = Tuple[int, bytes]
-
-
-class ElfError(ValueError):
-    """The file is not an AVR ELF this module can read."""
 
 
 def is_elf(data: bytes) -> bool:

@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import List, NamedTuple, Optional, Sequence
 
 from . import waves
+from .errors import PlotUnavailable
 
 MAX_PULSE_LABELS = 8          # a row with more complete pulses gets only its summary
 ROW_HEIGHT_IN = 0.62
@@ -48,10 +49,6 @@ class Annotation(NamedTuple):
     kind: str                 # "pulse" (one pulse's width) or "summary"
     text: str
     cycles: Optional[int]     # the measured width (pulse) or None
-
-
-class PlotUnavailable(RuntimeError):
-    pass
 
 
 def annotations(rows: Sequence[Row], f_cpu: int) -> List[Annotation]:

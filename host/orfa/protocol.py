@@ -7,10 +7,17 @@ used by the protocol (bit 0 is the R/W bit).
 
 from __future__ import annotations
 
-import enum
 import re
 from dataclasses import dataclass
 from typing import Iterable, List, Optional, Sequence, Union
+
+# The protocol's errors live in orfa.errors with the rest of the tree; they
+# are this module's names too (orfa.protocol.OrfaError, p.HexError).
+from .errors import (  # noqa: F401
+    ERRORS_BY_CODE, AddressNackError, DataError, DataNackError, ErrorCode, HexError,
+    IncompleteError, InternalError, LimitError, OrfaError, ProtocolError, ReplyTimeout,
+    UnknownCommandError, error_for_code,
+)
 
 PROTOCOL_VERSION = "1.1"
 
@@ -43,103 +50,6 @@ def autobaud_wait_s(baudrate: int) -> float:
     """Seconds from writing the preamble until the host may talk: its eight
     frames on the wire (10 bits each) and the quiet after them."""
     return len(AUTOBAUD_PREAMBLE) * 10.0 / baudrate + AUTOBAUD_QUIET_S
-
-
-class ErrorCode(enum.IntEnum):
-    """The protocol's error codes (`ERROR <code>` replies)."""
-
-    INTERNAL = 0x01
-    UNKNOWN_COMMAND = 0x02
-    BAD_HEX = 0x03
-    BAD_DATA = 0x04
-    INCOMPLETE = 0x05
-    ADDRESS_NACK = 0x06
-    DATA_NACK = 0x07
-
-
-class OrfaError(Exception):
-    """Root of every error of this package; `.code` is the protocol's code."""
-
-    code: Optional[int] = None
-
-    def __init__(self, message: str = "", code: Optional[int] = None):
-        if code is not None:
-            self.code = code
-        super().__init__(message or self._default_message())
-
-    def _default_message(self) -> str:
-        if self.code is None:
-            return type(self).__name__
-        return "ERROR %02X" % self.code
-
-
-class InternalError(OrfaError):
-    """ERROR 01: the firmware's parser failed (must not happen)."""
-
-    code = ErrorCode.INTERNAL
-
-
-class UnknownCommandError(OrfaError):
-    """ERROR 02: unknown command letter."""
-
-    code = ErrorCode.UNKNOWN_COMMAND
-
-
-class HexError(OrfaError):
-    """ERROR 03: not a hex digit where a byte was expected, or a one-digit byte."""
-
-    code = ErrorCode.BAD_HEX
-
-
-class DataError(OrfaError):
-    """ERROR 04: wrong data, or a request or reply over its limit."""
-
-    code = ErrorCode.BAD_DATA
-
-
-class LimitError(DataError, ValueError):
-    """Refused on the host: the board would answer ERROR 04 (over a limit)."""
-
-
-class IncompleteError(OrfaError):
-    """ERROR 05: the line ended before the P of an I2C request."""
-
-    code = ErrorCode.INCOMPLETE
-
-
-class AddressNackError(OrfaError):
-    """ERROR 06: no ACK for an address (no device, bus stuck, unreadable register)."""
-
-    code = ErrorCode.ADDRESS_NACK
-
-
-class DataNackError(OrfaError):
-    """ERROR 07: no ACK for a data byte (or a local write a driver rejects)."""
-
-    code = ErrorCode.DATA_NACK
-
-
-class ProtocolError(OrfaError):
-    """A reply that is not what the protocol allows (or no reply at all)."""
-
-
-class ReplyTimeout(ProtocolError):
-    """No complete reply line arrived in time."""
-
-
-ERRORS_BY_CODE = {
-    cls.code: cls
-    for cls in (InternalError, UnknownCommandError, HexError, DataError,
-                IncompleteError, AddressNackError, DataNackError)
-}
-
-
-def error_for_code(code: int) -> OrfaError:
-    """The exception for an `ERROR <code>` reply (unknown codes: OrfaError)."""
-    cls = ERRORS_BY_CODE.get(code)
-    if cls is None:
-        return OrfaError("ERROR %02X" % code, code=code)
-    return cls()
 
 
 # --- frames -----------------------------------------------------------------
@@ -314,34 +224,29 @@ def check_error(reply: Union[str, bytes]) -> str:
     return text
 
 
-def parse_version(reply: Union[str, bytes]) -> str:
+def _parse(reply: Union[str, bytes], pattern: str, what: str) -> "re.Match[str]":
+    """The match of a reply to one of V, X, L, C (or the error it is)."""
     text = check_error(reply)
-    m = re.match(r"V(\d+\.\d+)\Z", text)
+    m = re.match(pattern + r"\Z", text)
     if m is None:
-        raise ProtocolError("not a version reply: %r" % text)
-    return m.group(1)
+        raise ProtocolError("not a %s reply: %r" % (what, text))
+    return m
+
+
+def parse_version(reply: Union[str, bytes]) -> str:
+    return _parse(reply, r"V(\d+\.\d+)", "version").group(1)
 
 
 def parse_clear(reply: Union[str, bytes]) -> None:
-    text = check_error(reply)
-    if text != "X":
-        raise ProtocolError("not a clear reply: %r" % text)
+    _parse(reply, "X", "clear")
 
 
 def parse_local_address(reply: Union[str, bytes]) -> int:
-    text = check_error(reply)
-    m = re.match(r"L([0-9A-F]{2})\Z", text)
-    if m is None:
-        raise ProtocolError("not a local address reply: %r" % text)
-    return int(m.group(1), 16)
+    return int(_parse(reply, "L([0-9A-F]{2})", "local address").group(1), 16)
 
 
 def parse_clock(reply: Union[str, bytes]) -> int:
-    text = check_error(reply)
-    m = re.match(r"C([0-9A-F]{4})\Z", text)
-    if m is None:
-        raise ProtocolError("not a clock reply: %r" % text)
-    return int(m.group(1), 16)
+    return int(_parse(reply, "C([0-9A-F]{4})", "clock").group(1), 16)
 
 
 _FRAME_RE = re.compile(r"SW(A*)|SR((?:[0-9A-F]{2})+)")

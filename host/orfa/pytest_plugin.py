@@ -30,6 +30,7 @@ from typing import Any, Dict, Iterator, List, Tuple
 
 import pytest
 
+from .board import Board
 from .sim import BOARDS, SimBoard, SimError, SimRobot
 
 DEFAULT_BOARD = "m32d"
@@ -152,7 +153,6 @@ def orfa_sim_robot(request) -> Iterator[SimRobot]:
 def orfa_board(orfa_sim_board):
     """A Board (orfa.board, the typed API) on orfa_sim_board's own drivers:
     `orfa_board.servo.set_width(3, 1500)`; its gateway is closed after."""
-    from .board import Board
     with orfa_sim_board.gateway() as gw:
         yield Board(gw)
 
@@ -161,7 +161,6 @@ def orfa_board(orfa_sim_board):
 def orfa_robot_boards(orfa_sim_robot):
     """{address: Board} of orfa_sim_robot: the gateway's own (its local
     address, 0xAA) and each slave's, all on one serial link."""
-    from .board import Board
     with orfa_sim_robot.gateway() as gw:
         boards = {gw.local: Board(gw)}
         for spec in orfa_sim_robot.slaves:

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 from . import locate
+from .errors import SimError
 from .gateway import Gateway
 from .protocol import AUTOBAUD_PREAMBLE, DEFAULT_BAUD, F_CPU, autobaud_wait_s
 from .simctl import SimControl
@@ -35,13 +36,6 @@ sim_path = locate.sim_path
 firmware_path = locate.firmware_path
 slave_firmware_path = locate.slave_firmware_path
 missing_builds = locate.missing_builds
-
-
-class SimError(RuntimeError):
-    """The simulator could not be started or died. `.refused`: the
-    simulator's own one-line reason when it refused its arguments (exit
-    status 2: a part's address or options), else None."""
-    refused: Optional[str] = None
 
 
 class TraceEvent(NamedTuple):
@@ -205,29 +199,19 @@ class SimBoard:
 
     # --- lifetime -------------------------------------------------------------
     def command(self) -> List[str]:
+        options = ([("--eeprom", "0x%02X" % addr) for addr in self.eeproms]
+                   + [("--srf08", "0x%02X" % addr) for addr in self.srf08]
+                   + [("--part", opt) for opt in self.part_options]
+                   + [("--trace", self.trace_path), ("--control", self.control_path),
+                      ("--vcd", self.vcd_path)]
+                   + [("--spi", spec) for spec in self.spi]
+                   + [("--adc", "%d=%d" % item) for item in sorted(self.adc.items())]
+                   + [("--avcc", self.avcc), ("--aref", self.aref)]
+                   + [("--slave", opt) for opt in self.slave_options])
         cmd = [str(sim_path()), "--board", self.board, "--link", self.port]
-        for addr in self.eeproms:
-            cmd += ["--eeprom", "0x%02X" % addr]
-        for addr in self.srf08:
-            cmd += ["--srf08", "0x%02X" % addr]
-        for opt in self.part_options:
-            cmd += ["--part", opt]
-        if self.trace_path is not None:
-            cmd += ["--trace", str(self.trace_path)]
-        if self.control_path is not None:
-            cmd += ["--control", str(self.control_path)]
-        if self.vcd_path is not None:
-            cmd += ["--vcd", str(self.vcd_path)]
-        for spec in self.spi:
-            cmd += ["--spi", spec]
-        for ch, mv in sorted(self.adc.items()):
-            cmd += ["--adc", "%d=%d" % (ch, mv)]
-        if self.avcc is not None:
-            cmd += ["--avcc", str(self.avcc)]
-        if self.aref is not None:
-            cmd += ["--aref", str(self.aref)]
-        for opt in self.slave_options:
-            cmd += ["--slave", opt]
+        for option, value in options:
+            if value is not None:                  # None: an option not given
+                cmd += [option, str(value)]
         return cmd + list(self.extra_args) + [str(self.firmware)]
 
     def start(self) -> "SimBoard":

@@ -10,6 +10,8 @@ import socket
 import time
 from typing import Dict, List, Optional, Tuple, Union
 
+from .closing import Closing
+from .errors import SimControlError
 
 #: Bytes one `rx` request carries at most here: its hex fits a request line
 #: (1023 characters) with any cycle.
@@ -23,11 +25,7 @@ def parse_edges(reply: str) -> List[Tuple[int, int]]:
     return [(int(c), int(lv)) for c, lv in (item.split(":") for item in reply.split())]
 
 
-class SimControlError(RuntimeError):
-    """The simulator refused a request (its ``ERR ...`` text)."""
-
-
-class SimControl:
+class SimControl(Closing):
     def __init__(self, path: str, timeout: float = 60.0, connect_timeout: float = 10.0):
         self.path = str(path)
         self.timeout = timeout
@@ -47,12 +45,6 @@ class SimControl:
 
     def close(self) -> None:
         self.sock.close()
-
-    def __enter__(self) -> "SimControl":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     def request(self, line: str) -> str:
         """Send one request, return its reply line (without newline)."""

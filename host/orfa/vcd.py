@@ -16,14 +16,12 @@ from __future__ import annotations
 import re
 from typing import Dict, Iterable, Iterator, List, Optional, Tuple
 
+from .errors import VcdError
+
 Edge = Tuple[int, int]                   # (cycle, level)
 
 _CLOCK = re.compile(r"(\d+(?:\.\d+)?)\s*Hz")
 _UNITS_PS = {"s": 10 ** 12, "ms": 10 ** 9, "us": 10 ** 6, "ns": 10 ** 3, "ps": 1, "fs": 1e-3}
-
-
-class VcdError(ValueError):
-    """A file that is not a VCD this module can read (the message says where)."""
 
 
 class Trace:

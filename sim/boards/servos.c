@@ -30,10 +30,10 @@ static int bm_counters(board_model_t *bm)
 		}
 		signal_listen(&cp->pin[clk->bit], cd4017_on_clock, &bm->cnt[c]);
 		if (rst) {
-			bm_port_t *rp = board_model_port(bm, rst->port);
+			bm_port_t *reset_port = board_model_port(bm, rst->port);
 
-			if (rp) {
-				signal_listen(&rp->pin[rst->bit], cd4017_on_reset, &bm->cnt[c]);
+			if (reset_port) {
+				signal_listen(&reset_port->pin[rst->bit], cd4017_on_reset, &bm->cnt[c]);
 			}
 		}
 		bm->ncnt++;

@@ -36,7 +36,7 @@
 #include <string.h>
 
 #include "parts/part.h"
-#include "periph/twi_bus.h"
+#include "parts/regdev.h"
 
 #define BMP280_CHIP_ID 0x58
 #define BMP280_RESET_WORD 0xB6
@@ -67,12 +67,7 @@ static const int16_t bmp280_dig_p[10] = { 0, 0, -10685, 3024, 2855, 140, -7, 155
 					    -14600, 6000 };		/* [2] .. [9] */
 
 typedef struct bmp280_t {
-	twi_dev_t dev;			/* first: the bus's view */
-	const twi_bus_t *bus;		/* its `cycle` is the time of an event */
-	uint32_t hz;
-	uint8_t addr8;
-	uint8_t selected, want_reg;	/* addressed; the next byte written is a register */
-	uint8_t reg;			/* register address (kept across STOP) */
+	regdev_t rd;			/* first: the I2C side, register/value writes */
 	uint8_t ctrl_meas, config;
 	uint8_t data[6];		/* 0xF7..0xFC as read */
 	uint64_t copy_until;		/* im_update until this cycle */
@@ -180,7 +175,7 @@ static int32_t bmp280_step(const bmp280_t *b, unsigned osrs)
 
 static uint64_t bmp280_us(const bmp280_t *b, uint64_t us)
 {
-	return (uint64_t)b->hz * us / 1000000u;
+	return (uint64_t)b->rd.hz * us / 1000000u;
 }
 
 /* The typical measurement time of ctrl_meas, in cycles. */
@@ -322,54 +317,29 @@ static uint8_t bmp280_read_reg(const bmp280_t *b, uint8_t reg, uint64_t now)
 	}
 }
 
-/* --- the bus ---------------------------------------------------------------- */
+/* --- the bus (regdev) ---------------------------------------------------- */
 
-static int bmp280_start(twi_dev_t *dev, uint8_t addr8)
+static void bmp280_catch_up(regdev_t *d, uint64_t now)
 {
-	bmp280_t *b = (bmp280_t *)dev;
-
-	b->selected = (addr8 & 0xfe) == b->addr8;
-	b->want_reg = b->selected && !(addr8 & 1);
-	if (b->selected) {
-		bmp280_update(b, b->bus->cycle);	/* the shadow for this transfer */
-	}
-	return b->selected;
+	bmp280_update((bmp280_t *)d, now);	/* the shadow for this transfer */
 }
 
-static int bmp280_write(twi_dev_t *dev, uint8_t byte)
+static uint8_t bmp280_read(regdev_t *d, uint8_t reg)
 {
-	bmp280_t *b = (bmp280_t *)dev;
-
-	if (!b->selected) {
-		return 0;
-	}
-	if (b->want_reg) {
-		b->reg = byte;
-	} else {
-		bmp280_write_reg(b, b->reg, byte, b->bus->cycle);
-	}
-	b->want_reg = !b->want_reg;
-	return 1;
+	return bmp280_read_reg((bmp280_t *)d, reg, d->bus->cycle);
 }
 
-static uint8_t bmp280_read(twi_dev_t *dev, int master_acks)
+static void bmp280_write(regdev_t *d, uint8_t reg, uint8_t v)
 {
-	bmp280_t *b = (bmp280_t *)dev;
-
-	(void)master_acks;
-	return bmp280_read_reg(b, b->reg++, b->bus->cycle);
+	bmp280_write_reg((bmp280_t *)d, reg, v, d->bus->cycle);
 }
 
-static void bmp280_stop(twi_dev_t *dev)
-{
-	((bmp280_t *)dev)->selected = 0;
-}
-
-static const twi_dev_ops_t bmp280_ops = {
-	.start = bmp280_start,
-	.write = bmp280_write,
+static const regdev_ops_t bmp280_ops = {
+	.catch_up = bmp280_catch_up,
 	.read = bmp280_read,
-	.stop = bmp280_stop,
+	.write = bmp280_write,
+	.ptr_mask = 0xff,
+	.pairs = 1,
 };
 
 /* --- descriptor ------------------------------------------------------------ */
@@ -388,11 +358,7 @@ static int bmp280_part_init(void *self, const part_env_t *env, const char *opts,
 		*err = "no options";
 		return -1;
 	}
-	b->dev.ops = &bmp280_ops;
-	b->dev.name = "bmp280";
-	b->bus = env->bus;
-	b->hz = env->hz;
-	b->addr8 = env->addr8 & 0xfe;
+	regdev_init(&b->rd, env, "bmp280", &bmp280_ops);
 	b->temp_c = 25.0;	/* a room at sea level until told otherwise */
 	b->press_pa = 101325.0;
 	bmp280_reset(b, 0);

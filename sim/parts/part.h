@@ -94,6 +94,52 @@ typedef struct part_kind_t {
  * "accel" -> "m/s^2", NULL for an unknown one. */
 const char *part_sense_units(const char *quantity);
 
+/* --- helpers for sensor parts ---------------------------------------------- */
+
+/* One quantity a part senses: N values, each within MIN..MAX (its units),
+ * RANGE the same for errors ("+-16 g"). */
+typedef struct part_sense_t {
+	const char *quantity;
+	int n;
+	double min, max;
+	const char *range;
+} part_sense_t;
+
+/* The entry of TABLE (COUNT entries) that QUANTITY with its N values V
+ * fits: its index, or -1 with ERR (CAP bytes) saying why: WHO ("an
+ * MPU-6050") does not sense it, the wrong number of values, a value
+ * outside the range. */
+int part_sense_pick(const char *who, const part_sense_t *table, int count, const char *quantity,
+		    const double *v, int n, char *err, size_t cap);
+
+/* VALUE times PER_UNIT, rounded to nearest, held within MIN..MAX: the raw
+ * reading of a sensor with PER_UNIT LSB per unit that saturates there. */
+int32_t part_raw(double value, double per_unit, int32_t min, int32_t max);
+
+/* Cycles in US microseconds at HZ cycles per second, rounded up. */
+uint64_t part_us(uint32_t hz, uint64_t us);
+
+/* A measurement clock: event K (0, 1, ..) at cycle START + K x HZ / RATE,
+ * RATE in millihertz, rounded up; at most LIMIT events (0: no limit). */
+typedef struct part_ticker_t {
+	uint64_t start;
+	uint64_t mhz;			/* 0: stopped */
+	uint64_t limit;
+	uint64_t taken;			/* events counted by part_ticker_take */
+} part_ticker_t;
+
+/* Start T: the first event at cycle FIRST, then MHZ millihertz, at most LIMIT. */
+void part_ticker_start(part_ticker_t *t, uint64_t first, uint64_t mhz, uint64_t limit);
+
+/* No more events. */
+void part_ticker_stop(part_ticker_t *t);
+
+/* How many events came since the last call, up to and at cycle NOW. */
+uint64_t part_ticker_take(part_ticker_t *t, uint32_t hz, uint64_t now);
+
+/* The cycle of the next event not yet taken, UINT64_MAX when none comes. */
+uint64_t part_ticker_next(const part_ticker_t *t, uint32_t hz);
+
 /* The registry: every kind, NULL-terminated. */
 extern const part_kind_t *const part_kinds[];
 

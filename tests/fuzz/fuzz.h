@@ -19,6 +19,25 @@ void fuzz_fail(const char *file, int line, const char *fmt, ...)
 		} \
 	} while (0)
 
+/* --- the input, a byte at a time ------------------------------------------ */
+
+/* What is left of the fuzzer's input. */
+typedef struct {
+	const uint8_t *at;
+	size_t left;
+} fuzz_input_t;
+
+/* The input's next byte; 0 once it is used up, so that an input may end
+ * anywhere. */
+static inline uint8_t fuzz_byte(fuzz_input_t *in)
+{
+	if (!in->left) {
+		return 0;
+	}
+	in->left--;
+	return *in->at++;
+}
+
 /* --- the serial gateway (fuzz_gate.c; harnesses fuzz-parse, fuzz-exec) --- */
 
 /* What the board under the gateway provides. */

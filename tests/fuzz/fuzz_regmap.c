@@ -30,17 +30,7 @@
 #define CANARY 0xA5
 #define REGS_MAX 32  /* registers a board maps, at most (M32-D: 0x14) */
 
-static const uint8_t *in;
-static size_t left;
-
-static uint8_t next(void)
-{
-	if (!left) {
-		return 0;
-	}
-	left--;
-	return *in++;
-}
+static fuzz_input_t in;
 
 static uint8_t canary[64 + 16];
 
@@ -163,7 +153,7 @@ static void same(const reg_snap_t *before, const char *what)
 
 static void op_select(void)
 {
-	uint8_t r = next();
+	uint8_t r = fuzz_byte(&in);
 	uint8_t reg = (r & 0x80) ? r : (uint8_t)(r % (m.nregs + 1));
 	bool ok = regmap_select(reg);
 	FUZZ_REQUIRE(ok == (reg < m.nregs), "select %02X gave %d (%u registers)", reg, ok, m.nregs);
@@ -177,9 +167,9 @@ static void op_select(void)
 
 static uint8_t take_data(uint8_t *data)
 {
-	uint8_t len = (uint8_t)(next() % LEN_MAX);
+	uint8_t len = (uint8_t)(fuzz_byte(&in) % LEN_MAX);
 	for (uint8_t i = 0; i < len; i++) {
-		data[i] = next();
+		data[i] = fuzz_byte(&in);
 	}
 	return len;
 }
@@ -237,8 +227,8 @@ static void op_check(void)
 static void op_read(void)
 {
 	uint8_t a[LEN_MAX + 64], b[LEN_MAX + 64];
-	unsigned n = 1 + next() % LEN_MAX;
-	uint8_t max = (uint8_t)(1 + next() % 64);
+	unsigned n = 1 + fuzz_byte(&in) % LEN_MAX;
+	uint8_t max = (uint8_t)(1 + fuzz_byte(&in) % 64);
 	reg_status_t st0 = regmap_status();
 
 	unsigned got = read_reg(a, n, max, 1);
@@ -269,7 +259,7 @@ static void op_read(void)
 
 static void op_inputs(void)
 {
-	uint8_t what = next(), v = next();
+	uint8_t what = fuzz_byte(&in), v = fuzz_byte(&in);
 	switch (what % 3) {
 	case 0:
 		port_ext[(what >> 2) % BOARD_NPORTS] = v;
@@ -292,8 +282,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-	in = data;
-	left = size;
+	in = (fuzz_input_t){ data, size };
 	memset(canary, CANARY, sizeof canary);
 	boot();
 	fuzz_board_fixed_save();
@@ -301,8 +290,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	FUZZ_REQUIRE(m.nregs <= REGS_MAX, "%u registers", m.nregs);
 	m.reg = REGMAP_INTRO_REG;
 	m.selected = 1;
-	while (left) {
-		switch (next() % 5) {
+	while (in.left) {
+		switch (fuzz_byte(&in) % 5) {
 		case 0:
 			op_select();
 			break;

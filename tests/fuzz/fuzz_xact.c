@@ -32,17 +32,7 @@
 
 #define FRAMES_MAX 48
 
-static const uint8_t *in;
-static size_t left;
-
-static uint8_t next(void)
-{
-	if (!left) {
-		return 0;
-	}
-	left--;
-	return *in++;
-}
+static fuzz_input_t in;
 
 /* --- frames, three ways ---------------------------------------------------- */
 
@@ -52,16 +42,16 @@ static result_t res[3][FRAMES_MAX], sel[3][FRAMES_MAX];
 static void frames(uint8_t nregs)
 {
 	unsigned n = 0;
-	while (left && n < FRAMES_MAX) {
+	while (in.left && n < FRAMES_MAX) {
 		frame_t *f = &seq[n++];
-		uint8_t r = next(), flags = next();
+		uint8_t r = fuzz_byte(&in), flags = fuzz_byte(&in);
 		memset(f, 0, sizeof *f);
 		f->reg = (r & 0x80) ? r : (uint8_t)(r % (nregs + 1));
 		f->read = flags & 1;
 		f->n = f->read ? (uint8_t)(1 + (flags >> 1) % SLAVE_BUF)
 			       : (uint8_t)((flags >> 1) % (SLAVE_BUF + 1));
 		for (uint8_t k = 0; k < f->n && !f->read; k++) {
-			f->data[k] = next();
+			f->data[k] = fuzz_byte(&in);
 		}
 	}
 	xact_model_run(seq, n, res[0], sel[0], xact_model_gateway);
@@ -130,14 +120,14 @@ static void end_frame(void)
 	t.in_sr = t.in_st = 0;
 }
 
-static void twi_events(void)
+static void twi_events(uint8_t chaos)
 {
 	boot();
 	slave_fsm_init();
 	memset(&t, 0, sizeof t);
-	t.chaos = in[-1] & 2;
-	while (left) {
-		uint8_t op = next();
+	t.chaos = chaos;
+	while (in.left) {
+		uint8_t op = fuzz_byte(&in);
 		switch (op % (t.chaos ? 8 : 7)) {
 		case 0:
 			end_frame();
@@ -145,7 +135,7 @@ static void twi_events(void)
 			t.in_sr = t.twea = 1;
 			break;
 		case 1: {
-			uint8_t b = next();
+			uint8_t b = fuzz_byte(&in);
 			if (!t.in_sr) {
 				break;  /* not addressed: the TWI says nothing */
 			}
@@ -186,7 +176,7 @@ static void twi_events(void)
 			t.in_sr = t.in_st = 0;
 			break;
 		default: {
-			uint8_t status = next(), b = next();
+			uint8_t status = fuzz_byte(&in), b = fuzz_byte(&in);
 			event((uint8_t)(status & 0xF8), b, 0);
 			t.in_sr = t.in_st = 0;
 			break;
@@ -216,10 +206,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	if (size == 0) {
 		return 0;
 	}
-	in = data + 1;
-	left = size - 1;
+	in = (fuzz_input_t){ data + 1, size - 1 };
 	if (data[0] & 1) {
-		twi_events();
+		twi_events(data[0] & 2);
 	} else {
 		boot();
 		frames(fuzz_board_nregs());

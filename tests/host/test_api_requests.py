@@ -271,10 +271,13 @@ def reads(n):
     return lines, ["SR" + ("%02X" % (1 + i % 40)) * (1 + i % 40) + "P" for i in range(n)]
 
 
-def test_run_300_in_order_within_the_flow_rule(fake):
+@pytest.mark.parametrize("call", ["run", "pipeline"])
+def test_run_300_in_order_within_the_flow_rule(fake, call):
+    """300 reads are 2,400 characters of requests; Gateway.pipeline once
+    wrote them all at once, far past the firmware's 256."""
     gw, line = fake(echo_answers)
     lines, want = reads(300)
-    assert gw.run(lines) == want
+    assert getattr(gw, call)(lines) == want
     assert line.written == lines                        # no marker: nothing went wrong
     assert 200 < line.max_in_flight < 256
 
@@ -410,3 +413,24 @@ def test_introspection_after_a_stale_line(fake):
     b = Board(gw)
     assert b.map.board == "m32d"
     assert line.written[0] == "V" and gw.resyncs == 1
+
+
+def test_the_duty_range_is_checked_in_one_place(fake, monkeypatch):
+    """Motor, `orfa motor` and the dashboard all ask clients.motor.is_duty:
+    a narrower MAX_DUTY narrows all three, and nothing reaches the line."""
+    from orfa.cli import devices
+    from orfa.clients import motor
+    from orfa.dash import live
+    b, line = make_board(fake)
+    for duty in (255, -255):
+        assert motor.is_duty(duty)
+    for duty in (256, -256, 1.0, True, None):
+        assert not motor.is_duty(duty)
+    monkeypatch.setattr(motor, "MAX_DUTY", 100)
+    with pytest.raises(ValueError, match="duty must be"):
+        b.motor.set_all(101, 0)
+    with pytest.raises(errors.UsageError, match="duty '101'"):
+        devices._duty("101")
+    with pytest.raises(errors.ControlError, match="motor: duty -101 is outside"):
+        live.set_motor(b, {}, {"motor": 1, "duty": -101})
+    assert line.written == []

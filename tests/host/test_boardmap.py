@@ -3,6 +3,7 @@ from the firmware's C definitions, read by Python, the tests, the benchmark
 and the docs. These tests fail when any of them drifts."""
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -11,6 +12,7 @@ import pytest
 
 from orfa import boardmap, boards
 from orfa import protocol as p
+from orfa.errors import Status
 
 ROOT = Path(__file__).resolve().parents[2]
 MAPS = ROOT / "host" / "orfa" / "maps"
@@ -163,13 +165,34 @@ def test_map_is_consistent(board):
     assert raw["board"] == board and raw["schema"] == 1
 
 
+def c_codes(header: str, macro: str):
+    """{code: name} of an X-macro list in the C (`X(NAME, 0x05, "text")`)."""
+    text = (ROOT / header).read_text()
+    body = text.split("#define %s(X)" % macro, 1)[1].split("\n\n", 1)[0]
+    return {int(code, 16): name
+            for name, code in re.findall(r"X\((\w+), (0x[0-9A-Fa-f]+),", body)}
+
+
+def test_python_codes_have_the_c_names():
+    """Names and numbers, straight from the C headers: the protocol's errors
+    (serialgate/sg_parse.h) and the status register's codes
+    (firmware/regmap.h)."""
+    errors = c_codes("serialgate/sg_parse.h", "SG_ERR_LIST")
+    assert errors == {1: "INTERNAL", 2: "COMMAND", 3: "HEX", 4: "DATA", 5: "NO_P",
+                      6: "ADDR_NACK", 7: "DATA_NACK"}
+    assert {int(c): c.name for c in p.ErrorCode} == errors
+    assert {int(c): c.name for c in Status} == c_codes("firmware/regmap.h", "REG_STATUS_LIST")
+    # each ERROR reply's class stands for the code of that name
+    assert {cls.__name__: cls.code.name for cls in p.ERRORS_BY_CODE.values()} == {
+        "InternalError": "INTERNAL", "UnknownCommandError": "COMMAND", "HexError": "HEX",
+        "DataError": "DATA", "IncompleteError": "NO_P", "AddressNackError": "ADDR_NACK",
+        "DataNackError": "DATA_NACK"}
+    assert sorted(p.ERRORS_BY_CODE) == sorted(errors)
+    assert p.ErrorCode.NO_P.text == "the line ended before the P of an I2C request"
+
+
 def test_python_constants_follow_the_map():
     m = boardmap.load("m32d")
-    assert {c: e.name for c, e in boardmap.ERRORS.items()} == {
-        1: "INTERNAL", 2: "COMMAND", 3: "HEX", 4: "DATA", 5: "NO_P",
-        6: "ADDR_NACK", 7: "DATA_NACK"}
-    assert sorted(int(c) for c in p.ErrorCode) == sorted(boardmap.ERRORS)
-    assert sorted(p.ERRORS_BY_CODE) == sorted(boardmap.ERRORS)
     for board in boardmap.BOARDS:
         bm = boardmap.load(board)
         assert bm.limits["request_chars"] == p.MAX_REQUEST_CHARS

@@ -120,7 +120,9 @@ def test_loop_reply_lines():
             gw.read_reply()
 
 
-def test_pipeline_sends_everything_first(fake):
+def test_pipeline_is_run(fake):
+    """Replies in order, ERROR replies as text; after an ERROR reply a marker
+    checks that no extra line took a request's place (Gateway.run)."""
     with Gateway(fake.url) as gw:
         assert gw.pipeline(["V", "L", "SA2P", "C"]) == ["V1.1", "LAA", "ERROR 06", "C0063"]
-    assert fake.requests == SYNC + ["V", "L", "SA2P", "C"]
+    assert fake.requests == SYNC + ["V", "L", "SA2P", "C", "V"]

@@ -171,8 +171,17 @@ def test_error_replies(code, cls):
 
 
 def test_error_codes_enum():
-    assert [int(c) for c in p.ErrorCode] == [1, 2, 3, 4, 5, 6, 7]
-    assert p.DataNackError.code == p.ErrorCode.DATA_NACK
+    """The firmware's names (SG_ERR_* of serialgate/sg_parse.h), from the map."""
+    assert [(int(c), c.name) for c in p.ErrorCode] == [
+        (1, "INTERNAL"), (2, "COMMAND"), (3, "HEX"), (4, "DATA"), (5, "NO_P"),
+        (6, "ADDR_NACK"), (7, "DATA_NACK")]
+    assert p.DataNackError.code is p.ErrorCode.DATA_NACK
+    assert p.IncompleteError.code is p.ErrorCode.NO_P
+    assert p.AddressNackError.code is p.ErrorCode(6)
+    assert str(p.ErrorCode.ADDR_NACK) == "ADDR_NACK"
+    assert "%02X" % p.ErrorCode.ADDR_NACK == "{:02X}".format(p.ErrorCode.ADDR_NACK) == "06"
+    assert p.IncompleteError.__doc__ == \
+        "ERROR 05 (NO_P): the line ended before the P of an I2C request."
 
 
 def test_unknown_error_code():

@@ -78,14 +78,24 @@ static uint8_t status_now(void)
 	return st;
 }
 
+/* Selects `reg` for a check at file:line, which fails if no driver maps it. */
+static bool select_at(const char *file, int line, uint8_t reg)
+{
+	if (regmap_select(reg)) {
+		return true;
+	}
+	char what[40];
+	snprintf(what, sizeof what, "register %02X not mapped", reg);
+	check_at(file, line, 0, what);
+	return false;
+}
+
 void write_at(const char *file, int line, uint8_t reg, const char *hex, reg_status_t status)
 {
 	uint8_t data[256];
 	unsigned n = parse_hex(hex, data, sizeof data);
 	char what[700];
-	if (!regmap_select(reg)) {
-		snprintf(what, sizeof what, "register %02X not mapped", reg);
-		check_at(file, line, 0, what);
+	if (!select_at(file, line, reg)) {
 		return;
 	}
 	reg_status_t got = regmap_write(data, (uint8_t)n);
@@ -102,9 +112,7 @@ void read_at(const char *file, int line, uint8_t reg, uint8_t n, const char *hex
 	unsigned wn = parse_hex(hex, want, sizeof want);
 	memset(got, 0xEE, sizeof got);
 	char what[1200], g[800];
-	if (!regmap_select(reg)) {
-		snprintf(what, sizeof what, "register %02X not mapped", reg);
-		check_at(file, line, 0, what);
+	if (!select_at(file, line, reg)) {
 		return;
 	}
 	reg_status_t r = read_n(got, n);
@@ -121,9 +129,7 @@ void unreadable_at(const char *file, int line, uint8_t reg, uint8_t n)
 	uint8_t got[256];
 	memset(got, 0xEE, sizeof got);
 	char what[200];
-	if (!regmap_select(reg)) {
-		snprintf(what, sizeof what, "register %02X not mapped", reg);
-		check_at(file, line, 0, what);
+	if (!select_at(file, line, reg)) {
 		return;
 	}
 	reg_status_t r = read_n(got, n);
@@ -186,6 +192,18 @@ void same_at(const char *file, int line, const snap_t *before)
 			 && memcmp(now->regs[reg], before->regs[reg], 64) == 0, what);
 	}
 	free(now);
+}
+
+void refused_writes_at(const char *file, int line, uint8_t reg, reg_status_t status,
+		       const char *const *hex)
+{
+	snap_t *before = malloc(sizeof *before);
+	snap_take(before);
+	for (; *hex; hex++) {
+		write_at(file, line, reg, *hex, status);
+	}
+	same_at(file, line, before);
+	free(before);
 }
 
 /* --- introspection and the register map ------------------------------------ */
@@ -341,14 +359,8 @@ static void test_gpio_common(void)
 	CHECK_EQ(port_ddr[p], 0x3F);
 
 	/* Lengths other than 1 or 2: 01, nothing changes. */
-	snap_t *s = malloc(sizeof *s);
-	snap_take(s);
-	WRITE(vr, "11 22 33", REG_BAD_LENGTH);
-	WRITE(mr, "", REG_BAD_LENGTH);
-	WRITE(mr, "FF FF FF", REG_BAD_LENGTH);
-	WRITE(vr, "", REG_BAD_LENGTH);
-	SAME(s);
-	free(s);
+	REFUSED(vr, REG_BAD_LENGTH, "11 22 33", "");
+	REFUSED(mr, REG_BAD_LENGTH, "", "FF FF FF");
 }
 
 /* --- servos ---------------------------------------------------------------- */
@@ -567,9 +579,7 @@ static void test_spi_common(void)
 	WRITE(cfg, "01 00 03", REG_OK);
 	CHECK_EQ(strcmp(hw_log, ""), 0);
 	/* Another channel wants the same line: 03. */
-	snap_take(s);
-	WRITE(cfg, "02 00 03", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(cfg, REG_PIN_BUSY, "02 00 03");
 
 	/* Exchange: chip select low, bytes, chip select high, nothing else. */
 	static const uint8_t answer[] = { 0xC2, 0x20, 0x17, 0x99 };
@@ -726,19 +736,10 @@ static void test_adc_common(void)
 
 	/* Rejections change nothing. */
 	WRITE(rc, "05 33", REG_OK);
-	snap_t *s = malloc(sizeof *s);
-	snap_take(s);
-	WRITE(rc, "08 33", REG_BAD_VALUE);
-	WRITE(rc, "F8 33", REG_BAD_VALUE);
-	WRITE(rc, "80 00", REG_BAD_VALUE);
-	WRITE(rc, "01", REG_BAD_LENGTH);
-	WRITE(rc, "01 33 00", REG_BAD_LENGTH);
-	WRITE(rc, "", REG_BAD_LENGTH);
+	REFUSED(rc, REG_BAD_VALUE, "08 33", "F8 33", "80 00");
+	REFUSED(rc, REG_BAD_LENGTH, "01", "01 33 00", "");
 	/* RD cannot be written. */
-	WRITE(rd, "00 00", REG_NOT_WRITABLE);
-	WRITE(rd, "00", REG_NOT_WRITABLE);
-	SAME(s);
-	free(s);
+	REFUSED(rd, REG_NOT_WRITABLE, "00 00", "00");
 }
 
 /* The link-loss failsafe (regmap_safe()): every servo channel off, as a

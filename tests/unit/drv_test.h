@@ -75,6 +75,13 @@ void snap_take(snap_t *s);
 void same_at(const char *file, int line, const snap_t *before);
 #define SAME(before) same_at(__FILE__, __LINE__, (before))
 
+/* Writes each of the hex strings (a NULL-ended list) to `reg`: every one
+ * is refused with `status` and leaves everything as it was. */
+void refused_writes_at(const char *file, int line, uint8_t reg, reg_status_t status,
+		       const char *const *hex);
+#define REFUSED(reg, status, ...) \
+	refused_writes_at(__FILE__, __LINE__, (reg), (status), (const char *const[]){ __VA_ARGS__, NULL })
+
 /* Pin id of port index p, line l. */
 #define PIN(p, l) ((uint8_t)((p) * 8 + (l)))
 

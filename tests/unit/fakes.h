@@ -15,10 +15,7 @@
 #define DRV_fake_UID 0x0F0F
 #define DRV_fake_MAJOR 2
 #define DRV_fake_MINOR 3
-void drv_fake_init(void);
-reg_status_t drv_fake_write(uint8_t reg, const uint8_t *data, uint8_t len);
-reg_status_t drv_fake_check(uint8_t reg, const uint8_t *data, uint8_t len);
-uint8_t drv_fake_read(uint8_t reg, uint8_t *dst, uint8_t max);
+REGMAP_DRIVER_API(fake);
 /* Its link-loss safe state: counts the calls. */
 #define DRV_fake_SAFE() drv_fake_safe()
 void drv_fake_safe(void);

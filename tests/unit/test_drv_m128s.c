@@ -5,7 +5,6 @@
  * SPI on B0-B3, UART0 on E0-E1, TWI on D0-D1, no motors.
  */
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "drv_test.h"
@@ -143,7 +142,6 @@ static void test_fixed_pins(void)
 static void test_servos(void)
 {
 	char t[400], want[300];
-	snap_t *s = malloc(sizeof *s);
 
 	boot();
 	uint8_t pa = port_out[PA], pf = port_out[PF], da = port_ddr[PA], df = port_ddr[PF];
@@ -184,38 +182,26 @@ static void test_servos(void)
 	WRITE(SP, "1F 00 00", REG_OK);
 	READ(RS, 4, "7F FF FF FF");
 	READ(RS, 2, "7F FF");
-	snap_take(s);
-	WRITE(SP, "20 05 DC", REG_BAD_VALUE);
-	WRITE(SP, "00 05 DC 20 05 DC", REG_BAD_VALUE);
-	WRITE(SP, "20", REG_BAD_VALUE);
-	SAME(s);
+	REFUSED(SP, REG_BAD_VALUE, "20 05 DC", "00 05 DC 20 05 DC", "20");
 	/* Counter boundaries: channels 7 | 8, 23 | 24 are separate bits. */
 	WRITE(SP, "08 00 00 17 00 00", REG_OK);
 	READ(RS, 4, "7F 7F FE FF");
-	free(s);
 }
 
 static void test_adc_spi_port_f(void)
 {
-	snap_t *s = malloc(sizeof *s);
-
 	boot();
 	/* A chip select on F2 refuses ADC channel 2; F0 (a GPIO output driven
 	 * high) must stay so. */
 	WRITE(MODE_F, "01", REG_OK);
 	WRITE(VAL_F, "01", REG_OK);
 	WRITE(SPI_CFG, "00 01 02", REG_OK);
-	snap_take(s);
-	WRITE(ADC_RC, "00 05", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(ADC_RC, REG_PIN_BUSY, "00 05");
 	CHECK_EQ(port_ddr[PF], 0x05);
 	CHECK_EQ(port_out[PF], 0x05);
 	/* An ADC line refuses a chip select. */
 	WRITE(ADC_RC, "00 20", REG_OK);
-	snap_take(s);
-	WRITE(SPI_CFG, "01 01 05", REG_PIN_BUSY);
-	WRITE(SPI_CFG, "00 01 05", REG_PIN_BUSY);  /* also as a rebinding */
-	SAME(s);
+	REFUSED(SPI_CFG, REG_PIN_BUSY, "01 01 05", "00 01 05" /* also as a rebinding */);
 	READ(SPI_CFG, 9, "02 01 02 FF FF FF FF FF FF");
 	/* Port numbers are the GPIO driver's: 1 is F, 2 does not exist. */
 	WRITE(SPI_CFG, "01 02 00", REG_BAD_VALUE);
@@ -226,7 +212,6 @@ static void test_adc_spi_port_f(void)
 	WRITE(0x06, "00 03 00", REG_OK);
 	CHECK_EQ(strcmp(hw_log, "WF04:00 X0300>0012 WF04:04 "), 0);
 	READ(0x06, 2, "00 12");
-	free(s);
 }
 
 void board_tests(void)

@@ -4,7 +4,6 @@
  * lines are servo channels 14/15, UART on D0-D1, TWI on C0-C1, SPI on B4-B7.
  */
 #include <stdio.h>
-#include <stdlib.h>
 
 #include "drv_test.h"
 
@@ -133,8 +132,6 @@ static void test_gpio_held(void)
  * not the pins it could have had. */
 static void test_all_or_nothing(void)
 {
-	snap_t *s = malloc(sizeof *s);
-
 	/* docs/registers.md: an ADC channel on PA3 refuses servo 2+3. PA2 is a
 	 * GPIO output driven high (an LED, say): it must stay so. */
 	boot();
@@ -142,17 +139,13 @@ static void test_all_or_nothing(void)
 	WRITE(VAL(PA), "04 04", REG_OK);
 	WRITE(ADC_RC, "00 08", REG_OK);
 	WRITE(SP, "07 05 DC", REG_OK);
-	snap_take(s);
-	WRITE(SP, "02 05 DC 03 05 DC", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(SP, REG_PIN_BUSY, "02 05 DC 03 05 DC");
 	CHECK_EQ(port_ddr[PA], 0x84);
 	CHECK_EQ(port_out[PA], 0x04);
 	CHECK_EQ(pins_owner(PIN(PA, 2)), PIN_FREE);
-	WRITE(SP, "03 05 DC 02 05 DC", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(SP, REG_PIN_BUSY, "03 05 DC 02 05 DC");
 	/* Turning a channel off in the same write is undone as well. */
-	WRITE(SP, "07 00 00 03 05 DC", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(SP, REG_PIN_BUSY, "07 00 00 03 05 DC");
 	READ(SP, 16, "00 00 00 00 00 00 00 00 00 00 00 00 00 00 05 DC");
 	/* Without channel 3 it goes through. */
 	WRITE(SP, "02 05 DC", REG_OK);
@@ -164,50 +157,38 @@ static void test_all_or_nothing(void)
 	WRITE(MODE(PA), "01 01", REG_OK);
 	WRITE(VAL(PA), "01 01", REG_OK);
 	WRITE(SP, "01 05 DC", REG_OK);
-	snap_take(s);
-	WRITE(ADC_RC, "01 03", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(ADC_RC, REG_PIN_BUSY, "01 03");
 	CHECK_EQ(port_ddr[PA], 0x03);
 	CHECK_EQ(port_out[PA], 0x01);
 	READ(ADC_RC, 2, "00 00");
 	/* Also when it already has lines: they stay, settings stay. */
 	WRITE(ADC_RC, "05 10", REG_OK);
-	snap_take(s);
-	WRITE(ADC_RC, "01 13", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(ADC_RC, REG_PIN_BUSY, "01 13");
 	READ(ADC_RC, 2, "05 10");
 	CHECK_EQ(hw.adc_mask, 0x10);
 	CHECK_EQ(hw.adc_refs, 1);
 	/* A chip select refuses it too. */
 	WRITE(SPI_CFG, "02 00 06", REG_OK);
-	snap_take(s);
-	WRITE(ADC_RC, "00 40", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(ADC_RC, REG_PIN_BUSY, "00 40");
 
 	/* Servo on a line that is a chip select, an ADC line, or neither. */
-	snap_take(s);
-	WRITE(SP, "06 05 DC", REG_PIN_BUSY);
-	WRITE(SP, "04 05 DC", REG_PIN_BUSY);
-	WRITE(SP, "00 05 DC 04 05 DC", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(SP, REG_PIN_BUSY, "06 05 DC", "04 05 DC", "00 05 DC 04 05 DC");
 
 	/* Chip selects on lines other functions hold: 03, nothing changes. */
-	snap_take(s);
-	WRITE(SPI_CFG, "00 00 01", REG_PIN_BUSY);  /* servo 1 */
-	WRITE(SPI_CFG, "00 00 04", REG_PIN_BUSY);  /* ADC 4 */
-	WRITE(SPI_CFG, "00 03 00", REG_PIN_BUSY);  /* RXD */
-	WRITE(SPI_CFG, "00 03 01", REG_PIN_BUSY);  /* TXD */
-	WRITE(SPI_CFG, "00 02 00", REG_PIN_BUSY);  /* SCL */
-	WRITE(SPI_CFG, "00 02 01", REG_PIN_BUSY);  /* SDA */
-	WRITE(SPI_CFG, "00 01 04", REG_PIN_BUSY);  /* SS */
-	WRITE(SPI_CFG, "00 01 07", REG_PIN_BUSY);  /* SCK */
-	WRITE(SPI_CFG, "00 01 00", REG_PIN_BUSY);  /* DIR1 */
-	WRITE(SPI_CFG, "00 03 05", REG_PIN_BUSY);  /* PWM1, stopped */
-	WRITE(SPI_CFG, "00 03 04", REG_PIN_BUSY);  /* PWM2, stopped */
-	WRITE(SPI_CFG, "02 00 01", REG_PIN_BUSY);  /* a bound channel keeps its line */
-	SAME(s);
+	REFUSED(SPI_CFG, REG_PIN_BUSY,
+		"00 00 01",  /* servo 1 */
+		"00 00 04",  /* ADC 4 */
+		"00 03 00",  /* RXD */
+		"00 03 01",  /* TXD */
+		"00 02 00",  /* SCL */
+		"00 02 01",  /* SDA */
+		"00 01 04",  /* SS */
+		"00 01 07",  /* SCK */
+		"00 01 00",  /* DIR1 */
+		"00 03 05",  /* PWM1, stopped */
+		"00 03 04",  /* PWM2, stopped */
+		"02 00 01"); /* a bound channel keeps its line */
 	READ(SPI_CFG, 9, "02 FF FF FF FF 00 06 FF FF");
-	free(s);
 }
 
 /* The link-loss failsafe stops both motors (PWM 0, directions kept), as a
@@ -235,8 +216,6 @@ static void test_motor_failsafe(void)
 
 static void test_motors(void)
 {
-	snap_t *s = malloc(sizeof *s);
-
 	boot();
 	CHECK_EQ(hw.motor_inits, 1);
 	READ(PWM1, 4, "00 00 00 00");
@@ -275,20 +254,14 @@ static void test_motors(void)
 	CHECK_EQ(hw.motor_lines, 0x03);
 	CHECK_EQ(hw.motor_pwm[1], 0);
 
-	/* Rejections change nothing. */
-	snap_take(s);
-	unsigned applies = hw.motor_applies;
-	WRITE(PWM1, "00 00 00 00 00", REG_BAD_LENGTH);
-	WRITE(PWM2, "00 00 00 00", REG_BAD_LENGTH);
-	WRITE(DIR1, "00 00 00", REG_BAD_LENGTH);
-	WRITE(DIR2, "00 00", REG_BAD_LENGTH);
-	WRITE(PWM1, "", REG_BAD_LENGTH);
-	WRITE(DIR1, "02", REG_BAD_VALUE);
-	WRITE(DIR2, "FF", REG_BAD_VALUE);
-	WRITE(PWM1, "00 00 00 02", REG_BAD_VALUE);
-	WRITE(PWM1, "10 10 80 00", REG_BAD_VALUE);
-	SAME(s);
-	CHECK_EQ(hw.motor_applies, applies);
+	/* Rejections change nothing, the hardware records included. */
+	REFUSED(PWM1, REG_BAD_LENGTH, "00 00 00 00 00", "");
+	REFUSED(PWM2, REG_BAD_LENGTH, "00 00 00 00");
+	REFUSED(DIR1, REG_BAD_LENGTH, "00 00 00");
+	REFUSED(DIR2, REG_BAD_LENGTH, "00 00");
+	REFUSED(DIR1, REG_BAD_VALUE, "02");
+	REFUSED(DIR2, REG_BAD_VALUE, "FF");
+	REFUSED(PWM1, REG_BAD_VALUE, "00 00 00 02", "10 10 80 00");
 	/* GPIO never reaches the motor lines. */
 	WRITE(MODE(PD), "00", REG_OK);
 	WRITE(MODE(PB), "00", REG_OK);
@@ -301,10 +274,8 @@ static void test_motors(void)
 	CHECK_EQ(hw.servo_width[15], 1500);
 	/* While it pulses motor 2 cannot run: 03, nothing changes (motor 1
 	 * included, the write is all or nothing). */
-	snap_take(s);
-	WRITE(PWM2, "01", REG_PIN_BUSY);
-	WRITE(PWM1, "40 FF 00 00", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(PWM2, REG_PIN_BUSY, "01");
+	REFUSED(PWM1, REG_PIN_BUSY, "40 FF 00 00");
 	/* PWM2 = 0 is fine; motor 2's line is left to the servo. */
 	WRITE(PWM1, "40 00 01 01", REG_OK);
 	CHECK_EQ(hw.motor_lines, 0x01);
@@ -312,10 +283,7 @@ static void test_motors(void)
 	CHECK_EQ(hw.motor_dir[1], 1);
 	CHECK_EQ(pins_owner(PIN(PD, 4)), PIN_SERVO);
 	/* Motor 1 runs: servo 14 (PD5) is refused, 03, nothing changes. */
-	snap_take(s);
-	WRITE(SP, "0E 05 DC", REG_PIN_BUSY);
-	WRITE(SP, "0F 07 D0 0E 05 DC", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(SP, REG_PIN_BUSY, "0E 05 DC", "0F 07 D0 0E 05 DC");
 	/* Motor 1 stops: servo 14 may take PD5 now. */
 	WRITE(PWM1, "00", REG_OK);
 	CHECK_EQ(pins_owner(PIN(PD, 5)), PIN_MOTOR_IDLE);
@@ -326,9 +294,7 @@ static void test_motors(void)
 	WRITE(DIR1, "00 00", REG_OK);
 	CHECK_EQ(hw.motor_lines, 0x00);
 	CHECK_EQ(hw.motor_dir[0], 0);
-	snap_take(s);
-	WRITE(PWM1, "01", REG_PIN_BUSY);
-	SAME(s);
+	REFUSED(PWM1, REG_PIN_BUSY, "01");
 	/* Servo 15 off: PD4 goes back to the stopped motor, low output. */
 	WRITE(SP, "0F 00 00", REG_OK);
 	CHECK_EQ(pins_owner(PIN(PD, 4)), PIN_MOTOR_IDLE);
@@ -350,7 +316,6 @@ static void test_motors(void)
 	CHECK_EQ(hw.motor_lines, 0x03);
 	READ(PWM1, 4, "01 C0 00 00");
 	READ(RS, 2, "00 00");
-	free(s);
 }
 
 static void test_servo_pins(void)

@@ -112,6 +112,16 @@ static long echo(uint64_t t, uint8_t a8, int k)
 	return b[0] << 8 | b[1];
 }
 
+/* Targets at NEAR_MM and FAR_MM (0: none) in front, the ranging command
+ * CMD to 0xE0 at cycle T: returns the cycle WAIT later (the ranging's
+ * length), when the results can be read. */
+static uint64_t ranging(uint64_t t, uint32_t near_mm, uint32_t far_mm, uint8_t cmd, uint64_t wait)
+{
+	srf08_set_targets(&s, near_mm, far_mm);
+	command(t, 0xE0, cmd);
+	return t + wait;
+}
+
 static void fresh(void)
 {
 	memset(&bus, 0, sizeof(bus));
@@ -164,16 +174,11 @@ static void test_units(void)
 	uint64_t t = 0;
 
 	fresh();
-	srf08_set_targets(&s, 1234, 0);
-	command(t, 0xE0, 0x50);
-	t += MS65;
+	t = ranging(t, 1234, 0, 0x50, MS65);
 	eq(echo(t, 0xE0, 0), 49, "0x50: 1234 mm = 48.6 in -> 49");
-	command(t, 0xE0, 0x52);
-	t += MS65;
+	t = ranging(t, 1234, 0, 0x52, MS65);
 	eq(echo(t, 0xE0, 0), 7180, "0x52: 1234 mm -> 7180 us of flight at 343.75 m/s");
-	srf08_set_targets(&s, 11008, 0);
-	command(t, 0xE0, 0x52);
-	t += MS65;
+	t = ranging(t, 11008, 0, 0x52, MS65);
 	eq(echo(t, 0xE0, 0), 64047, "11008 mm (the maximum) -> 64047 us, inside 65 ms");
 	eq(srf08_convert(0x51, 4), 0, "4 mm rounds to 0 cm");
 	eq(srf08_convert(0x51, 5), 1, "5 mm rounds to 1 cm");
@@ -196,18 +201,12 @@ static void test_range_register(void)
 	eq(fast, 46800, "range 24: 6.35 ms of ranging (65 ms x 25/256)");
 	eq(write_loc(t, 0xE0, 2, &v, 1), 3, "write range register");
 	eq(s.range, 24, "range register holds 24");
-	srf08_set_targets(&s, 1234, 0);
-	command(t, 0xE0, 0x51);
-	eq(echo(t + fast - 1, 0xE0, 0), -1, "still ranging just before 6.35 ms");
-	eq(echo(t + fast, 0xE0, 0), 0, "1234 mm is beyond a 1075 mm range: 0");
-	t += fast;
-	srf08_set_targets(&s, 1075, 0);
-	command(t, 0xE0, 0x51);
-	t += fast;
+	t = ranging(t, 1234, 0, 0x51, fast);
+	eq(echo(t - 1, 0xE0, 0), -1, "still ranging just before 6.35 ms");
+	eq(echo(t, 0xE0, 0), 0, "1234 mm is beyond a 1075 mm range: 0");
+	t = ranging(t, 1075, 0, 0x51, fast);
 	eq(echo(t, 0xE0, 0), 108, "1075 mm, at the edge of the range, is seen");
-	srf08_set_targets(&s, 1076, 0);
-	command(t, 0xE0, 0x51);
-	t += fast;
+	t = ranging(t, 1076, 0, 0x51, fast);
 	eq(echo(t, 0xE0, 0), 0, "1076 mm is not");
 }
 
@@ -221,9 +220,7 @@ static void test_gain_and_increment(void)
 	eq(s.range, 0x8C, "location counter moved on to the range register");
 	eq(write_loc(0, 0xE0, 3, gr, 1), 3, "a write to location 3 is acknowledged");
 	eq(s.gain, 0x10, "... and changes nothing");
-	srf08_set_targets(&s, 500, 0);
-	command(0, 0xE0, 0x51);
-	uint64_t t = srf08_ranging_cycles(&s, 0x8C);
+	uint64_t t = ranging(0, 500, 0, 0x51, srf08_ranging_cycles(&s, 0x8C));
 	eq(read_loc(t, 0xE0, 2, b, 1), 0, "read the high byte");
 	eq(read_loc(t, 0xE0, -1, b + 1, 1), 0, "a new read continues at location 3");
 	eq(b[0] << 8 | b[1], 50, "500 mm in two reads: 50 cm");
@@ -236,19 +233,13 @@ static void test_two_echoes(void)
 	uint64_t t = 0;
 
 	fresh();
-	srf08_set_targets(&s, 2000, 800);
-	command(t, 0xE0, 0x51);
-	t += MS65;
+	t = ranging(t, 2000, 800, 0x51, MS65);
 	eq(echo(t, 0xE0, 0), 80, "nearest echo first");
 	eq(echo(t, 0xE0, 1), 200, "then the farther one");
 	eq(echo(t, 0xE0, 2), 0, "then nothing");
-	srf08_set_targets(&s, 800, 20000);
-	command(t, 0xE0, 0x51);
-	t += MS65;
+	t = ranging(t, 800, 20000, 0x51, MS65);
 	eq(echo(t, 0xE0, 1), 0, "a second echo beyond 11 m is not seen");
-	srf08_set_targets(&s, 0, 0);
-	command(t, 0xE0, 0x51);
-	t += MS65;
+	t = ranging(t, 0, 0, 0x51, MS65);
 	eq(echo(t, 0xE0, 0), 0, "nothing in front: 0, buffer cleared");
 }
 
@@ -343,18 +334,16 @@ static void test_ann(void)
 	int nonzero = 0;
 
 	fresh();
-	srf08_set_targets(&s, 3000, 0);
-	command(0, 0xE0, 0x54);
-	eq(read_loc(MS65, 0xE0, 0, b, 36), 0, "read all 36 locations");
+	uint64_t t = ranging(0, 3000, 0, 0x54, MS65);
+	eq(read_loc(t, 0xE0, 0, b, 36), 0, "read all 36 locations");
 	eq(b[2] << 8 | b[3], 300, "ANN cm: locations 2,3 as in ranging mode");
 	eq(b[12] != 0, 1, "3 m: location 12 (the document's example)");
 	for (int i = 4; i < 36; i++) {
 		nonzero += b[i] != 0;
 	}
 	eq(nonzero, 1, "no other slot set");
-	srf08_set_targets(&s, 100, 400);
-	command(MS65, 0xE0, 0x53);
-	read_loc(2 * MS65, 0xE0, 0, b, 36);
+	t = ranging(t, 100, 400, 0x53, MS65);
+	read_loc(t, 0xE0, 0, b, 36);
 	eq(b[2] << 8 | b[3], 4, "ANN inches: 100 mm -> 4");
 	eq(b[4] != 0 && b[5] != 0 && b[6] == 0, 1, "0-352 mm: location 4, 353-705: 5");
 }

@@ -278,6 +278,22 @@ static void test_check_agrees_with_write(void)
 	CHECK(taken > 1000);  /* the writes were not all refused anyway */
 }
 
+/* The slave addressed for writing, then each byte given, every one
+ * acknowledged: a write frame as a master begins it. */
+static void slave_write_at(const char *file, int line, const uint8_t *data, size_t n)
+{
+	uint8_t b = 0;
+	check_eq_at(file, line, xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK,
+		    "SLA+W's answer");
+	for (size_t i = 0; i < n; i++) {
+		b = data[i];
+		check_eq_at(file, line, xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK,
+			    "a data byte's answer");
+	}
+}
+#define SLAVE_WRITE(...) slave_write_at(__FILE__, __LINE__, (const uint8_t[]){ __VA_ARGS__ }, \
+					sizeof (const uint8_t[]){ __VA_ARGS__ })
+
 /* A master that gives up mid-frame: a bus error (illegal START/STOP) drops
  * the frame whole; a read that a STOP ends without a NACK leaves the slave
  * ready for the next frame. */
@@ -288,27 +304,14 @@ static void test_aborted_frames(void)
 	boot();
 	slave_fsm_init();
 	uint8_t sp = B.servo_sp;
-	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
-	b = sp;
-	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
-	b = 0x00;
-	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
-	b = 0x05;
-	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
-	b = 0xDC;
-	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	SLAVE_WRITE(sp, 0x00, 0x05, 0xDC);
 	CHECK_EQ(xact_model_twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
 	CHECK_EQ(regmap_status(), REG_DROPPED);
 	READ(sp, 2, "00 00");                    /* nothing applied */
 	/* A frame gone quiet (twi_quiet.h): i2c_slave.c drops it before the
 	 * late event that ends it (the next request's START: TW_SR_STOP),
 	 * which then applies nothing. */
-	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
-	const uint8_t cut[4] = { sp, 0x00, 0x05, 0xDC };
-	for (int i = 0; i < 4; i++) {
-		b = cut[i];
-		CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
-	}
+	SLAVE_WRITE(sp, 0x00, 0x05, 0xDC);
 	CHECK(slave_fsm_in_frame());
 	slave_fsm_drop();
 	CHECK(!slave_fsm_in_frame());
@@ -317,44 +320,28 @@ static void test_aborted_frames(void)
 	READ(sp, 2, "00 00");
 	/* a bare register selection dropped: the selection stands, the
 	 * status is not touched */
-	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
-	b = sp;
-	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	SLAVE_WRITE(sp);
 	slave_fsm_drop();
 	CHECK_EQ(regmap_status(), REG_OK);
 	/* the next frame is served: the same write, ended properly */
-	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
-	const uint8_t w[4] = { sp, 0x00, 0x05, 0xDC };
-	for (int i = 0; i < 4; i++) {
-		b = w[i];
-		CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
-	}
+	SLAVE_WRITE(sp, 0x00, 0x05, 0xDC);
 	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
 	READ(sp, 2, "05 DC");
 	/* a read the master ends with a STOP after an ACK: no event comes
 	 * (the TWI leaves the frame by itself); the next write is served.
 	 * (READ above left the status register selected: select SP.) */
-	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
-	b = sp;
-	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	SLAVE_WRITE(sp);
 	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
 	CHECK_EQ(xact_model_twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
 	CHECK_EQ(b, 0x05);
 	CHECK_EQ(xact_model_twi_event(TW_ST_DATA_ACK, &b), SLAVE_SEND);
 	CHECK_EQ(b, 0xDC);
-	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
-	const uint8_t off[4] = { sp, 0x00, 0x00, 0x00 };
-	for (int i = 0; i < 4; i++) {
-		b = off[i];
-		CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
-	}
+	SLAVE_WRITE(sp, 0x00, 0x00, 0x00);
 	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
 	READ(sp, 2, "00 00");
 	/* No register selected after an unmapped one, also across a bus
 	 * error: a read gives FF, the status keeps 08. */
-	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
-	b = 0x00;
-	CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	SLAVE_WRITE(0x00);
 	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
 	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
 	b = 0xFE;

@@ -88,7 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
     devices.add_parsers(sub, common)
     console.add_parsers(sub, common)
     simulate.add_parsers(sub, common)
-    plot.add_parsers(sub, common)
+    plot.add_parsers(sub, common, run=main)
     dash.add_parsers(sub, common)
     if importlib.util.find_spec("orfa.flash") is not None:
         importlib.import_module("orfa.flash").add_parser(sub)

@@ -11,7 +11,7 @@ from typing import List, Sequence
 from .. import protocol as p
 from ..board import Board
 from ..gateway import SCAN_FIRST, SCAN_LAST
-from .common import (ADDRESS_RULE, UsageError, address, byte, connect, explain,
+from .common import (UsageError, address, arg, byte, command, connect, explain,
                      hex_bytes, number, show_address)
 from .names import board_of
 
@@ -22,6 +22,13 @@ from .names import board_of
 # --- version ------------------------------------------------------------------
 
 def cmd_version(args) -> int:
+    """the gateway's protocol version and board
+
+    Print the protocol version the gateway speaks (V) and its board (with
+    --addr: the slave's), known from its drivers.
+
+    example: orfa --sim m32d version
+    """
     addr = None if args.addr is None else address(args, args.addr, "--addr")
     with connect(args) as gw:
         version = gw.version()
@@ -51,6 +58,16 @@ def scan_grid(found: Sequence[int], first: int, last: int) -> str:
 
 
 def cmd_scan(args) -> int:
+    """probe every address, i2cdetect's grid
+
+    Probe each 7-bit address with an empty write (S<addr> P, pipelined) and
+    print i2cdetect's grid: the 7-bit address where a device answered, --
+    where none did. The line under it lists the same devices in the form
+    the other commands take (8-bit, or 7-bit with --7bit); 8-bit = 7-bit <<
+    1, so the gateway's own 0xAA is 0x55 in the grid.
+
+    example: orfa --sim m32d --eeprom 0xA0 scan
+    """
     first, last = (0x00, 0x7F) if args.all else (SCAN_FIRST, SCAN_LAST)
     with connect(args) as gw:
         local = gw.local_address()
@@ -71,6 +88,13 @@ MAX_READ = (p.MAX_REPLY_CHARS - len("SWASRP")) // 2
 
 
 def cmd_read(args) -> int:
+    """read registers (i2cget)
+
+    Select register REG of device ADDR and read COUNT bytes (S ADDR REG S
+    ADDR|1 COUNT P); print them as hex. {ADDRESS_RULE}
+
+    example: orfa read 0xA0 0x10 2  ->  0x41 0x42
+    """
     addr = address(args, args.addr_arg)
     if not 1 <= args.count <= MAX_READ:
         raise UsageError("COUNT is 1..%d (a reply holds %d characters)"
@@ -84,6 +108,13 @@ def cmd_read(args) -> int:
 
 
 def cmd_write(args) -> int:
+    """write registers (i2cset)
+
+    Write BYTEs to register REG of device ADDR (S ADDR REG BYTE... P). No
+    BYTE: only select REG. {ADDRESS_RULE}
+
+    example: orfa write 0xA0 0x10 0x41 0x42
+    """
     addr = address(args, args.addr_arg)
     frames = p.register_write_frames(addr, args.reg, args.bytes)
     _check_fits(frames)
@@ -150,6 +181,16 @@ def parse_messages(args, words: Sequence[str]) -> List[p.Frame]:
 
 
 def cmd_transfer(args) -> int:
+    """several messages in one transaction (i2ctransfer)
+
+    Messages as i2ctransfer takes them, sent as one request with a repeated
+    START between them: {r|w}LENGTH[@ADDR], a write followed by its LENGTH
+    data bytes; a message without @ADDR goes to the previous message's
+    address. Each read prints a line of hex bytes. i2ctransfer's data
+    suffixes (+, -, =, p) are not taken. {ADDRESS_RULE}
+
+    example: orfa transfer w1@0xA0 0x10 r2  ->  0x41 0x42
+    """
     frames = parse_messages(args, args.messages)
     _check_fits(frames)
     with connect(args) as gw:
@@ -163,6 +204,13 @@ def cmd_transfer(args) -> int:
 # --- request ------------------------------------------------------------------
 
 def cmd_request(args) -> int:
+    """send protocol requests, print the replies
+
+    Send each REQUEST line (docs/protocol.md) and print its reply. Exit
+    status 1 when a reply is an ERROR (all replies are printed).
+
+    example: orfa request --port /dev/ttyUSB0 V "S A0 10 S A1 02 P"
+    """
     status = 0
     with connect(args) as gw:
         for line in args.requests:
@@ -180,64 +228,16 @@ def cmd_request(args) -> int:
 # --- the parsers --------------------------------------------------------------
 
 def add_parsers(sub, common) -> None:
-    cmd = sub.add_parser(
-        "version", parents=[common], help="the gateway's protocol version and board",
-        description="Print the protocol version the gateway speaks (V) and its board"
-                    " (with --addr: the slave's), known from its drivers.",
-        epilog="example: orfa --sim m32d version")
-    cmd.set_defaults(func=cmd_version)
-
-    cmd = sub.add_parser(
-        "scan", parents=[common], help="probe every address, i2cdetect's grid",
-        description="Probe each 7-bit address with an empty write (S<addr> P, pipelined)"
-                    " and print i2cdetect's grid: the 7-bit address where a device"
-                    " answered, -- where none did. The line under it lists the same"
-                    " devices in the form the other commands take (8-bit, or 7-bit"
-                    " with --7bit); 8-bit = 7-bit << 1, so the gateway's own 0xAA is"
-                    " 0x55 in the grid.",
-        epilog="example: orfa --sim m32d --eeprom 0xA0 scan")
-    cmd.add_argument("-a", "--all", action="store_true",
-                     help="probe 0x00-0x7F (default 0x08-0x77, as i2cdetect)")
-    cmd.set_defaults(func=cmd_scan)
-
-    cmd = sub.add_parser(
-        "read", parents=[common], help="read registers (i2cget)",
-        description="Select register REG of device ADDR and read COUNT bytes"
-                    " (S ADDR REG S ADDR|1 COUNT P); print them as hex. " + ADDRESS_RULE,
-        epilog="example: orfa read 0xA0 0x10 2  ->  0x41 0x42")
-    cmd.add_argument("addr_arg", type=number, metavar="ADDR")
-    cmd.add_argument("reg", type=byte, metavar="REG")
-    cmd.add_argument("count", type=number, nargs="?", default=1, metavar="COUNT",
-                     help="bytes to read, 1..%d (default 1)" % MAX_READ)
-    cmd.set_defaults(func=cmd_read)
-
-    cmd = sub.add_parser(
-        "write", parents=[common], help="write registers (i2cset)",
-        description="Write BYTEs to register REG of device ADDR (S ADDR REG BYTE... P)."
-                    " No BYTE: only select REG. " + ADDRESS_RULE,
-        epilog="example: orfa write 0xA0 0x10 0x41 0x42")
-    cmd.add_argument("addr_arg", type=number, metavar="ADDR")
-    cmd.add_argument("reg", type=byte, metavar="REG")
-    cmd.add_argument("bytes", type=byte, nargs="*", metavar="BYTE")
-    cmd.set_defaults(func=cmd_write)
-
-    cmd = sub.add_parser(
-        "transfer", parents=[common], help="several messages in one transaction (i2ctransfer)",
-        description="Messages as i2ctransfer takes them, sent as one request with a"
-                    " repeated START between them: {r|w}LENGTH[@ADDR], a write followed"
-                    " by its LENGTH data bytes; a message without @ADDR goes to the"
-                    " previous message's address. Each read prints a line of hex"
-                    " bytes. i2ctransfer's data suffixes (+, -, =, p) are not taken. "
-                    + ADDRESS_RULE,
-        epilog="example: orfa transfer w1@0xA0 0x10 r2  ->  0x41 0x42")
-    cmd.add_argument("messages", nargs="+", metavar="MSG")
-    cmd.set_defaults(func=cmd_transfer)
-
-    cmd = sub.add_parser(
-        "request", parents=[common], help="send protocol requests, print the replies",
-        description="Send each REQUEST line (docs/protocol.md) and print its reply."
-                    " Exit status 1 when a reply is an ERROR (all replies are printed).",
-        epilog='example: orfa request --port /dev/ttyUSB0 V "S A0 10 S A1 02 P"')
-    cmd.add_argument("requests", nargs="+", metavar="REQUEST")
-    cmd.set_defaults(func=cmd_request)
-
+    where = (arg("addr_arg", type=number, metavar="ADDR"),
+             arg("reg", type=byte, metavar="REG"))
+    command(sub, [common], cmd_version)
+    command(sub, [common], cmd_scan,
+            arg("-a", "--all", action="store_true",
+                help="probe 0x00-0x7F (default 0x08-0x77, as i2cdetect)"))
+    command(sub, [common], cmd_read, *where,
+            arg("count", type=number, nargs="?", default=1, metavar="COUNT",
+                help="bytes to read, 1..%d (default 1)" % MAX_READ))
+    command(sub, [common], cmd_write, *where,
+            arg("bytes", type=byte, nargs="*", metavar="BYTE"))
+    command(sub, [common], cmd_transfer, arg("messages", nargs="+", metavar="MSG"))
+    command(sub, [common], cmd_request, arg("requests", nargs="+", metavar="REQUEST"))

@@ -5,14 +5,15 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import inspect
 import math
 import os
 from typing import Iterator, List, Optional
 
 from .. import protocol as p
-from ..errors import explain  # noqa: F401 (the commands' one-line errors)
+from ..errors import UsageError, explain  # noqa: F401 (the commands' errors, one line each)
 from ..gateway import Gateway, os_reason
-from ..sim import BOARDS, SimBoard, SimError
+from ..sim import BOARDS, SimBoard, SimError, part_kinds
 
 #: The environment variable that gives --port its default.
 PORT_ENV = "ORFA_PORT"
@@ -22,10 +23,6 @@ ADDRESS_RULE = ("Addresses are the protocol's 8-bit form (0xA0, 0x10, the gatewa
                 " own 0xAA: even, bit 0 is the R/W bit), as in requests and everywhere"
                 " else in ORFA; with --7bit they are i2c-tools' 7-bit form (0x50, 0x08,"
                 " 0x55), 8-bit = 7-bit << 1.")
-
-
-class UsageError(Exception):
-    """A mistake on the command line found after parsing: exit status 2."""
 
 
 def number(text: str) -> int:
@@ -134,9 +131,73 @@ def open_gateway(url: str, args) -> Gateway:
         raise UsageError("cannot open %s: %s" % (url, os_reason(exc, errno=False))) from None
 
 
+def slave_spec(text: str):
+    """`BOARD:ADDR[:ELF]` -> (board, addr, elf or None: the board's slave build)."""
+    parts = text.split(":", 2)
+    if len(parts) < 2 or parts[0] not in BOARDS:
+        raise argparse.ArgumentTypeError(
+            "%r: BOARD:ADDR[:ELF] with BOARD one of %s" % (text, ", ".join(BOARDS)))
+    try:
+        addr = int(parts[1], 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0x10" % text) from None
+    _check_device_address(text, addr)
+    return (parts[0], addr, parts[2] if len(parts) == 3 and parts[2] else None)
+
+
+def eeprom_spec(text: str) -> int:
+    """`ADDR` of --eeprom, checked as --slave's is."""
+    try:
+        addr = int(text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0xA0" % text) from None
+    _check_device_address(text, addr)
+    return addr
+
+
+def part_spec(text: str):
+    """`KIND@ADDR[:OPTIONS]` of --part -> (kind, addr, options); ADDR checked
+    as --eeprom's, KIND against the simulator's kinds."""
+    kind, at, rest = text.partition("@")
+    addr_text, _, opts = rest.partition(":")
+    kinds = part_kinds()
+    if not at or not kind:
+        raise argparse.ArgumentTypeError("%r: KIND@ADDR[:OPTIONS] like bmp280@0xEC" % text)
+    if kinds and kind not in kinds:
+        raise argparse.ArgumentTypeError("%r: no part %r (the simulator's: %s)"
+                                         % (text, kind, ", ".join(kinds)))
+    try:
+        addr = int(addr_text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0xEC" % text) from None
+    _check_device_address(text, addr)
+    return (kind, addr, opts)
+
+
+def _check_device_address(text: str, addr: int) -> None:
+    """A simulated device's 8-bit bus address: even, outside the addresses
+    I2C reserves, and not the gateway's own (its requests never reach the bus)."""
+    if addr & 1 or not 0x10 <= addr <= 0xEE:
+        raise argparse.ArgumentTypeError("%r: ADDR must be even, 0x10..0xEE" % text)
+    if addr == p.DEFAULT_LOCAL_ADDRESS:
+        raise argparse.ArgumentTypeError("%r: 0x%02X is the gateway's own address (its"
+                                         " requests never reach the bus)" % (text, addr))
+
+
+def adc_spec(text: str):
+    """`CH=MV` -> (channel, millivolts)."""
+    ch, sep, mv = text.partition("=")
+    try:
+        pair = (int(ch, 0), int(mv, 0))
+    except ValueError:
+        pair = None
+    if not sep or pair is None or not 0 <= pair[0] <= 7 or pair[1] < 0:
+        raise argparse.ArgumentTypeError("%r: CH=MV with CH 0-7 (3=1200)" % text)
+    return pair
+
+
 def add_sim_devices(parser, suppress: bool = False) -> None:
     """The simulated board's devices: for `sim`, and for --sim."""
-    from .simulate import adc_spec, eeprom_spec, part_spec, slave_spec
     default = argparse.SUPPRESS if suppress else None
     parser.add_argument("--eeprom", type=eeprom_spec, action="append", default=default or [],
                         metavar="ADDR",
@@ -209,6 +270,30 @@ def connect(args) -> Iterator[Gateway]:
                          % (PORT_ENV, "|".join(BOARDS)))
     with open_gateway(url, args) as gw:
         yield gw
+
+
+def arg(*names, **options):
+    """One argument of command(): arg("--all", action="store_true", help=...)."""
+    return names, options
+
+
+def command(sub, parents, func, *arguments, **fill) -> argparse.ArgumentParser:
+    """Add the command `func` runs, named after it (cmd_scan: `scan`), to the
+    subparsers `sub`, with `arguments` (arg(...)), and return its parser.
+    The function's docstring says the rest: its first line is the help, its
+    last paragraph the epilog (the examples), the paragraphs between them
+    the description, where `{NAME}` stands for fill[NAME] ({ADDRESS_RULE}:
+    ADDRESS_RULE)."""
+    paragraphs = inspect.cleandoc(func.__doc__).split("\n\n")
+    description = " ".join(paragraphs[1:-1])
+    for name, text in dict(fill, ADDRESS_RULE=ADDRESS_RULE).items():
+        description = description.replace("{%s}" % name, str(text))
+    cmd = sub.add_parser(func.__name__[len("cmd_"):], parents=list(parents),
+                         help=paragraphs[0], description=description, epilog=paragraphs[-1])
+    for names, options in arguments:
+        cmd.add_argument(*names, **options)
+    cmd.set_defaults(func=func)
+    return cmd
 
 
 def hex_bytes(data: bytes) -> str:

@@ -18,7 +18,7 @@ import sys
 from typing import Callable, List, Optional, TextIO
 
 from .. import protocol as p
-from .common import connect, explain
+from .common import command, connect, explain
 
 HISTORY_ENV = "ORFA_HISTORY"
 HISTORY_FILE = "~/.orfa_history"
@@ -153,22 +153,23 @@ def run_console(gw) -> int:
 
 
 def cmd_console(args) -> int:
+    """a line console: requests in, replies out
+
+    Each line is a request (docs/protocol.md), sent as typed; the board's
+    reply is printed, and an ERROR's meaning on stderr as `orfa request`
+    prints it. `help` or `?` lists the requests. On a terminal: line
+    editing and history (readline; the history file is ${HISTORY_ENV} or
+    {HISTORY_FILE}). A CR inside a line ends a request, as on the board. A
+    line over 128 characters gets the board's ERROR 04; comment lines (#
+    first) of any length are sent and get no reply. Ends at end of input
+    (Ctrl-D) or Ctrl-C, exit status 0; a serial failure ends it with one
+    line, exit status 1.
+
+    example: orfa --sim m32d --eeprom 0xA0 console
+    """
     with connect(args) as gw:
         return run_console(gw)
 
 
 def add_parsers(sub, common) -> None:
-    cmd = sub.add_parser(
-        "console", parents=[common], help="a line console: requests in, replies out",
-        description="Each line is a request (docs/protocol.md), sent as typed; the"
-                    " board's reply is printed, and an ERROR's meaning on stderr as"
-                    " `orfa request` prints it. `help` or `?` lists the requests. On"
-                    " a terminal: line editing and history (readline; the history"
-                    " file is $%s or %s). A CR inside a line ends a request, as on"
-                    " the board. A line over 128 characters gets the board's ERROR"
-                    " 04; comment lines (# first) of any length are sent and get no"
-                    " reply. Ends at end of input (Ctrl-D) or Ctrl-C, exit status 0;"
-                    " a serial failure ends it with one line, exit status 1."
-                    % (HISTORY_ENV, HISTORY_FILE),
-        epilog="example: orfa --sim m32d --eeprom 0xA0 console")
-    cmd.set_defaults(func=cmd_console)
+    command(sub, [common], cmd_console, HISTORY_ENV=HISTORY_ENV, HISTORY_FILE=HISTORY_FILE)

@@ -8,7 +8,7 @@ import importlib.util
 import logging
 import signal
 
-from .common import UsageError, add_sim_devices, address, connect, number
+from .common import UsageError, add_sim_devices, address, arg, command, connect, number
 
 #: The address the page is served on unless --listen says otherwise.
 DEFAULT_LISTEN = ("127.0.0.1", 8000)
@@ -65,6 +65,19 @@ def _stop_with(status: int):
 
 
 def cmd_dash(args) -> int:
+    """a live web page of the board or robot
+
+    Serve a local web page of the gateway's board and the ORFA slave boards
+    on its bus: servo widths and angles, motor duty and direction, ADC
+    volts, GPIO levels and directions, status, reset cause and failsafe,
+    read every --interval and pushed to the page, with controls for servos,
+    motors, GPIO lines and the ADC. Prints the page's URL, serves until
+    Ctrl-C (exit 130) or SIGTERM (exit 0). Needs Flask (pip install
+    'orfa[dash]'). docs/dashboard.md.
+
+    example: orfa dash --sim m32d --slave m128s:0x10; orfa dash --port
+    /dev/ttyUSB0 --listen 127.0.0.1:8080
+    """
     if importlib.util.find_spec("flask") is None:
         raise UsageError(FLASK_HINT)
     if args.addr is not None:
@@ -106,25 +119,13 @@ def cmd_dash(args) -> int:
 
 
 def add_parsers(sub, common) -> None:
-    cmd = sub.add_parser(
-        "dash", parents=[common], help="a live web page of the board or robot",
-        description="Serve a local web page of the gateway's board and the ORFA slave"
-                    " boards on its bus: servo widths and angles, motor duty and"
-                    " direction, ADC volts, GPIO levels and directions, status, reset"
-                    " cause and failsafe, read every --interval and pushed to the page,"
-                    " with"
-                    " controls for servos, motors, GPIO lines and the ADC. Prints the"
-                    " page's URL,"
-                    " serves until Ctrl-C (exit 130) or SIGTERM (exit 0). Needs Flask"
-                    " (pip install 'orfa[dash]'). docs/dashboard.md.",
-        epilog="example: orfa dash --sim m32d --slave m128s:0x10; orfa dash --port"
-               " /dev/ttyUSB0 --listen 127.0.0.1:8080")
-    cmd.add_argument("--listen", type=listen_spec, default=DEFAULT_LISTEN,
-                     metavar="HOST:PORT",
-                     help="where to serve the page (default 127.0.0.1:8000; port 0: a"
-                          " free one). Anyone who reaches it can move the motors")
-    cmd.add_argument("--interval", type=seconds, default=0.2, metavar="S",
-                     help="seconds between two readings of the boards (default 0.2)")
+    cmd = command(sub, [common], cmd_dash,
+                  arg("--listen", type=listen_spec, default=DEFAULT_LISTEN,
+                      metavar="HOST:PORT",
+                      help="where to serve the page (default 127.0.0.1:8000; port 0: a"
+                           " free one). Anyone who reaches it can move the motors"),
+                  arg("--interval", type=seconds, default=0.2, metavar="S",
+                      help="seconds between two readings of the boards (default 0.2)"))
     which = cmd.add_mutually_exclusive_group()
     which.add_argument("--boards", type=address_list, metavar="ADDR[,ADDR...]",
                        help="the slave boards to show, by bus address, instead of those a"
@@ -133,5 +134,4 @@ def add_parsers(sub, common) -> None:
     which.add_argument("--no-scan", action="store_true",
                        help="the gateway's own board only: do not look for slaves")
     add_sim_devices(cmd.add_argument_group("devices of the --sim board"), suppress=True)
-    cmd.set_defaults(func=cmd_dash)
 

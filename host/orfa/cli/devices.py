@@ -13,9 +13,10 @@ from .. import boardmap
 from .. import protocol as p
 from ..board import Board
 from ..clients.adc import CHANNELS as ADC_CHANNELS, VREF
+from ..clients.motor import DUTY_RANGE, is_duty
 from ..clients.servo import ServoRange
-from .common import (UsageError, address, byte, connect, explain, hex_bytes, number,
-                     interval, show_address, table, volts)
+from .common import (UsageError, address, arg, byte, command, connect, explain, hex_bytes,
+                     number, interval, show_address, table, volts)
 from .names import board_of, driver_name
 
 
@@ -47,6 +48,13 @@ def registers(record) -> str:
 
 
 def cmd_drivers(args) -> int:
+    """the drivers a board reports (introspection)
+
+    List the drivers of the gateway (or of the slave at --addr): UID, name,
+    version and the registers each one maps.
+
+    example: orfa --sim m32d drivers; orfa --port PORT drivers --addr 0x10
+    """
     with open_board(args) as board:
         records = board.drivers
         where = _where(args, board)
@@ -94,6 +102,16 @@ def _show_width(us: int) -> str:
 
 
 def cmd_servo(args) -> int:
+    """servo pulse widths and angles
+
+    servo: every channel's width; servo CH: its width in us (off: no
+    pulses); servo CH US: set it (500..2500; 0 or off stops the pulses);
+    servo CH --angle [DEG]: the angle, or set it, by the manual's formula
+    deg = MIN_DEG + (MAX_DEG - MIN_DEG) * (us - MIN_US) / (MAX_US - MIN_US)
+    over --range (default 1000:2000:-75:75); servo off: every channel off.
+
+    example: orfa servo 3 1500; orfa servo 3 --angle 30; orfa servo 3 off
+    """
     kw = {} if args.range is None else {"range": args.range}
     with open_board(args) as board:
         servo = board.servo
@@ -159,6 +177,14 @@ def _angle(text: str) -> float:
 # --- motor ----------------------------------------------------------------------
 
 def cmd_motor(args) -> int:
+    """motor duty and direction
+
+    motor: both motors' duty; motor N: motor N's (1 or 2); motor N DUTY:
+    set it, {DUTY_RANGE} (the sign is the direction, 0 or stop stops it);
+    motor stop: both stop.
+
+    example: orfa motor 1 -128; orfa motor stop
+    """
     with open_board(args) as board:
         motor = board.motor
         if args.n == "stop":
@@ -194,8 +220,8 @@ def _duty(text: str) -> int:
         duty = int(text, 0)
     except ValueError:
         duty = None
-    if duty is None or not -255 <= duty <= 255:
-        raise UsageError("duty %r: -255..255 (sign = direction, 0 or stop: stop)" % text)
+    if not is_duty(duty):
+        raise UsageError("duty %r: %s (sign = direction, 0 or stop: stop)" % (text, DUTY_RANGE))
     return duty
 
 
@@ -247,6 +273,17 @@ def _settle(board: Board, args) -> None:
 
 
 def cmd_adc(args) -> int:
+    """analog inputs: a table, or a live one
+
+    Print the ADC's channels: raw value and volts (from the reference: AVCC
+    5 V, internal 2.56 V; AREF needs --vref). --channels, --ref or --bits
+    configure the ADC first (the board keeps it): the channels given
+    (default all), the reference (default avcc), the resolution (default
+    10). --watch redraws the table every SECONDS (in place on a terminal)
+    until Ctrl-C (exit 0) or --count tables.
+
+    example: orfa adc --channels 0-3 --ref avcc --watch 0.2
+    """
     with open_board(args) as board:
         adc = board.adc
         if args.channels is not None or args.ref is not None or args.bits is not None:
@@ -289,6 +326,16 @@ def _port(board: Board, text: str) -> str:
 
 
 def cmd_gpio(args) -> int:
+    """GPIO levels and modes
+
+    gpio: every port's levels (PINx) and modes (DDRx, 1 = output); gpio
+    PORT: that port's; gpio PORT VALUE [MASK]: set the lines in MASK
+    (default all): an output's level, an input's pull-up; --output/--input
+    MASK make those lines outputs or inputs first. Lines another function
+    holds are left as they are.
+
+    example: orfa gpio B 0x05 --output 0x0F
+    """
     with open_board(args) as board:
         gpio = board.gpio
         if args.gpio_port is None:
@@ -315,6 +362,15 @@ def cmd_gpio(args) -> int:
 # --- spi --------------------------------------------------------------------------
 
 def cmd_spi(args) -> int:
+    """SPI chip selects, bus settings, transfers
+
+    spi bind CH PORT LINE: GPIO line PORT LINE is channel CH's chip select;
+    spi config: print the bus settings and chip selects, or set them
+    (--div, --mode, --lsb/--msb); spi transfer CH BYTE...: exchange the
+    bytes, print what came back.
+
+    example: orfa spi bind 0 B 4; orfa spi transfer 0 0x03 0x00 0x00
+    """
     with open_board(args) as board:
         spi = board.spi
         if args.spi_command == "bind":
@@ -342,6 +398,14 @@ def cmd_spi(args) -> int:
 # --- status ---------------------------------------------------------------------
 
 def cmd_status(args) -> int:
+    """status register, reset cause, failsafe
+
+    The board's status register (the result of the last register access)
+    with its meaning, why it reset since the causes were cleared, and the
+    link-loss failsafe.
+
+    example: orfa status --addr 0x10; orfa status --failsafe 200
+    """
     with open_board(args) as board:
         if args.clear_reset:
             board.clear_reset_cause()
@@ -362,84 +426,44 @@ def cmd_status(args) -> int:
 # --- the parsers ------------------------------------------------------------------
 
 def add_parsers(sub, common) -> None:
-    cmd = sub.add_parser(
-        "drivers", parents=[common], help="the drivers a board reports (introspection)",
-        description="List the drivers of the gateway (or of the slave at --addr): UID,"
-                    " name, version and the registers each one maps.",
-        epilog="example: orfa --sim m32d drivers; orfa --port PORT drivers --addr 0x10")
-    cmd.set_defaults(func=cmd_drivers)
+    command(sub, [common], cmd_drivers)
+    command(sub, [common], cmd_servo,
+            arg("channel", nargs="?", metavar="CH", help="channel number, or off (all)"),
+            arg("us", nargs="?", metavar="US", help="width in microseconds, or off"),
+            arg("--angle", nargs="?", type=_angle, const=READ, metavar="DEG",
+                help="set the angle (DEG), or print it (no DEG)"),
+            arg("--range", type=servo_range, metavar="MIN_US:MAX_US:MIN_DEG:MAX_DEG",
+                help="the servo's range for --angle (default 1000:2000:-75:75)"))
+    command(sub, [common], cmd_motor,
+            arg("n", nargs="?", metavar="N", help="1 or 2, or stop (both)"),
+            arg("duty", nargs="?", metavar="DUTY", help=DUTY_RANGE + ", or stop"),
+            DUTY_RANGE=DUTY_RANGE)
+    command(sub, [common], cmd_adc,
+            arg("--channels", type=channel_list, metavar="LIST",
+                help="turn on these channels, the others off (0-3,6; all; none; default all)"),
+            arg("--ref", choices=("avcc", "aref", "internal"),
+                help="the reference (default avcc)"),
+            arg("--bits", type=int, choices=(8, 10), help="the resolution (default 10)"),
+            arg("--vref", type=volts, metavar="V",
+                help="the reference's volts (for aref; default 5.0 avcc, 2.56 internal)"),
+            arg("--watch", nargs="?", type=interval, const=0.5, metavar="SECONDS",
+                help="redraw the table every SECONDS (default 0.5)"),
+            arg("--count", type=number, metavar="N", help="with --watch: stop after N tables"))
+    command(sub, [common], cmd_gpio,
+            arg("gpio_port", nargs="?", metavar="PORT", help="a port letter (A)"),
+            arg("value", nargs="?", type=byte, metavar="VALUE"),
+            arg("mask", nargs="?", type=byte, metavar="MASK"),
+            arg("--output", type=byte, metavar="MASK", help="make these lines outputs"),
+            arg("--input", type=byte, metavar="MASK", help="make these lines inputs"))
+    _spi_actions(command(sub, [common], cmd_spi), common)
+    command(sub, [common], cmd_status,
+            arg("--clear-reset", action="store_true", help="clear the reset causes first"),
+            arg("--failsafe", type=number, metavar="MS",
+                help="set the failsafe first: MS milliseconds, 0 off"))
 
-    cmd = sub.add_parser(
-        "servo", parents=[common], help="servo pulse widths and angles",
-        description="servo: every channel's width; servo CH: its width in us (off:"
-                    " no pulses); servo CH US: set it (500..2500; 0 or off stops the"
-                    " pulses); servo CH --angle [DEG]: the angle, or set it, by the"
-                    " manual's formula deg = MIN_DEG + (MAX_DEG - MIN_DEG) * (us -"
-                    " MIN_US) / (MAX_US - MIN_US) over --range (default"
-                    " 1000:2000:-75:75); servo off: every channel off.",
-        epilog="example: orfa servo 3 1500; orfa servo 3 --angle 30; orfa servo 3 off")
-    cmd.add_argument("channel", nargs="?", metavar="CH", help="channel number, or off (all)")
-    cmd.add_argument("us", nargs="?", metavar="US", help="width in microseconds, or off")
-    cmd.add_argument("--angle", nargs="?", type=_angle, const=READ, metavar="DEG",
-                     help="set the angle (DEG), or print it (no DEG)")
-    cmd.add_argument("--range", type=servo_range, metavar="MIN_US:MAX_US:MIN_DEG:MAX_DEG",
-                     help="the servo's range for --angle (default 1000:2000:-75:75)")
-    cmd.set_defaults(func=cmd_servo)
 
-    cmd = sub.add_parser(
-        "motor", parents=[common], help="motor duty and direction",
-        description="motor: both motors' duty; motor N: motor N's (1 or 2); motor N"
-                    " DUTY: set it, -255..255 (the sign is the direction, 0 or stop"
-                    " stops it); motor stop: both stop.",
-        epilog="example: orfa motor 1 -128; orfa motor stop")
-    cmd.add_argument("n", nargs="?", metavar="N", help="1 or 2, or stop (both)")
-    cmd.add_argument("duty", nargs="?", metavar="DUTY", help="-255..255, or stop")
-    cmd.set_defaults(func=cmd_motor)
-
-    cmd = sub.add_parser(
-        "adc", parents=[common], help="analog inputs: a table, or a live one",
-        description="Print the ADC's channels: raw value and volts (from the"
-                    " reference: AVCC 5 V, internal 2.56 V; AREF needs --vref)."
-                    " --channels, --ref or --bits configure the ADC first (the board"
-                    " keeps it): the channels given (default all), the reference"
-                    " (default avcc), the resolution (default 10)."
-                    " --watch redraws the table every SECONDS (in place on a terminal)"
-                    " until Ctrl-C (exit 0) or --count tables.",
-        epilog="example: orfa adc --channels 0-3 --ref avcc --watch 0.2")
-    cmd.add_argument("--channels", type=channel_list, metavar="LIST",
-                     help="turn on these channels, the others off (0-3,6; all; none; default all)")
-    cmd.add_argument("--ref", choices=("avcc", "aref", "internal"),
-                     help="the reference (default avcc)")
-    cmd.add_argument("--bits", type=int, choices=(8, 10), help="the resolution (default 10)")
-    cmd.add_argument("--vref", type=volts, metavar="V",
-                     help="the reference's volts (for aref; default 5.0 avcc, 2.56 internal)")
-    cmd.add_argument("--watch", nargs="?", type=interval, const=0.5, metavar="SECONDS",
-                     help="redraw the table every SECONDS (default 0.5)")
-    cmd.add_argument("--count", type=number, metavar="N", help="with --watch: stop after N tables")
-    cmd.set_defaults(func=cmd_adc)
-
-    cmd = sub.add_parser(
-        "gpio", parents=[common], help="GPIO levels and modes",
-        description="gpio: every port's levels (PINx) and modes (DDRx, 1 = output);"
-                    " gpio PORT: that port's; gpio PORT VALUE [MASK]: set the lines in"
-                    " MASK (default all): an output's level, an input's pull-up;"
-                    " --output/--input MASK make those lines outputs or inputs first."
-                    " Lines another function holds are left as they are.",
-        epilog="example: orfa gpio B 0x05 --output 0x0F")
-    cmd.add_argument("gpio_port", nargs="?", metavar="PORT", help="a port letter (A)")
-    cmd.add_argument("value", nargs="?", type=byte, metavar="VALUE")
-    cmd.add_argument("mask", nargs="?", type=byte, metavar="MASK")
-    cmd.add_argument("--output", type=byte, metavar="MASK", help="make these lines outputs")
-    cmd.add_argument("--input", type=byte, metavar="MASK", help="make these lines inputs")
-    cmd.set_defaults(func=cmd_gpio)
-
-    cmd = sub.add_parser(
-        "spi", parents=[common], help="SPI chip selects, bus settings, transfers",
-        description="spi bind CH PORT LINE: GPIO line PORT LINE is channel CH's chip"
-                    " select; spi config: print the bus settings and chip selects, or"
-                    " set them (--div, --mode, --lsb/--msb); spi transfer CH BYTE...:"
-                    " exchange the bytes, print what came back.",
-        epilog="example: orfa spi bind 0 B 4; orfa spi transfer 0 0x03 0x00 0x00")
+def _spi_actions(cmd, common) -> None:
+    """spi's own actions: bind, config, transfer."""
     spi = cmd.add_subparsers(dest="spi_command", metavar="ACTION")
     spi.required = True
     bind = spi.add_parser("bind", parents=[common], help="a chip select line for a channel",
@@ -459,16 +483,3 @@ def add_parsers(sub, common) -> None:
                           epilog="example: orfa spi transfer 0 0x03 0x00 0x00")
     xfer.add_argument("channel", type=number, metavar="CH")
     xfer.add_argument("bytes", type=byte, nargs="+", metavar="BYTE")
-    cmd.set_defaults(func=cmd_spi)
-
-    cmd = sub.add_parser(
-        "status", parents=[common], help="status register, reset cause, failsafe",
-        description="The board's status register (the result of the last register"
-                    " access) with its meaning, why it reset since the causes were"
-                    " cleared, and the link-loss failsafe.",
-        epilog="example: orfa status --addr 0x10; orfa status --failsafe 200")
-    cmd.add_argument("--clear-reset", action="store_true", help="clear the reset causes first")
-    cmd.add_argument("--failsafe", type=number, metavar="MS",
-                     help="set the failsafe first: MS milliseconds, 0 off")
-    cmd.set_defaults(func=cmd_status)
-

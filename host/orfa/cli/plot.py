@@ -11,13 +11,13 @@ import os
 import re
 import shlex
 import sys
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 from .. import boardmap, vcd, waves
 from .. import plot as drawing
 from ..sim import SimError
 from ..simctl import SimControl, SimControlError, parse_edges
-from .common import UsageError, env_port, sim_board
+from .common import UsageError, command, env_port, sim_board
 
 DEFAULT_FOR_US = 50000           # live: 50 ms of simulated time, 2.5 servo frames
 MAX_DEFAULT_ROWS = 12
@@ -186,11 +186,12 @@ def _from_file(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]
 
 
 def _run_commands(port: str, args) -> None:
-    from . import main
+    """The --do commands, each as `orfa --port PORT COMMAND` (args.run: the
+    command's main, handed down by add_parsers)."""
     for line in args.do or ():
         argv = ["--port", port, "--baud", str(args.baud)] + shlex.split(line)
         try:
-            rc = main(argv)
+            rc = args.run(argv)
         except SystemExit as exc:            # argparse's usage error, already told
             rc = exc.code if isinstance(exc.code, int) else 2
         if rc:
@@ -330,6 +331,19 @@ def _clip_all(found: Dict[str, waves.Wave], window: Tuple[int, int]) -> Dict[str
 
 
 def cmd_plot(args) -> int:
+    """draw waveforms from a VCD or a live simulated board
+
+    Draw servo pulses, motor PWM, chip selects and bus activity as a PNG
+    (matplotlib), the time axis counted from the window's start (without
+    --from/--to: trimmed to where the rows change) and the measured widths
+    written on it. From a VCD file (orfa sim --vcd FILE), or live: --sim
+    BOARD starts a board, runs the --do commands and records --for of
+    simulated time; --control PATH does the same on a running `orfa sim
+    --control PATH`. Prints one line per row: what it measured.
+
+    examples: orfa plot board.vcd --signals 'servo*' --from 0 --to 40ms -o
+    servo.png; orfa plot --sim m32d --do 'servo 3 1500' -o servo.png
+    """
     try:
         drawing.require()                   # before a board starts and commands run
     except drawing.PlotUnavailable as exc:
@@ -376,19 +390,9 @@ def cmd_plot(args) -> int:
     return 0
 
 
-def add_parsers(sub, common) -> None:
-    cmd = sub.add_parser(
-        "plot", parents=[common],
-        help="draw waveforms from a VCD or a live simulated board",
-        description="Draw servo pulses, motor PWM, chip selects and bus activity as a PNG"
-                    " (matplotlib), the time axis counted from the window's start"
-                    " (without --from/--to: trimmed to where the rows change) and the"
-                    " measured widths written on it. From a VCD file (orfa sim --vcd FILE), or live: --sim"
-                    " BOARD starts a board, runs the --do commands and records --for of"
-                    " simulated time; --control PATH does the same on a running"
-                    " `orfa sim --control PATH`. Prints one line per row: what it measured.",
-        epilog="examples: orfa plot board.vcd --signals 'servo*' --from 0 --to 40ms -o"
-               " servo.png; orfa plot --sim m32d --do 'servo 3 1500' -o servo.png")
+def add_parsers(sub, common, run: Callable[[List[str]], int]) -> None:
+    """`orfa plot`; `run(argv)` runs an orfa command line (its --do)."""
+    cmd = command(sub, [common], cmd_plot)
     cmd.add_argument("trace", nargs="?", metavar="TRACE.vcd", help="the simulator's VCD file")
     cmd.add_argument("-o", "--output", required=True, metavar="OUT.png",
                      help="the picture to write (.png; .svg and .pdf work too)")
@@ -411,4 +415,4 @@ def add_parsers(sub, common) -> None:
                      help="the board the VCD or socket is of (default: told by its pins)")
     cmd.add_argument("-v", "--verbose", action="store_true",
                      help="also print every pulse's width")
-    cmd.set_defaults(func=cmd_plot)
+    cmd.set_defaults(run=run)

@@ -9,74 +9,10 @@ import signal
 import sys
 
 from .. import protocol as p
-from ..sim import BOARDS, SimError, part_kinds
-from .common import UsageError, add_sim_devices, baud_rate, sim_board
+from ..sim import BOARDS, SimError
+from .common import UsageError, add_sim_devices, arg, baud_rate, command, sim_board
+from .common import adc_spec, eeprom_spec, slave_spec  # noqa: F401 (here before)
 from .console import run_console
-
-
-def slave_spec(text: str):
-    """`BOARD:ADDR[:ELF]` -> (board, addr, elf or None: the board's slave build)."""
-    parts = text.split(":", 2)
-    if len(parts) < 2 or parts[0] not in BOARDS:
-        raise argparse.ArgumentTypeError(
-            "%r: BOARD:ADDR[:ELF] with BOARD one of %s" % (text, ", ".join(BOARDS)))
-    try:
-        addr = int(parts[1], 0)
-    except ValueError:
-        raise argparse.ArgumentTypeError("%r: ADDR like 0x10" % text) from None
-    _check_device_address(text, addr)
-    return (parts[0], addr, parts[2] if len(parts) == 3 and parts[2] else None)
-
-
-def eeprom_spec(text: str) -> int:
-    """`ADDR` of --eeprom, checked as --slave's is."""
-    try:
-        addr = int(text, 0)
-    except ValueError:
-        raise argparse.ArgumentTypeError("%r: ADDR like 0xA0" % text) from None
-    _check_device_address(text, addr)
-    return addr
-
-
-def part_spec(text: str):
-    """`KIND@ADDR[:OPTIONS]` of --part -> (kind, addr, options); ADDR checked
-    as --eeprom's, KIND against the simulator's kinds."""
-    kind, at, rest = text.partition("@")
-    addr_text, _, opts = rest.partition(":")
-    kinds = part_kinds()
-    if not at or not kind:
-        raise argparse.ArgumentTypeError("%r: KIND@ADDR[:OPTIONS] like bmp280@0xEC" % text)
-    if kinds and kind not in kinds:
-        raise argparse.ArgumentTypeError("%r: no part %r (the simulator's: %s)"
-                                         % (text, kind, ", ".join(kinds)))
-    try:
-        addr = int(addr_text, 0)
-    except ValueError:
-        raise argparse.ArgumentTypeError("%r: ADDR like 0xEC" % text) from None
-    _check_device_address(text, addr)
-    return (kind, addr, opts)
-
-
-def _check_device_address(text: str, addr: int) -> None:
-    """A simulated device's 8-bit bus address: even, outside the addresses
-    I2C reserves, and not the gateway's own (its requests never reach the bus)."""
-    if addr & 1 or not 0x10 <= addr <= 0xEE:
-        raise argparse.ArgumentTypeError("%r: ADDR must be even, 0x10..0xEE" % text)
-    if addr == p.DEFAULT_LOCAL_ADDRESS:
-        raise argparse.ArgumentTypeError("%r: 0x%02X is the gateway's own address (its"
-                                         " requests never reach the bus)" % (text, addr))
-
-
-def adc_spec(text: str):
-    """`CH=MV` -> (channel, millivolts)."""
-    ch, sep, mv = text.partition("=")
-    try:
-        pair = (int(ch, 0), int(mv, 0))
-    except ValueError:
-        pair = None
-    if not sep or pair is None or not 0 <= pair[0] <= 7 or pair[1] < 0:
-        raise argparse.ArgumentTypeError("%r: CH=MV with CH 0-7 (3=1200)" % text)
-    return pair
 
 
 def _raise_interrupt(*_):
@@ -92,6 +28,19 @@ def _link(target, path: str) -> None:
 
 
 def cmd_sim(args) -> int:
+    """run a simulated board or robot, print its port
+
+    Run build/sim/orfa-sim on a board's gateway firmware (with --slave: a
+    robot, the slave boards on its I2C bus) and print the path of its
+    serial port on the first line (with --control, the control socket's on
+    the second). Runs until Ctrl-C or SIGTERM (exit 0), or with --terminal
+    for a console on the board until the end of its input (then the lines
+    say what they are: `serial port: PATH`). Bus addresses are the
+    protocol's 8-bit form. docs/simulator.md describes the devices and the
+    control socket.
+
+    example: orfa sim --board m32d --eeprom 0xA0 --slave m128s:0x10 --terminal
+    """
     control = args.control is not None or args.autobaud
     extra = []
     if args.trace:
@@ -131,19 +80,8 @@ def cmd_sim(args) -> int:
 
 
 def add_parsers(sub, common) -> None:
-    cmd = sub.add_parser(
-        "sim", help="run a simulated board or robot, print its port",
-        description="Run build/sim/orfa-sim on a board's gateway firmware (with --slave:"
-                    " a robot, the slave boards on its I2C bus) and print the path of"
-                    " its serial port on the first line (with --control, the control"
-                    " socket's on the second). Runs until Ctrl-C or SIGTERM (exit 0),"
-                    " or with --terminal for a console on the board until the end of"
-                    " its input (then the lines say what they are: `serial port:"
-                    " PATH`). Bus addresses are the protocol's 8-bit form."
-                    " docs/simulator.md describes the devices and the control socket.",
-        epilog="example: orfa sim --board m32d --eeprom 0xA0 --slave m128s:0x10 --terminal")
-    cmd.add_argument("--board", choices=BOARDS, default="m32d",
-                     help="the gateway's board (default %(default)s)")
+    cmd = command(sub, [], cmd_sim, arg("--board", choices=BOARDS, default="m32d",
+                                        help="the gateway's board (default %(default)s)"))
     add_sim_devices(cmd)
     cmd.add_argument("--firmware", help="ELF to run (default: build/<board>-gate/orfa.elf)")
     cmd.add_argument("--control", nargs="?", const="", metavar="PATH",
@@ -157,4 +95,3 @@ def add_parsers(sub, common) -> None:
     cmd.add_argument("--autobaud", action="store_true",
                      help="the console opens with the BAUD=auto preamble (eight CRs,"
                           " 20 ms of simulated quiet)")
-    cmd.set_defaults(func=cmd_sim)

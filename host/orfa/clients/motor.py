@@ -6,6 +6,18 @@ from typing import List, Optional
 
 from ..errors import PinBusyError
 
+#: A motor's duty is -MAX_DUTY..MAX_DUTY, its sign the direction (PWMn is a byte).
+MAX_DUTY = 255
+#: The range as the messages and help texts give it.
+DUTY_RANGE = "-%d..%d" % (MAX_DUTY, MAX_DUTY)
+
+
+def is_duty(value) -> bool:
+    """True for a duty a motor takes: an int in -MAX_DUTY..MAX_DUTY. The one
+    check of the range: Motor's, `orfa motor`'s and the dashboard's."""
+    return isinstance(value, int) and not isinstance(value, bool) \
+        and -MAX_DUTY <= value <= MAX_DUTY
+
 
 class Motor:
     def __init__(self, board):
@@ -21,8 +33,8 @@ class Motor:
 
     @staticmethod
     def _duty(duty: int) -> int:
-        if not isinstance(duty, int) or isinstance(duty, bool) or not -255 <= duty <= 255:
-            raise ValueError("duty must be -255..255 (sign: direction), not %r" % (duty,))
+        if not is_duty(duty):
+            raise ValueError("duty must be %s (sign: direction), not %r" % (DUTY_RANGE, duty))
         return duty
 
     def set(self, n: int, duty: int) -> None:

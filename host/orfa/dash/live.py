@@ -20,26 +20,10 @@ from typing import Callable, Dict, List, Optional, Sequence
 from .. import protocol as p
 from ..board import Board
 from ..clients.adc import CHANNELS as ADC_CHANNELS, REFERENCES as ADC_REFERENCES
-from ..errors import explain
+from ..clients.motor import DUTY_RANGE, is_duty
+from ..errors import ControlError, NotFound, Refused, explain  # noqa: F401 (dash.web's)
 from ..gateway import Gateway
 from . import snapshot
-
-
-class ControlError(ValueError):
-    """A control request that is wrong in itself (a field missing or out of
-    range): the page gets the message, the board is not asked."""
-
-
-class NotFound(KeyError):
-    """No board at that address on this dashboard, or no such control."""
-
-    def __str__(self) -> str:
-        return self.args[0]
-
-
-class Refused(Exception):
-    """The board did not do what a control asked (it refused, or a line
-    belongs to another function)."""
 
 
 class Dashboard:
@@ -290,11 +274,13 @@ def set_servo(board: Board, info: Dict, body: Dict) -> Dict[str, object]:
 
 
 def set_motor(board: Board, info: Dict, body: Dict) -> Dict[str, object]:
-    """{"motor": N, "duty": -255..255} (the sign is the direction)."""
+    """{"motor": N, "duty": -255..255} (the sign is the direction; clients.motor.is_duty)."""
     _check_keys(body, ("motor", "duty"), "motor")
     motor = board.motor
     n = _number(body, "motor", 1, motor.count, "motor")
-    duty = _number(body, "duty", -255, 255, "motor")
+    duty = _number(body, "duty", -math.inf, math.inf, "motor")
+    if not is_duty(duty):
+        raise ControlError("motor: duty %d is outside %s" % (duty, DUTY_RANGE))
     motor.set(n, duty)
     return {"motor": n, "duty": duty}
 
