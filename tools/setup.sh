@@ -15,7 +15,17 @@ APT_PACKAGES="make gcc gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf
 # python module:pip package. matplotlib draws `orfa plot`, flask serves
 # `orfa dash` (the extras orfa[plot] and orfa[dash]), selenium drives the
 # browser in the dashboard's test.
-PY_PACKAGES="serial:pyserial pytest:pytest matplotlib:matplotlib flask:flask selenium:selenium"
+# smbus2 and Pimoroni's bmp280 driver (which takes an SMBus as i2c_dev=), for
+# the tests of orfa.smbus.
+PY_PACKAGES="serial:pyserial pytest:pytest matplotlib:matplotlib flask:flask selenium:selenium smbus2:smbus2 bmp280:bmp280 typing_extensions:typing_extensions"
+# Adafruit's CircuitPython drivers, for the tests of orfa.busio. Their
+# metadata asks for Adafruit-Blinka, whose own dependencies a PC without a
+# USB bridge does not need (sysv_ipc, a C extension for the Raspberry Pi;
+# pyftdi and binho for the FT232H and Binho bridges): so each goes in
+# without dependencies, and with it the part of Blinka that the drivers import
+# (busio, digitalio: the names of their type annotations; micropython.const),
+# its platform detection and PureIO. orfa.busio itself needs none of them.
+PY_NODEPS_PACKAGES="busio:adafruit-blinka adafruit_platformdetect:adafruit-platformdetect Adafruit_PureIO:adafruit-pureio circuitpython_typing:adafruit-circuitpython-typing adafruit_bus_device:adafruit-circuitpython-busdevice adafruit_register:adafruit-circuitpython-register adafruit_mpu6050:adafruit-circuitpython-mpu6050 adafruit_lis3mdl:adafruit-circuitpython-lis3mdl adafruit_bmp280:adafruit-circuitpython-bmp280 adafruit_24lc32:adafruit-circuitpython-24lc32"
 
 if [ "$(id -u)" -eq 0 ]; then
 	SUDO=""
@@ -58,23 +68,37 @@ if ! "$PYTHON" -c "import ensurepip" >/dev/null 2>&1; then
 	apt_install python3-venv
 fi
 
-pip_missing=""
-for entry in $PY_PACKAGES; do
-	module=${entry%%:*}
-	package=${entry#*:}
-	if ! "$PYTHON" -c "import $module" >/dev/null 2>&1; then
-		pip_missing="$pip_missing $package"
-	fi
-done
+# The packages of a list ("module:package ...") whose module does not import.
+pip_missing_of() {
+	out=""
+	for entry in $1; do
+		module=${entry%%:*}
+		package=${entry#*:}
+		if ! "$PYTHON" -c "import $module" >/dev/null 2>&1; then
+			out="$out $package"
+		fi
+	done
+	echo "$out"
+}
+pip_missing=$(pip_missing_of "$PY_PACKAGES")
 # pip itself: the install test fetches its wheels with it, even where
 # pyserial and pytest came from Debian's packages.
 if ! "$PYTHON" -m pip --version >/dev/null 2>&1; then
 	echo "setup: installing python3-pip"
 	apt_install python3-pip
 fi
+pip_install() {
+	# Debian's python marks itself externally managed (PEP 668).
+	"$PYTHON" -m pip install -q "$@" 2>/dev/null ||
+		"$PYTHON" -m pip install -q --break-system-packages "$@"
+}
 if [ -n "$pip_missing" ]; then
 	echo "setup: pip installing$pip_missing"
-	# Debian's python marks itself externally managed (PEP 668).
-	"$PYTHON" -m pip install -q $pip_missing 2>/dev/null ||
-		"$PYTHON" -m pip install -q --break-system-packages $pip_missing
+	pip_install $pip_missing
+fi
+# the drivers last, without their dependencies: what they import came above
+pip_missing=$(pip_missing_of "$PY_NODEPS_PACKAGES")
+if [ -n "$pip_missing" ]; then
+	echo "setup: pip installing without dependencies$pip_missing"
+	pip_install --no-deps $pip_missing
 fi

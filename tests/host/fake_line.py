@@ -101,6 +101,18 @@ class FakeLine:
             return
 
 
+def synced_gateway(monkeypatch, line: FakeLine, timeout: float = 0.2):
+    """A Gateway whose port is `line` (pyserial's serial_for_url patched to
+    give it, for any URL), its opening sync done and left out of
+    line.written. The line's answers must include `V` and `C`."""
+    from orfa.gateway import Gateway
+    monkeypatch.setattr("orfa.gateway.serial.serial_for_url", lambda url, **kw: line)
+    gw = Gateway("fake://", timeout=timeout)
+    gw.in_step()
+    line.forget()
+    return gw
+
+
 class ChattyLine(FakeLine):
     """A FakeLine whose far end, while `chatty`, never stops talking: each
     read first lets the board answer a waiting request, then adds the next

@@ -5,7 +5,7 @@ noise and timeouts. The simulated boards: tests/sim/test_board_api.py."""
 
 import pytest
 
-from fake_line import FakeLine
+from fake_line import FakeLine, synced_gateway
 from orfa import (AddressNackError, BadValueError, Board, DataNackError, Gateway,
                   LimitError, NoDriverError, OrfaError, PinBusyError, ProtocolError,
                   RegisterError, ReplyTimeout, SerialError, ServoRange, Status)
@@ -38,11 +38,7 @@ def fake(monkeypatch):
     of line.written."""
     def make(answer):
         line = FakeLine(lambda text: "C0063" if text == "C" else answer(text))
-        monkeypatch.setattr("orfa.gateway.serial.serial_for_url", lambda url, **kw: line)
-        gw = Gateway("fake://", timeout=0.2)
-        gw.in_step()
-        line.forget()
-        return gw, line
+        return synced_gateway(monkeypatch, line), line
     return make
 
 
