@@ -507,3 +507,35 @@ def test_an_unknown_part_names_the_kinds():
     assert (result.returncode, result.stdout, result.stderr) == (
         2, "", "orfa: error: argument --part: 'bmp380@0xEC': no part 'bmp380' (the"
                " simulator's: %s) (orfa --help)\n" % ", ".join(kinds))
+
+
+# --- the drivers robot builders use -------------------------------------------------------
+
+def test_adafruit_and_pimoroni_bmp280_drivers_read_what_was_set():
+    """Unmodified drivers over orfa.busio and orfa.smbus: Adafruit's at its
+    defaults (normal mode, x2 temperature, x16 pressure) and forced, then
+    Pimoroni's (x2/x16 as well: 17 and 20 bits); within a step of their
+    resolution (0.0025 degrees C; 0.2 Pa)."""
+    adafruit_bmp280 = pytest.importorskip("adafruit_bmp280",
+                                          reason="tools/setup.sh installs it")
+    pimoroni = pytest.importorskip("bmp280", reason="tools/setup.sh installs it")
+    from orfa.busio import I2C
+    from orfa.smbus import SMBus
+    require_builds(["m32d"])
+    with SimBoard("m32d", trace=False, control=True, parts=[("bmp280", BARO)]) as sim, \
+            sim.gateway() as gw:
+        sim.control.sense(BARO, "temp", 21.37)
+        sim.control.sense(BARO, "pressure", 98765.4)
+        sensor = adafruit_bmp280.Adafruit_BMP280_I2C(I2C(gw), address=BARO >> 1)
+        sim.control.wait(meas_cycles(2, 5) + F_CPU // 2000)   # its first measurement
+        assert sensor.temperature == pytest.approx(21.37, abs=0.0025)
+        assert sensor.pressure * 100 == pytest.approx(98765.4, abs=0.2)    # hPa
+        sim.control.sense(BARO, "temp", -5.5)
+        sim.control.sense(BARO, "pressure", 101000)
+        sensor.mode = adafruit_bmp280.MODE_FORCE
+        assert sensor.temperature == pytest.approx(-5.5, abs=0.0025)
+        assert sensor.pressure * 100 == pytest.approx(101000, abs=0.2)
+        bmp = pimoroni.BMP280(i2c_dev=SMBus(gw), i2c_addr=BARO >> 1)
+        bmp.setup(mode="forced")
+        assert bmp.get_temperature() == pytest.approx(-5.5, abs=0.0025)
+        assert bmp.get_pressure() * 100 == pytest.approx(101000, abs=0.2)
