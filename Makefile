@@ -254,8 +254,10 @@ demo: setup
 	@$(MAKE) -s --no-print-directory BOARD=m32d MODE=gate firmware sim
 	@PYTHONPATH=host exec python3 -m orfa sim --board m32d --eeprom 0xA0 --terminal
 
-# A robot: the M32-D gateway, an M128-S slave at 0x10, an M32-D slave at 0x12
-# and the EEPROM at A0, all on one simulated I2C bus.
+# A robot: the M32-D gateway, an M128-S slave at 0x10, an M32-D slave at 0x12,
+# the EEPROM at A0 and the robot's sensors (an MPU-6050 IMU at D0, an
+# HMC5883L compass at 3C, a LIS3MDL magnetometer at 38, a BMP280 barometer at
+# EC, a 24LC32 EEPROM at A8), all on one simulated I2C bus.
 demo-robot: setup
 	@$(MAKE) --no-print-directory BOARD=m32d MODE=gate firmware sim
 	@$(MAKE) --no-print-directory BOARD=m128s MODE=slave ADDR=0x10 \
@@ -263,6 +265,8 @@ demo-robot: setup
 	@$(MAKE) --no-print-directory BOARD=m32d MODE=slave ADDR=0x12 \
 		BUILD=build/robot/m32d-0x12 firmware
 	PYTHONPATH=host python3 -m orfa sim --board m32d --eeprom 0xA0 \
+		--part mpu6050@0xD0 --part hmc5883l@0x3C --part lis3mdl@0x38 \
+		--part bmp280@0xEC --part 24lc32@0xA8 \
 		--slave m128s:0x10:build/robot/m128s-0x10/orfa.elf \
 		--slave m32d:0x12:build/robot/m32d-0x12/orfa.elf --terminal
 

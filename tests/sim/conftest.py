@@ -179,6 +179,23 @@ class Bench:
         assert self.sim.running, self.sim.stderr
 
 
+class ControlBench(Bench):
+    """A Bench on a simulator with its control socket (control=True): request
+    lines put on the serial line at chosen cycles, the bus events traced."""
+
+    def __init__(self, sim: SimBoard):
+        super().__init__(sim)
+        self.ctl = sim.control
+
+    def rx(self, cycle: int, line: str) -> int:
+        """Put a request line on the serial line at `cycle`; its end cycle."""
+        return self.ctl.rx(cycle, line.encode("ascii") + b"\n")
+
+    def twi(self, since: int, kind: str):
+        """(cycle, fields) of the bus events of one kind ("addr", "write")."""
+        return [(e.cycle, e.fields) for e in self.events(since, ["twi " + kind])]
+
+
 @contextlib.contextmanager
 def running(sim: SimBoard, make_bench=Bench):
     """Start `sim`, give a bench on it (make_bench(sim)), and stop it after:

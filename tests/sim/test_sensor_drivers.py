@@ -1,9 +1,9 @@
 """The Python world's own sensor drivers, unmodified, on a simulated robot:
 an M32-D gateway whose bus holds an M128-S slave board at 10 (7-bit 0x08)
 and the simulator's sensor parts (docs/simulator.md): an MPU-6050 at D0
-(0x68), an HMC5883L at 3C (0x1E), an LIS3MDL at 38 (0x1C) and, where the
-simulator has them, BMP280s at EC (0x76, Pimoroni's default) and EE (0x77,
-Adafruit's) and a 24LC32 at A8 (0x54).
+(0x68), an HMC5883L at 3C (0x1E), an LIS3MDL at 38 (0x1C), BMP280s at EC
+(0x76, Pimoroni's default) and EE (0x77, Adafruit's) and a 24LC32 at A8
+(0x54).
 
 Through orfa.busio.I2C: Adafruit's adafruit_mpu6050, adafruit_lis3mdl,
 adafruit_bmp280 and adafruit_24lc32; through orfa.smbus.SMBus: Pimoroni's
@@ -32,10 +32,10 @@ from pathlib import Path
 
 import pytest
 
-from conftest import SENSOR_READINGS, require_builds, require_slave, running
+from conftest import SENSOR_READINGS, ControlBench, require_builds, require_slave, running
 from orfa import boardmap
 from orfa.busio import I2C
-from orfa.sim import SimBoard, sim_path
+from orfa.sim import SimBoard
 from orfa.smbus import SMBus
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -47,8 +47,8 @@ G = 9.80665                              # m/s^2 per g, as the MPU-6050's driver
 # 8-bit bus addresses (the parts, the slave) and their 7-bit forms (the drivers)
 MPU, HMC, LIS, BMP_PIM, BMP_ADA, EE32, SLAVE8 = 0xD0, 0x3C, 0x38, 0xEC, 0xEE, 0xA8, 0x10
 GATEWAY = 0x55                           # the gateway's own map (AA)
-BASE_PARTS = [("mpu6050", MPU), ("hmc5883l", HMC), ("lis3mdl", LIS)]
-LATER_PARTS = [("bmp280", BMP_PIM), ("bmp280", BMP_ADA), ("24lc32", EE32)]
+PARTS = [("mpu6050", MPU), ("hmc5883l", HMC), ("lis3mdl", LIS), ("bmp280", BMP_PIM),
+         ("bmp280", BMP_ADA), ("24lc32", EE32)]
 
 
 def ms(t: float) -> int:
@@ -74,7 +74,7 @@ def fmt(values) -> str:
         return values
     if isinstance(values, (tuple, list)):
         return ", ".join(fmt(v) for v in values)
-    return "%.6g" % values
+    return "%.8g" % values
 
 
 def table_row(driver: str, reading: str, set_, got, lsb) -> str:
@@ -121,36 +121,13 @@ def within(got, exact, set_, lsb):
 
 # --- the robot ----------------------------------------------------------------------------
 
-def sim_parts():
-    # until orfa.sim.part_kinds (branch i18-baro) is on main
-    import subprocess
-    text = subprocess.run([str(sim_path()), "--help"], capture_output=True, text=True).stderr
-    section = text.partition("Parts on the I2C bus")[2].partition("Parts on a board")[0]
-    return [line.split()[0].split("[")[0] for line in section.splitlines()[1:] if line.strip()]
-
-
-def parts_there():
-    """The parts this robot carries: the sensor parts, and the barometers and
-    the 24LC32 once the simulator has them."""
-    kinds = sim_parts()
-    return BASE_PARTS + [p for p in LATER_PARTS if p[0] in kinds]
-
-
-def need_part(kind: str):
-    if kind not in sim_parts():
-        pytest.skip("orfa-sim has no %s part yet (--part %s@ADDR; the parts of issue 18)"
-                    % (kind, kind))
-
-
 @pytest.fixture(scope="module")
 def robot():
     require_builds(["m32d"])
     elf = require_slave("m128s", SLAVE8)
     sim = SimBoard("m32d", trace=False, control=True, slaves=[("m128s", SLAVE8, elf)],
-                   extra_args=[a for kind, addr in parts_there()
-                               for a in ("--part", "%s@0x%02X" % (kind, addr))])
-    with running(sim) as b:
-        b.ctl = sim.control
+                   parts=PARTS)
+    with running(sim, ControlBench) as b:
         yield b
 
 
@@ -193,7 +170,7 @@ def read_reg(i2c: I2C, addr7: int, reg: int, n: int) -> bytes:
 # --- the bus --------------------------------------------------------------------------------
 
 def test_every_sensor_and_the_slave_answer_on_one_bus(robot, i2c):
-    expected = sorted([SLAVE8 >> 1, GATEWAY] + [addr >> 1 for _, addr in parts_there()])
+    expected = sorted([SLAVE8 >> 1, GATEWAY] + [addr >> 1 for _, addr in PARTS])
     while not i2c.try_lock():
         pass
     try:
@@ -430,7 +407,6 @@ BMP_SENSED = [(21.5, 98765.4), (-5.25, 101325.0)]
 
 @pytest.fixture(scope="module")
 def bmp_adafruit(i2c):
-    need_part("bmp280")
     adafruit_bmp280 = need("adafruit_bmp280", "adafruit-circuitpython-bmp280")
     return adafruit_bmp280.Adafruit_BMP280_I2C(i2c)          # 0x77: EE
 
@@ -466,7 +442,6 @@ def test_adafruit_bmp280(robot, i2c, bmp_adafruit, note, celsius, pa):
 
 @pytest.fixture(scope="module")
 def bmp_pimoroni(robot):
-    need_part("bmp280")
     BMP280 = need("bmp280", "bmp280").BMP280
     bus = SMBus(robot.gw)
     bmp = BMP280(i2c_dev=bus)                                # 0x76: EC
@@ -503,7 +478,6 @@ def test_adafruit_24lc32_bytes_and_slices(i2c, note):
     transfer: the last byte, a slice across a 32-byte page boundary, and
     the longest slice one request reads (60 bytes after the two address
     bytes; one more is orfa.busio's ValueError, never two transfers)."""
-    need_part("24lc32")
     EEPROM_I2C = need("adafruit_24lc32", "adafruit-circuitpython-24lc32").EEPROM_I2C
     eeprom = EEPROM_I2C(i2c, address=EE32 >> 1)
     assert len(eeprom) == 4096
@@ -514,6 +488,6 @@ def test_adafruit_24lc32_bytes_and_slices(i2c, note):
     assert eeprom[0x0000:0x003C] == b"\xff" * 0x3C            # erased, as shipped
     with pytest.raises(ValueError, match="reads at most 60 after 2 written"):
         eeprom[0x0000:0x003D]
-    note("adafruit_24lc32", "eeprom[0x0FFF]", "0xA5", "0x%02X" % eeprom[0x0FFF][0], "")
+    note("adafruit_24lc32", "eeprom[0x0FFF]", "0xA5", "0x%02X" % eeprom[0x0FFF][0], "exact")
     note("adafruit_24lc32", "eeprom[0x003E:0x0042]", "10 20 30 40",
-         eeprom[0x003E:0x0042].hex(" "), "")
+         eeprom[0x003E:0x0042].hex(" "), "exact")

@@ -18,7 +18,7 @@ import pytest
 from orfa.sim import BOARDS, SimBoard
 from orfa.simctl import SimControlError
 
-from conftest import Bench, require_builds, running
+from conftest import ControlBench, require_builds, running
 
 SRF = 0xE0
 F_CPU = 7372800
@@ -33,18 +33,7 @@ POLL = "S E0 00 S E1 01 P"
 POLL_OK = b"SWASR%02XP\r\n" % REVISION
 
 
-class SrfBench(Bench):
-    def __init__(self, sim):
-        super().__init__(sim)
-        self.ctl = sim.control
-
-    def rx(self, cycle: int, line: str) -> int:
-        """Put a request line on the serial line at `cycle`; its end cycle."""
-        return self.ctl.rx(cycle, line.encode("ascii") + b"\n")
-
-    def twi(self, since: int, kind: str):
-        """(cycle, fields) of the bus events of one kind ("addr", "write")."""
-        return [(e.cycle, e.fields) for e in self.events(since, ["twi " + kind])]
+SrfBench = ControlBench
 
 
 @pytest.fixture(scope="module", params=BOARDS)
