@@ -37,6 +37,8 @@ from orfa import boardmap
 from orfa.busio import I2C
 from orfa.sim import SimBoard
 from orfa.smbus import SMBus
+from test_sensors_baro import (P1, P2, P3, P4, P5, P6, P7, P8, P9, T1, T2, T3, press_double,
+                               temp_double)
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs" / "sensors.md"
@@ -359,25 +361,10 @@ def bmp_codes(read):
     return ((d[0] << 12 | d[1] << 4 | d[2] >> 4), (d[3] << 12 | d[4] << 4 | d[5] >> 4))
 
 
-def bmp_t_fine(adc_t: float, cal) -> float:
-    """The datasheet's compensation (section 8.1, the double version):
-    t_fine; degrees C = t_fine / 5120."""
-    t1, t2, t3 = cal[:3]
-    return (adc_t / 16384.0 - t1 / 1024.0) * t2 + \
-        (adc_t / 131072.0 - t1 / 8192.0) ** 2 * t3
-
-
-def bmp_pa(adc_p: float, t_fine: float, cal) -> float:
-    """Pa of ADC_P at T_FINE (datasheet section 8.1, the double version)."""
-    p1, p2, p3, p4, p5, p6, p7, p8, p9 = cal[3:]
-    var1 = t_fine / 2.0 - 64000.0
-    var2 = var1 * var1 * p6 / 32768.0
-    var2 = var2 + var1 * p5 * 2.0
-    var2 = var2 / 4.0 + p4 * 65536.0
-    var1 = (p3 * var1 * var1 / 524288.0 + p2 * var1) / 524288.0
-    var1 = (1.0 + var1 / 32768.0) * p1
-    p = (1048576.0 - adc_p - var2 / 4096.0) * 6250.0 / var1
-    return p + (p9 * p * p / 2147483648.0 + p8 * p / 32768.0 + p7) / 16.0
+def bmp_t_fine(adc_t: float) -> float:
+    """The datasheet's t_fine (section 8.1, the double version) before the
+    truncation to an integer; degrees C = t_fine / 5120."""
+    return temp_double(adc_t)[0] * 5120
 
 
 def bmp_check(read, celsius, pa, t_step, p_step, int_t_fine):
@@ -388,18 +375,19 @@ def bmp_check(read, celsius, pa, t_step, p_step, int_t_fine):
     values the driver must return from those codes, with its own t_fine
     (INT_T_FINE: truncated as the datasheet's int32, or not), and one LSB
     of each, in degrees C and Pa."""
-    cal = bmp_calibration(read)
+    # the words the drivers read are the ones the formulas here have
+    assert bmp_calibration(read) == [T1, T2, T3, P1, P2, P3, P4, P5, P6, P7, P8, P9]
     adc_p, adc_t = bmp_codes(read)
     assert adc_t % t_step == 0 and adc_p % p_step == 0, (adc_t, adc_p)
-    temps = [bmp_t_fine(adc_t + k * t_step, cal) / 5120 for k in (-1, 0, 1)]
+    temps = [bmp_t_fine(adc_t + k * t_step) / 5120 for k in (-1, 0, 1)]
     t_lsb = max(abs(temps[2] - temps[1]), abs(temps[1] - temps[0]))
     assert abs(temps[1] - celsius) <= t_lsb / 2
-    t_fine = int(bmp_t_fine(adc_t, cal))
-    press = [bmp_pa(adc_p + k * p_step, t_fine, cal) for k in (-1, 0, 1)]
+    t_fine = int(bmp_t_fine(adc_t))
+    press = [press_double(adc_p + k * p_step, t_fine) for k in (-1, 0, 1)]
     p_lsb = max(abs(press[2] - press[1]), abs(press[1] - press[0]))
     assert abs(press[1] - pa) <= p_lsb / 2
-    driver_t_fine = t_fine if int_t_fine else bmp_t_fine(adc_t, cal)
-    return driver_t_fine / 5120, bmp_pa(adc_p, driver_t_fine, cal), t_lsb, p_lsb
+    driver_t_fine = t_fine if int_t_fine else bmp_t_fine(adc_t)
+    return driver_t_fine / 5120, press_double(adc_p, driver_t_fine), t_lsb, p_lsb
 
 
 BMP_SENSED = [(21.5, 98765.4), (-5.25, 101325.0)]
