@@ -37,6 +37,17 @@ ifeq ($(wildcard boards/$(BOARD)/board.mk),)
 $(error BOARD=$(BOARD): no such board (boards/: $(notdir $(wildcard boards/*))))
 endif
 include boards/$(BOARD)/board.mk
+include tools/board_facts.mk
+# The MCU and the clock: board.h holds them (the simulator and the map read
+# that header too, and the firmware has them as -mmcu and -DF_CPU).
+BOARD_MCU := $(call board_mcu,$(BOARD))
+BOARD_F_CPU := $(call board_f_cpu,$(BOARD))
+ifeq ($(BOARD_MCU),)
+$(error boards/$(BOARD)/board.h: no $(HASH)define BOARD_MCU_NAME "<mcu>")
+endif
+ifeq ($(BOARD_F_CPU),)
+$(error boards/$(BOARD)/board.h: no $(HASH)define BOARD_CLOCK_HZ <hz>UL)
+endif
 
 # The slave's bus address, 8-bit form (docs/registers.md, "On a slave board"):
 # even, and not one of the 7-bit addresses I2C reserves (8-bit 0x00-0x0F and
@@ -195,14 +206,16 @@ sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf build/sim-fw/twi_slave_e
 
 # Test firmware for the simulator's bus tests (tests/sim/fw), not ORFA: the
 # echo slave on an ATmega32 at 0x20 and on an ATmega128 at 0x22.
-SIM_FW_CFLAGS := -DF_CPU=7372800UL -std=gnu99 -Os -Wall -Wextra -Werror
+# Each runs on a board's MCU at its clock (board.h).
+SIM_FW_CFLAGS := -std=gnu99 -Os -Wall -Wextra -Werror
 build/sim-fw/%_m128.elf: tests/sim/fw/%.c
 	@mkdir -p $(dir $@)
-	avr-gcc -mmcu=atmega128 -DECHO_ADDR=0x22 $(SIM_FW_CFLAGS) $< -o $@
+	avr-gcc -mmcu=$(call board_mcu,m128s) -DF_CPU=$(call board_f_cpu,m128s) -DECHO_ADDR=0x22 \
+		$(SIM_FW_CFLAGS) $< -o $@
 
 build/sim-fw/%.elf: tests/sim/fw/%.c
 	@mkdir -p $(dir $@)
-	avr-gcc -mmcu=atmega32 $(SIM_FW_CFLAGS) $< -o $@
+	avr-gcc -mmcu=$(call board_mcu,m32d) -DF_CPU=$(call board_f_cpu,m32d) $(SIM_FW_CFLAGS) $< -o $@
 
 build/sim/orfa-sim: $(SIM_SRC) $(SIM_HDR)
 	@mkdir -p $(dir $@)

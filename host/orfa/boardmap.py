@@ -155,6 +155,19 @@ def _codes(key: str) -> Dict[int, Code]:
     return {c["code"]: Code(**c) for c in _read(BOARDS[0])[key]}
 
 
+def _shared(key: str):
+    """A fact every board's map holds alike: its value (a ValueError names
+    the boards if they differ)."""
+    values = {board: _read(board)[key] for board in BOARDS}
+    if any(v != values[BOARDS[0]] for v in values.values()):
+        raise ValueError("the board maps differ in %r: %s" % (key, values))
+    return values[BOARDS[0]]
+
+
+#: The clock of every board in Hz (board.h's BOARD_CLOCK_HZ): one for all,
+#: as the simulator steps its boards by one cycle count.
+F_CPU: int = _shared("f_cpu")
+
 #: The status register's values: code -> Code(code, name, text).
 STATUS: Dict[int, Code] = _codes("status")
 #: The protocol's error codes: code -> Code(code, name, text).

@@ -22,6 +22,7 @@ const sim_board_desc_t SIM_BOARD = {
 	.name = BOARD_ID,
 	.title = BOARD_NAME,
 	.mcu = BOARD_MCU_NAME,
+	.hz = BOARD_CLOCK_HZ,
 	.wiring = {
 		.pins = sim_board_pins,
 		.npins = sizeof(sim_board_pins) / sizeof(sim_board_pins[0]),

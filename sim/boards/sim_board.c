@@ -90,7 +90,7 @@ int sim_board_init(sim_board_t *b, const sim_board_desc_t *board, const char *el
 		return 2;
 	}
 	avr_load_firmware(b->avr, &fw);
-	b->avr->frequency = SIM_FREQUENCY;	/* our ELFs carry no .mmcu */
+	b->avr->frequency = board->hz;	/* our ELFs carry no .mmcu */
 	b->avr->sleep = sim_board_sleep;
 
 	usart_init(&b->usart, b->avr, &b->mcu->usart[board->wiring.host_usart],
