@@ -50,9 +50,14 @@ $(error boards/$(BOARD)/board.h: no $(HASH)define BOARD_CLOCK_HZ <hz>UL)
 endif
 
 # The slave's bus address, 8-bit form (docs/registers.md, "On a slave board"):
-# even, and not one of the 7-bit addresses I2C reserves (8-bit 0x00-0x0F and
-# 0xF0-0xFE).
+# the rule of firmware/i2c_addr.h (even, I2C_ADDR_MIN..I2C_ADDR_MAX: not one
+# of the addresses I2C reserves), whose limits are read from there.
 ifeq ($(MODE),slave)
+ADDR_MIN := $(call c_define,firmware/i2c_addr.h,I2C_ADDR_MIN)
+ADDR_MAX := $(call c_define,firmware/i2c_addr.h,I2C_ADDR_MAX)
+ifeq ($(and $(ADDR_MIN),$(ADDR_MAX)),)
+$(error firmware/i2c_addr.h: no $(HASH)define I2C_ADDR_MIN / I2C_ADDR_MAX)
+endif
 ADDR_NUM := $(shell v=$$(printf '%d' '$(ADDR)' 2>/dev/null) && echo $$v)
 ifeq ($(strip $(ADDR)),)
 ADDR_NUM :=
@@ -61,13 +66,14 @@ ifeq ($(ADDR_NUM),)
 $(error ADDR=$(ADDR) is not a number: give the 8-bit bus address, e.g. ADDR=0x10)
 endif
 ifneq ($(shell test $(ADDR_NUM) -ge 0 -a $(ADDR_NUM) -le 255 && echo ok),ok)
-$(error ADDR=$(ADDR) is not an 8-bit bus address (0x10..0xEE, even))
+$(error ADDR=$(ADDR) is not an 8-bit bus address ($(ADDR_MIN)..$(ADDR_MAX), even))
 endif
 ifneq ($(shell expr $(ADDR_NUM) % 2),0)
 $(error ADDR=$(ADDR) is odd: give the 8-bit form, whose bit 0 is the R/W bit (e.g. ADDR=0x10 for 7-bit 0x08))
 endif
-ifneq ($(shell test $(ADDR_NUM) -ge 16 -a $(ADDR_NUM) -le 239 && echo ok),ok)
-$(error ADDR=$(ADDR) is reserved by I2C (8-bit 0x00-0x0F and 0xF0-0xFE): use 0x10..0xEE)
+ifneq ($(shell test $(ADDR_NUM) -ge $$(printf %d $(ADDR_MIN)) -a \
+	$(ADDR_NUM) -le $$(printf %d $(ADDR_MAX)) && echo ok),ok)
+$(error ADDR=$(ADDR) is reserved by I2C: use $(ADDR_MIN)..$(ADDR_MAX))
 endif
 endif
 

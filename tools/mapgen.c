@@ -16,6 +16,7 @@
 
 #include "board.h"
 #include "drivers/drivers.h"
+#include "firmware/i2c_addr.h"
 #include "firmware/sys.h"
 #include "serialgate/sg_exec.h"
 #include "serialgate/sg_parse.h"
@@ -119,6 +120,7 @@ int main(void)
 	       BOARD_UART, gpio_ports, BOARD_ADC_PORT);
 	printf("  \"servo_channels\": %d,\n", BOARD_SERVO_CHANNELS);
 	printf("  \"local_address\": %d,\n", SG_LOCAL_DEFAULT);
+	printf("  \"bus_address\": {\"min\": %d, \"max\": %d},\n", I2C_ADDR_MIN, I2C_ADDR_MAX);
 	printf("  \"limits\": {\"request_chars\": %d, \"reply_chars\": %d, "
 	       "\"servo_min_us\": %d, \"servo_max_us\": %d, \"servo_triples\": %d, "
 	       "\"spi_channels\": %d, \"spi_bytes\": %d, \"read_bytes\": %d, "

@@ -168,6 +168,19 @@ def _shared(key: str):
 #: as the simulator steps its boards by one cycle count.
 F_CPU: int = _shared("f_cpu")
 
+#: The bus addresses a slave board or a part may be given, 8-bit form
+#: (firmware/i2c_addr.h): even, ADDRESS_MIN..ADDRESS_MAX, which leaves out
+#: the addresses I2C reserves.
+ADDRESS_MIN: int = _shared("bus_address")["min"]
+ADDRESS_MAX: int = _shared("bus_address")["max"]
+#: The rule in words, for messages and help: "even, 0x10..0xEE".
+ADDRESS_TEXT = "even, 0x%02X..0x%02X" % (ADDRESS_MIN, ADDRESS_MAX)
+
+
+def address_ok(addr8: int) -> bool:
+    """Whether addr8 is a bus address a slave board or a part may have."""
+    return addr8 % 2 == 0 and ADDRESS_MIN <= addr8 <= ADDRESS_MAX
+
 #: The status register's values: code -> Code(code, name, text).
 STATUS: Dict[int, Code] = _codes("status")
 #: The protocol's error codes: code -> Code(code, name, text).

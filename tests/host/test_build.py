@@ -88,13 +88,14 @@ def test_mcu_and_clock_come_from_board_h(board, tmp_path):
 def copy_build_files(tmp_path):
     """What make reads before it compiles, into tmp_path, for a header to break."""
     for name in ("Makefile", "tools/board_facts.mk", "boards/m32d/board.mk",
-                 "boards/m32d/board.h"):
+                 "boards/m32d/board.h", "firmware/i2c_addr.h"):
         (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy(ROOT / name, tmp_path / name)
 
 
 @pytest.mark.parametrize("name, file", [
     ("BOARD_MCU_NAME", "boards/m32d/board.h"), ("BOARD_CLOCK_HZ", "boards/m32d/board.h"),
+    ("I2C_ADDR_MIN", "firmware/i2c_addr.h"),
 ])
 def test_a_header_without_its_fact_stops_the_build(name, file, tmp_path):
     copy_build_files(tmp_path)
@@ -107,3 +108,20 @@ def test_a_header_without_its_fact_stops_the_build(name, file, tmp_path):
     assert r.returncode != 0
     assert "%s: no #define %s" % (file, name) in r.stderr, r.stderr
     assert r.stderr.count("\n") == 1 and "avr-gcc" not in r.stdout
+
+
+def test_the_slave_address_rule_is_i2c_addr_h_s(tmp_path):
+    """make takes its limits from firmware/i2c_addr.h: moved there, they
+    move the build's check (and its message) too."""
+    copy_build_files(tmp_path)
+    header = tmp_path / "firmware" / "i2c_addr.h"
+    header.write_text(header.read_text().replace("I2C_ADDR_MIN 0x10", "I2C_ADDR_MIN 0x20"))
+
+    def run(addr):      # a target that needs no sources: the check is all
+        return subprocess.run(["make", "--no-print-directory", "-s", "MODE=slave",
+                               "ADDR=" + addr, "print-baud-rates"],
+                              cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    r = run("0x1E")
+    assert r.returncode != 0 and "ADDR=0x1E is reserved by I2C: use 0x20..0xEE" in r.stderr
+    r = run("0x20")
+    assert r.returncode == 0 and r.stderr == "", r.stderr
