@@ -181,6 +181,11 @@ def address_ok(addr8: int) -> bool:
     """Whether addr8 is a bus address a slave board or a part may have."""
     return addr8 % 2 == 0 and ADDRESS_MIN <= addr8 <= ADDRESS_MAX
 
+
+#: The functions a board may give a pin (firmware/board_fn.h), the names
+#: of Pin.function.
+PIN_FUNCTIONS: Tuple[str, ...] = tuple(_shared("pin_functions"))
+
 #: The status register's values: code -> Code(code, name, text).
 STATUS: Dict[int, Code] = _codes("status")
 #: The protocol's error codes: code -> Code(code, name, text).

@@ -55,7 +55,7 @@ const char *sim_board_names(void)
 	return names;
 }
 
-const sim_pin_t *sim_wiring_pin(const sim_wiring_t *w, sim_pin_fn_t fn, int index)
+const sim_pin_t *sim_wiring_pin(const sim_wiring_t *w, board_fn_t fn, int index)
 {
 	for (int i = 0; i < w->npins; i++) {
 		if (w->pins[i].fn == fn && w->pins[i].index == index) {

@@ -4,6 +4,7 @@ appears again or when a reader of the fact stops agreeing with it."""
 
 import argparse
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -98,3 +99,20 @@ def test_the_build_checks_the_rule(end, offset, c_rule):
                         "ADDR=0x%02X" % addr, "print-baud-rates"],
                        cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert (r.returncode == 0) == (addr in c_rule), r.stderr
+
+
+def test_pins_have_the_functions_of_the_one_list():
+    """firmware/board_fn.h's list, through the map (test_boardmap.py keeps
+    the map what tools/mapgen.c writes): every board's pins use it, and the
+    generated pages have a text for each of its names."""
+    assert boardmap.PIN_FUNCTIONS[:2] == ("UART_RX", "UART_TX")
+    for board in boardmap.BOARDS:
+        assert {p.function for p in boardmap.load(board).pins} <= set(boardmap.PIN_FUNCTIONS)
+    sys.path.insert(0, str(ROOT / "tools"))
+    try:
+        import docgen_en
+        import docgen_ru
+    finally:
+        sys.path.remove(str(ROOT / "tools"))
+    assert set(docgen_en.PIN_FUNCTIONS) == set(docgen_ru.PIN_FUNCTIONS) == \
+        set(boardmap.PIN_FUNCTIONS)
