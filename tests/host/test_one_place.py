@@ -84,6 +84,7 @@ def refused(check, addr):
     ("SimRobot slave", lambda a: sim.slave_spec(("m128s", a))),
     ("orfa sim --slave", lambda a: common.slave_spec("m128s:%d" % a)),
     ("orfa sim --eeprom", lambda a: common.eeprom_spec("%d" % a)),
+    ("orfa sim --part", lambda a: common.part_spec("eeprom24@%d" % a)),
     ("orfa flash --addr", lambda a: flash.slave_elf("m128s", a)),
 ])
 def test_every_host_check_is_the_rule(name, check, c_rule):
