@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
-from . import locate
+from . import boardmap, locate
 from .errors import SimError
 from .gateway import Gateway
 from .protocol import AUTOBAUD_PREAMBLE, DEFAULT_BAUD, F_CPU, autobaud_wait_s
@@ -77,9 +77,9 @@ def slave_spec(spec) -> Tuple[str, int, Union[str, Path, None]]:
     board, addr = spec[0], spec[1]
     if board not in BOARDS:
         raise ValueError("slave board %r: one of %s" % (board, ", ".join(BOARDS)))
-    if addr & 1 or not 0x10 <= addr <= 0xEE:
-        raise ValueError("slave address %s: an 8-bit address, even, 0x10..0xEE"
-                         % ("0x%02X" % addr if addr >= 0 else addr))
+    if not boardmap.address_ok(addr):
+        raise ValueError("slave address %s: an 8-bit address, %s"
+                         % ("0x%02X" % addr if addr >= 0 else addr, boardmap.ADDRESS_TEXT))
     return (board, addr, spec[2] if len(spec) == 3 else None)
 
 

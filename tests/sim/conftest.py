@@ -247,9 +247,9 @@ def board(bench):
 # off, SPI bus settings 02, GPIO lines inputs without pull-up, external drives
 # released), so no test sees another's state.
 
-F_CPU = 7372800
+F_CPU = boardmap.F_CPU
 #: One servo frame: 20 ms.
-SERVO_FRAME = 147456
+SERVO_FRAME = F_CPU * 20 // 1000
 
 def _layout(board: str) -> dict:
     """Registers and pins of a board with all its drivers, from its map

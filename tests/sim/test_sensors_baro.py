@@ -26,14 +26,13 @@ import pytest
 from orfa.sim import SimBoard, part_kinds
 from orfa.simctl import SimControlError
 
-from conftest import ControlBench, require_builds, running
+from conftest import F_CPU, ControlBench, require_builds, running
 
 BARO = 0xEC
 EE = 0xA8
 EE_WP = 0xAC
-F_CPU = 7372800
-TWC = F_CPU * 5 // 1000                 # 36864 cycles: the 24LC32A's write cycle
-STARTUP = F_CPU * 2 // 1000             # 14745: the BMP280's NVM copy after a reset
+TWC = F_CPU * 5 // 1000                 # the 24LC32A's write cycle
+STARTUP = F_CPU * 2 // 1000             # the BMP280's NVM copy after a reset
 ENV = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2] / "host"))
 #: How far ahead of "now" bytes are scheduled with `rx` (see test_srf08.py).
 LEAD = F_CPU // 2

@@ -15,14 +15,14 @@ import re
 
 import pytest
 
+from orfa.protocol import F_CPU
 from orfa.sim import BOARDS, SimBoard
 from orfa.simctl import SimControlError
 
 from conftest import ControlBench, require_builds, running
 
 SRF = 0xE0
-F_CPU = 7372800
-MS65 = F_CPU * 65 // 1000            # 479232 cycles: a ranging at range 255
+MS65 = F_CPU * 65 // 1000            # a ranging at range 255
 RANGE24 = MS65 * 25 // 256           # 46800 cycles: at range 24 (0x18)
 REVISION = 0x0A                      # sim/parts/srf08.h (the document names none)
 #: How far ahead of "now" bytes are scheduled with `rx`: half a simulated

@@ -10,6 +10,7 @@ import math
 import os
 from typing import Iterator, List, Optional
 
+from .. import boardmap
 from .. import protocol as p
 from ..errors import UsageError, explain  # noqa: F401 (the commands' errors, one line each)
 from ..gateway import Gateway, os_reason
@@ -177,8 +178,8 @@ def part_spec(text: str):
 def _check_device_address(text: str, addr: int) -> None:
     """A simulated device's 8-bit bus address: even, outside the addresses
     I2C reserves, and not the gateway's own (its requests never reach the bus)."""
-    if addr & 1 or not 0x10 <= addr <= 0xEE:
-        raise argparse.ArgumentTypeError("%r: ADDR must be even, 0x10..0xEE" % text)
+    if not boardmap.address_ok(addr):
+        raise argparse.ArgumentTypeError("%r: ADDR must be %s" % (text, boardmap.ADDRESS_TEXT))
     if addr == p.DEFAULT_LOCAL_ADDRESS:
         raise argparse.ArgumentTypeError("%r: 0x%02X is the gateway's own address (its"
                                          " requests never reach the bus)" % (text, addr))
@@ -202,7 +203,8 @@ def add_sim_devices(parser, suppress: bool = False) -> None:
     parser.add_argument("--eeprom", type=eeprom_spec, action="append", default=default or [],
                         metavar="ADDR",
                         help="a 24C02-like EEPROM at the 8-bit bus address ADDR (0xA0;"
-                             " even, 0x10..0xEE, not the gateway's 0xAA), repeatable")
+                             " %s, not the gateway's 0xAA), repeatable"
+                             % boardmap.ADDRESS_TEXT)
     parser.add_argument("--part", type=part_spec, action="append", default=default or [],
                         metavar="KIND@ADDR[:OPTIONS]",
                         help="a part of KIND on the I2C bus at the 8-bit ADDR, checked as"
@@ -210,10 +212,11 @@ def add_sim_devices(parser, suppress: bool = False) -> None:
                              " lists the kinds), repeatable")
     parser.add_argument("--slave", type=slave_spec, action="append", default=default or [],
                         metavar="BOARD:ADDR[:ELF]",
-                        help="a slave board on the bus at the 8-bit ADDR (even, 0x10..0xEE,"
+                        help="a slave board on the bus at the 8-bit ADDR (%s,"
                              " not the gateway's 0xAA; repeatable); ELF"
                              " defaults to build/robot/<board>-<ADDR>/orfa.elf (make robot)"
-                             " if built, else build/<board>-slave/orfa.elf")
+                             " if built, else build/<board>-slave/orfa.elf"
+                             % boardmap.ADDRESS_TEXT)
     parser.add_argument("--adc", type=adc_spec, action="append", default=default or [],
                         metavar="CH=MV", help="analog input CH (0-7) at MV millivolts,"
                                               " repeatable")
