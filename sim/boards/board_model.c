@@ -294,13 +294,13 @@ const char *board_model_add_spi(board_model_t *bm, const char *spec)
 		return unknown;
 	}
 	part_env_t env = { .mode = mode, .lsb_first = lsb, .adc_mv = bm->adc_mv,
-			   .avcc = &bm->avcc };
+			   .avcc = &bm->avcc, .opts = "" };
 	const char *err = NULL;
 
 	if (bm->spi.ndev == SPI_MAX_DEVICES) {
 		return "too many SPI devices";
 	}
-	d = part_make(kind, &env, "", &err);
+	d = part_make(kind, &env, &err);
 	if (!d) {
 		return err;
 	}

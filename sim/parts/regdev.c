@@ -70,6 +70,13 @@ static const twi_dev_ops_t regdev_twi_ops = {
 	.stop = regdev_stop,
 };
 
+void regdev_catch_up(void *self, uint64_t now)
+{
+	regdev_t *d = self;
+
+	d->ops->catch_up(d, now);
+}
+
 void regdev_init(regdev_t *d, const part_env_t *env, const char *name, const regdev_ops_t *ops)
 {
 	d->dev.ops = &regdev_twi_ops;
