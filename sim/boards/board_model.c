@@ -293,8 +293,7 @@ const char *board_model_add_spi(board_model_t *bm, const char *spec)
 			 part_kind_names(PART_SPI, ", ", names, sizeof(names)));
 		return unknown;
 	}
-	part_env_t env = { .mode = mode, .lsb_first = lsb, .adc_mv = bm->adc_mv,
-			   .avcc = &bm->avcc, .opts = "" };
+	part_env_t env = { .adc_mv = bm->adc_mv, .avcc = &bm->avcc, .opts = "" };
 	const char *err = NULL;
 
 	if (bm->spi.ndev == SPI_MAX_DEVICES) {
@@ -304,6 +303,9 @@ const char *board_model_add_spi(board_model_t *bm, const char *spec)
 	if (!d) {
 		return err;
 	}
+	d->kind = kind->name;
+	d->mode = mode;
+	d->lsb_first = lsb;
 	if (spi_attach(&bm->spi, d, &p->pin[bit]) < 0) {
 		return "too many SPI devices";
 	}

@@ -26,7 +26,8 @@ const char *world_add_part(world_t *w, const part_kind_t *kind, uint8_t addr8, c
 		return err;
 	}
 	part_list_add(&w->parts, kind, self, addr8);
-	twi_bus_attach(&w->bus, self);	/* its first member: the twi_dev_t */
+	((twi_dev_t *)self)->name = kind->name;	/* its first member: the twi_dev_t */
+	twi_bus_attach(&w->bus, self);
 	return NULL;
 }
 

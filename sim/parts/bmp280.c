@@ -348,7 +348,7 @@ static void bmp280_part_init(void *self, const part_env_t *env)
 {
 	bmp280_t *b = self;
 
-	regdev_init(&b->rd, env, "bmp280", &bmp280_ops);
+	regdev_init(&b->rd, env, &bmp280_ops);
 	b->temp_c = 25.0;	/* a room at sea level until told otherwise */
 	b->press_pa = 101325.0;
 	bmp280_reset(b, 0);

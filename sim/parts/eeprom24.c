@@ -71,7 +71,6 @@ static void eeprom24_init(void *self, const part_env_t *env)
 
 	memset(e->mem, 0xff, sizeof(e->mem));
 	e->dev.ops = &eeprom24_ops;
-	e->dev.name = "eeprom24";
 	e->addr8 = env->addr8 & 0xfe;
 	e->write_protect = !strcmp(env->opts, "wp");
 }

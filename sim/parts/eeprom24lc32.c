@@ -121,7 +121,6 @@ static void ee24lc32_part_init(void *self, const part_env_t *env)
 	ee24lc32_t *e = self;
 
 	e->dev.ops = &ee24lc32_ops;
-	e->dev.name = "24lc32";
 	e->bus = env->bus;
 	e->hz = env->hz;
 	e->addr8 = env->addr8 & 0xfe;

@@ -125,15 +125,13 @@ static int ee_dump(spi_dev_t *d, char *buf, int size)
 
 /* --- descriptor ------------------------------------------------------------ */
 
-/* Erased (FF), speaking ENV's SPI mode and bit order. */
+/* Erased (FF). */
 static void eeprom25_init(void *self, const part_env_t *env)
 {
 	eeprom25_t *e = self;
 
+	(void)env;
 	memset(e->mem, 0xff, sizeof(e->mem));
-	e->dev.kind = "eeprom25";
-	e->dev.mode = env->mode;
-	e->dev.lsb_first = env->lsb_first;
 	e->dev.byte = ee_byte;
 	e->dev.reset_state = ee_reset_state;
 	e->dev.end = ee_end;

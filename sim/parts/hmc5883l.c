@@ -244,7 +244,7 @@ static void hmc5883l_part_init(void *self, const part_env_t *env)
 {
 	hmc5883l_t *h = self;
 
-	regdev_init(&h->rd, env, "hmc5883l", &hmc5883l_rd_ops);
+	regdev_init(&h->rd, env, &hmc5883l_rd_ops);
 	h->reg[HMC5883L_CRA] = 0x10;
 	h->reg[HMC5883L_CRB] = 0x20;
 	h->reg[HMC5883L_MODE] = HMC5883L_MD_SINGLE;

@@ -255,7 +255,7 @@ static void lis3mdl_part_init(void *self, const part_env_t *env)
 {
 	lis3mdl_t *l = self;
 
-	regdev_init(&l->rd, env, "lis3mdl", &lis3mdl_rd_ops);
+	regdev_init(&l->rd, env, &lis3mdl_rd_ops);
 	l->temp = 25.0;
 	lis3mdl_reset_regs(l);
 }

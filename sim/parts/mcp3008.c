@@ -95,15 +95,11 @@ static int mcp_dump(spi_dev_t *d, char *buf, int size)
 
 /* --- descriptor ------------------------------------------------------------ */
 
-/* Converting the board's analog inputs against its AVCC (ENV), speaking
- * ENV's SPI mode and bit order. */
+/* Converting the board's analog inputs against its AVCC (ENV). */
 static void mcp3008_init(void *self, const part_env_t *env)
 {
 	mcp3008_t *m = self;
 
-	m->dev.kind = "mcp3008";
-	m->dev.mode = env->mode;
-	m->dev.lsb_first = env->lsb_first;
 	m->dev.select = mcp_select;
 	m->dev.deselect = mcp_deselect;
 	m->dev.in_bit = mcp_in;

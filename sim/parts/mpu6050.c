@@ -257,7 +257,7 @@ static void mpu6050_part_init(void *self, const part_env_t *env)
 {
 	mpu6050_t *m = self;
 
-	regdev_init(&m->rd, env, "mpu6050", &mpu6050_rd_ops);
+	regdev_init(&m->rd, env, &mpu6050_rd_ops);
 	m->temp = 25.0;
 	mpu6050_reset(m);
 }

@@ -31,7 +31,6 @@ typedef struct part_env_t {
 	struct twi_bus_t *bus;		/* I2C: the bus (its `cycle` is the time) */
 	uint32_t hz;			/* cycles per second */
 	uint8_t addr8;			/* I2C: its 8-bit address */
-	int mode, lsb_first;		/* SPI: the mode and bit order it speaks */
 	const uint32_t *adc_mv;		/* SPI: the board's 8 analog inputs, mV */
 	const uint32_t *avcc;		/* SPI: the board's AVCC, mV */
 	const char *opts;		/* the option text after KIND@ADDR: ("" for
@@ -42,7 +41,8 @@ typedef struct part_env_t {
 struct part_kind_t;
 
 /* One part made: its kind and its context struct, whose first member is
- * the bus's view of it (twi_dev_t or spi_dev_t). */
+ * the bus's view of it (twi_dev_t or spi_dev_t; what attaches the part
+ * names that view after its kind and sets how it speaks SPI). */
 typedef struct part_t {
 	const struct part_kind_t *kind;
 	void *self;
@@ -95,7 +95,7 @@ typedef struct part_kind_t {
 	 * (the unused ones 0; none: any even address); part_kind_addr_ok */
 	part_addr_span_t addrs[PART_ADDR_SPANS];
 	/* Its context struct: SIZE bytes, zeroed, then set up by INIT from
-	 * ENV (SPI: mode and bit order; its option, already checked). */
+	 * ENV (its option already checked). */
 	size_t size;
 	void (*init)(void *self, const part_env_t *env);
 	const part_request_t *requests;

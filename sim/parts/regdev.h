@@ -43,6 +43,6 @@ struct regdev_t {
 void regdev_catch_up(void *self, uint64_t now);
 
 /* Set up D (the first member of the part's context) at ENV's address. */
-void regdev_init(regdev_t *d, const part_env_t *env, const char *name, const regdev_ops_t *ops);
+void regdev_init(regdev_t *d, const part_env_t *env, const regdev_ops_t *ops);
 
 #endif
