@@ -576,3 +576,21 @@ def pytest_terminal_summary(terminalreporter, config):
         terminalreporter.section("sensor readings (build/sensor-readings.txt)")
         for row in rows:
             terminalreporter.write_line(row)
+
+
+def cli_runner(port: str, capsys, monkeypatch):
+    """run(*argv, stdin="") runs the `orfa` command in this process on
+    `port` and gives (exit status, stdout, stderr)."""
+    import io
+
+    from orfa import cli
+
+    def run(*argv, stdin=""):
+        monkeypatch.setattr("sys.stdin", io.StringIO(stdin))
+        try:
+            status = cli.main(["--port", port, "--timeout", "5"] + list(argv))
+        except SystemExit as exc:
+            status = exc.code
+        out, err = capsys.readouterr()
+        return status, out, err
+    return run
