@@ -27,8 +27,8 @@ _Static_assert((TWI_WAIT_TICKS + 2) * CLOCK_TICK_CYCLES <= F_CPU / 100,
 static struct {
 	uint8_t ticks;     /* clock ticks a step may take before it has failed */
 	uint8_t quiet;     /* the quiet fence is up (twi_quiet.h) */
-	uint8_t quiet_t0;  /* clock_now8() when it went up */
 	uint8_t open;      /* a START of ours is on the bus, no STOP yet */
+	uint16_t quiet_t0; /* clock_now() when it went up */
 } twi;
 
 /* Nothing of ours on the bus until the fence is down: a frame this board
@@ -37,19 +37,29 @@ static struct {
 static void twi_fence_up(void)
 {
 	twi.quiet = 1;
-	twi.quiet_t0 = clock_now8();
+	twi.quiet_t0 = clock_now();
 }
 
-/* Measured with the clock's low byte: a request that comes more than 256
- * ticks (71 ms) after the fence went up may wait once for nothing, never
- * too little. */
-static void twi_fence_wait(void)
+/* Is the fence still up? It comes down by itself when its time is over,
+ * looked at here and from the idle loop (twi_idle), so the 16-bit clock's
+ * wrap (18.2 s) never makes an old fence look new. */
+static bool twi_fence_up_still(void)
 {
-	if (twi.quiet) {
-		while ((uint8_t)(clock_now8() - twi.quiet_t0) <= TWI_QUIET_FENCE_TICKS) {
-		}
+	if (twi.quiet && (uint16_t)(clock_now() - twi.quiet_t0) > TWI_QUIET_FENCE_TICKS) {
 		twi.quiet = 0;
 	}
+	return twi.quiet;
+}
+
+static void twi_fence_wait(void)
+{
+	while (twi_fence_up_still()) {
+	}
+}
+
+void twi_idle(void)
+{
+	(void)twi_fence_up_still();
 }
 
 /* The transaction is given up without a STOP (that would make a slave

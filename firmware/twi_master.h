@@ -31,6 +31,10 @@ twi_result_t twi_start(uint8_t addr8);
 twi_result_t twi_write(uint8_t byte);
 /* Reads a byte; `ack` tells the slave more bytes are wanted. */
 twi_result_t twi_read(uint8_t *byte, bool ack);
+/* From the front end's idle loop: lets the quiet fence come down when its
+ * time is over (cheap: one byte test while it is down). */
+void twi_idle(void);
+
 /* STOP, ending the transaction. False when it could not be put on the bus
  * (a step timed out: abandoned, the frame is dropped by its slave); true
  * when it was, or the transaction was abandoned already. */

@@ -51,6 +51,7 @@ void front_poll(void)
 			 * the M32-D's streamed servo writes have no cycle to spare
 			 * (characters always leave the loop idle in between). */
 			sys_poll();
+			twi_idle();
 			return;
 		}
 		ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {

@@ -106,6 +106,10 @@ bool twi_stop(void)
 	return !held;
 }
 
+void twi_idle(void)
+{
+}
+
 bool twi_clear_bus(void)
 {
 	logf_("X ", 0);
