@@ -191,3 +191,26 @@ def test_a_healthy_write_right_after_is_applied(rb):
     assert status(b, M32D) == OK
     reply = b.ask("S 12 %02X 00 S 13 20 P" % sp(M32D))
     assert reply == b"SWAASR" + b"05DC" * 16 + b"P\r\n", reply
+
+
+def test_an_old_fence_never_delays_an_error(rb):
+    """The quiet time after a fault is over for good once it has passed: a
+    request long after it (here 4 x 256 clock ticks + 20 ms, where a clock
+    read modulo 256 ticks would think the fault fresh) with the bus stuck
+    again gets its ERROR within 10 ms, as the first did."""
+    b = rb
+    ctl = b.sim.control
+    req = b"S1201S1301P\r"
+    mark = b.mark()
+    try:
+        ctl.requests(["i2c hold-scl on", "rx +2000 %s" % req.hex().upper()])
+        assert b.read_lines(1) == b"ERROR 06\r\n"
+        off = [e.cycle for e in b.events(mark, ["twi off"])]
+        assert len(off) == 1, off                          # the gateway gave up there
+        end = off[0] + 4 * 256 * 2048 + 20 * MS             # the next request's last bit
+        ctl.rx(end - 10 * ctl.line()["bit"] * len(req), req)
+        assert b.read_lines(1) == b"ERROR 06\r\n"
+        tx = [e.cycle for e in b.events(mark, ["uart tx"]) if e.cycle > end]
+        assert 9 * MS < tx[0] - end < 10 * MS, tx[0] - end
+    finally:
+        ctl.i2c_hold_scl(False)
