@@ -37,11 +37,27 @@ ifeq ($(wildcard boards/$(BOARD)/board.mk),)
 $(error BOARD=$(BOARD): no such board (boards/: $(notdir $(wildcard boards/*))))
 endif
 include boards/$(BOARD)/board.mk
+include tools/board_facts.mk
+# The MCU and the clock: board.h holds them (the simulator and the map read
+# that header too, and the firmware has them as -mmcu and -DF_CPU).
+BOARD_MCU := $(call board_mcu,$(BOARD))
+BOARD_F_CPU := $(call board_f_cpu,$(BOARD))
+ifeq ($(BOARD_MCU),)
+$(error boards/$(BOARD)/board.h: no $(HASH)define BOARD_MCU_NAME "<mcu>")
+endif
+ifeq ($(BOARD_F_CPU),)
+$(error boards/$(BOARD)/board.h: no $(HASH)define BOARD_CLOCK_HZ <hz>UL)
+endif
 
 # The slave's bus address, 8-bit form (docs/registers.md, "On a slave board"):
-# even, and not one of the 7-bit addresses I2C reserves (8-bit 0x00-0x0F and
-# 0xF0-0xFE).
+# the rule of firmware/i2c_addr.h (even, I2C_ADDR_MIN..I2C_ADDR_MAX: not one
+# of the addresses I2C reserves), whose limits are read from there.
 ifeq ($(MODE),slave)
+ADDR_MIN := $(call c_define,firmware/i2c_addr.h,I2C_ADDR_MIN)
+ADDR_MAX := $(call c_define,firmware/i2c_addr.h,I2C_ADDR_MAX)
+ifeq ($(and $(ADDR_MIN),$(ADDR_MAX)),)
+$(error firmware/i2c_addr.h: no $(HASH)define I2C_ADDR_MIN / I2C_ADDR_MAX)
+endif
 ADDR_NUM := $(shell v=$$(printf '%d' '$(ADDR)' 2>/dev/null) && echo $$v)
 ifeq ($(strip $(ADDR)),)
 ADDR_NUM :=
@@ -50,13 +66,14 @@ ifeq ($(ADDR_NUM),)
 $(error ADDR=$(ADDR) is not a number: give the 8-bit bus address, e.g. ADDR=0x10)
 endif
 ifneq ($(shell test $(ADDR_NUM) -ge 0 -a $(ADDR_NUM) -le 255 && echo ok),ok)
-$(error ADDR=$(ADDR) is not an 8-bit bus address (0x10..0xEE, even))
+$(error ADDR=$(ADDR) is not an 8-bit bus address ($(ADDR_MIN)..$(ADDR_MAX), even))
 endif
 ifneq ($(shell expr $(ADDR_NUM) % 2),0)
 $(error ADDR=$(ADDR) is odd: give the 8-bit form, whose bit 0 is the R/W bit (e.g. ADDR=0x10 for 7-bit 0x08))
 endif
-ifneq ($(shell test $(ADDR_NUM) -ge 16 -a $(ADDR_NUM) -le 239 && echo ok),ok)
-$(error ADDR=$(ADDR) is reserved by I2C (8-bit 0x00-0x0F and 0xF0-0xFE): use 0x10..0xEE)
+ifneq ($(shell test $(ADDR_NUM) -ge $$(printf %d $(ADDR_MIN)) -a \
+	$(ADDR_NUM) -le $$(printf %d $(ADDR_MAX)) && echo ok),ok)
+$(error ADDR=$(ADDR) is reserved by I2C: use $(ADDR_MIN)..$(ADDR_MAX))
 endif
 endif
 
@@ -195,14 +212,16 @@ sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf build/sim-fw/twi_slave_e
 
 # Test firmware for the simulator's bus tests (tests/sim/fw), not ORFA: the
 # echo slave on an ATmega32 at 0x20 and on an ATmega128 at 0x22.
-SIM_FW_CFLAGS := -DF_CPU=7372800UL -std=gnu99 -Os -Wall -Wextra -Werror
+# Each runs on a board's MCU at its clock (board.h).
+SIM_FW_CFLAGS := -std=gnu99 -Os -Wall -Wextra -Werror
 build/sim-fw/%_m128.elf: tests/sim/fw/%.c
 	@mkdir -p $(dir $@)
-	avr-gcc -mmcu=atmega128 -DECHO_ADDR=0x22 $(SIM_FW_CFLAGS) $< -o $@
+	avr-gcc -mmcu=$(call board_mcu,m128s) -DF_CPU=$(call board_f_cpu,m128s) -DECHO_ADDR=0x22 \
+		$(SIM_FW_CFLAGS) $< -o $@
 
 build/sim-fw/%.elf: tests/sim/fw/%.c
 	@mkdir -p $(dir $@)
-	avr-gcc -mmcu=atmega32 $(SIM_FW_CFLAGS) $< -o $@
+	avr-gcc -mmcu=$(call board_mcu,m32d) -DF_CPU=$(call board_f_cpu,m32d) $(SIM_FW_CFLAGS) $< -o $@
 
 build/sim/orfa-sim: $(SIM_SRC) $(SIM_HDR)
 	@mkdir -p $(dir $@)
@@ -254,8 +273,10 @@ demo: setup
 	@$(MAKE) -s --no-print-directory BOARD=m32d MODE=gate firmware sim
 	@PYTHONPATH=host exec python3 -m orfa sim --board m32d --eeprom 0xA0 --terminal
 
-# A robot: the M32-D gateway, an M128-S slave at 0x10, an M32-D slave at 0x12
-# and the EEPROM at A0, all on one simulated I2C bus.
+# A robot: the M32-D gateway, an M128-S slave at 0x10, an M32-D slave at 0x12,
+# the EEPROM at A0 and the robot's sensors (an MPU-6050 IMU at D0, an
+# HMC5883L compass at 3C, a LIS3MDL magnetometer at 38, a BMP280 barometer at
+# EC, a 24LC32 EEPROM at A8), all on one simulated I2C bus.
 demo-robot: setup
 	@$(MAKE) --no-print-directory BOARD=m32d MODE=gate firmware sim
 	@$(MAKE) --no-print-directory BOARD=m128s MODE=slave ADDR=0x10 \
@@ -263,6 +284,8 @@ demo-robot: setup
 	@$(MAKE) --no-print-directory BOARD=m32d MODE=slave ADDR=0x12 \
 		BUILD=build/robot/m32d-0x12 firmware
 	PYTHONPATH=host python3 -m orfa sim --board m32d --eeprom 0xA0 \
+		--part mpu6050@0xD0 --part hmc5883l@0x3C --part lis3mdl@0x38 \
+		--part bmp280@0xEC --part 24lc32@0xA8 \
 		--slave m128s:0x10:build/robot/m128s-0x10/orfa.elf \
 		--slave m32d:0x12:build/robot/m32d-0x12/orfa.elf --terminal
 

@@ -7,16 +7,8 @@
 
 #include <stdint.h>
 
+#include "firmware/board_fn.h"
 #include "firmware/flash.h"
-
-/* The functions a board file may give a pin. */
-typedef enum {
-	BF_UART_RX, BF_UART_TX,
-	BF_TWI_SCL, BF_TWI_SDA,
-	BF_SPI_SS, BF_SPI_MOSI, BF_SPI_MISO, BF_SPI_SCK,
-	BF_MOTOR_PWM, BF_MOTOR_DIR,
-	BF_SERVO, BF_SERVO_CLK, BF_SERVO_RST,
-} board_fn_t;
 
 #define BOARD_PIN_NONE 0xFF
 

@@ -41,10 +41,6 @@
 #define MCU_RESET_FLAGS    MCUCSR
 #else
 #error "ORFA supports ATmega32 and ATmega128"
-/* Frees the JTAG pins (M32-D PC2-PC5, M128-S PF4-PF7) for their board
- * functions even when the JTAGEN fuse is programmed. */
-void mcu_jtag_off(void);
-
 #endif
 
 /* The three registers of one I/O port. */

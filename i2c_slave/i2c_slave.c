@@ -13,6 +13,7 @@
 #include <util/twi.h>
 
 #include "firmware/clock.h"
+#include "firmware/i2c_addr.h"
 #include "firmware/sys.h"
 #include "firmware/twi_quiet.h"
 #include "i2c_slave/slave_fsm.h"
@@ -22,7 +23,7 @@
 #endif
 
 _Static_assert((ORFA_ADDR & 1) == 0, "ADDR is the 8-bit form: even");
-_Static_assert(ORFA_ADDR >= 0x10 && ORFA_ADDR < 0xF0, "ADDR is an I2C reserved address");
+_Static_assert(I2C_ADDR_OK(ORFA_ADDR), "ADDR is an I2C reserved address (firmware/i2c_addr.h)");
 
 /* Interrupt on, acknowledging: the TWI's resting state as a slave. */
 #define SLAVE_TWCR (_BV(TWEN) | _BV(TWIE) | _BV(TWEA))

@@ -37,7 +37,7 @@ from orfa import boardmap  # noqa: E402
 from orfa.sim import SimBoard, firmware_path, parse_trace, slave_firmware_path  # noqa: E402
 from orfa.simctl import RX_MAX, SimControlError  # noqa: E402
 
-F_CPU = 7372800
+F_CPU = boardmap.F_CPU
 CYCLES_PER_BYTE = 640  # 10 bit times at 115200 baud
 #: The first request's first byte: 2.3 s simulated after power-up, far ahead
 #: of the cycle the simulator is at when the schedule is sent (about 0.1 s).

@@ -16,6 +16,8 @@
 
 #include "board.h"
 #include "drivers/drivers.h"
+#include "firmware/board_fn.h"
+#include "firmware/i2c_addr.h"
 #include "firmware/sys.h"
 #include "serialgate/sg_exec.h"
 #include "serialgate/sg_parse.h"
@@ -32,6 +34,13 @@ static const char gpio_ports[] = {
 	BOARD_GPIO_PORTS(MAP_PORT)
 #undef MAP_PORT
 	'\0'
+};
+
+/* The pin functions' names, by board_fn_t. */
+static const char *const pin_functions[] = {
+#define MAP_FN(name) [BF_##name] = #name,
+	BOARD_FN_LIST(MAP_FN)
+#undef MAP_FN
 };
 
 static unsigned next_start;
@@ -119,6 +128,7 @@ int main(void)
 	       BOARD_UART, gpio_ports, BOARD_ADC_PORT);
 	printf("  \"servo_channels\": %d,\n", BOARD_SERVO_CHANNELS);
 	printf("  \"local_address\": %d,\n", SG_LOCAL_DEFAULT);
+	printf("  \"bus_address\": {\"min\": %d, \"max\": %d},\n", I2C_ADDR_MIN, I2C_ADDR_MAX);
 	printf("  \"limits\": {\"request_chars\": %d, \"reply_chars\": %d, "
 	       "\"servo_min_us\": %d, \"servo_max_us\": %d, \"servo_triples\": %d, "
 	       "\"spi_channels\": %d, \"spi_bytes\": %d, \"read_bytes\": %d, "
@@ -126,10 +136,16 @@ int main(void)
 	       SG_LINE_MAX, SG_REPLY_MAX, SERVO_MIN_US, SERVO_MAX_US, SERVO_MAX_TRIPLES,
 	       SPI_CHANNELS, SPI_BUF, REGMAP_READ_MAX, SYS_FAILSAFE_MAX_MS);
 
+	printf("  \"pin_functions\": [");
+	for (size_t i = 0; i < sizeof pin_functions / sizeof pin_functions[0]; i++) {
+		printf("%s\"%s\"", i ? ", " : "", pin_functions[i]);
+	}
+	printf("],\n");
+	/* BF_##fn: a function the list does not have does not compile. */
 	printf("  \"pins\": [");
 #define MAP_PIN(port, bit, fn, index) \
 	printf("%s\n    {\"port\": \"%c\", \"bit\": %d, \"function\": \"%s\", \"index\": %d}", \
-	       first ? "" : ",", port, bit, #fn, index); \
+	       first ? "" : ",", port, bit, pin_functions[BF_##fn], index); \
 	first = 0;
 	BOARD_PINS(MAP_PIN)
 #undef MAP_PIN

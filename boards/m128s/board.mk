@@ -1,6 +1,4 @@
-# OR-AVR-M128-S: ATmega128 at 7.3728 MHz.
-BOARD_MCU := atmega128
-BOARD_F_CPU := 7372800UL
+# OR-AVR-M128-S (its MCU and clock: board.h, read by the Makefile).
 # Drivers after introspection, in register order (docs/board-m128s.md).
 BOARD_DRIVERS := gpio spi adc servo
 # Servo pulse hardware: CD4017 counters clocked by timer compare outputs.

@@ -1,6 +1,4 @@
-# OR-AVR-M32-D: ATmega32 at 7.3728 MHz.
-BOARD_MCU := atmega32
-BOARD_F_CPU := 7372800UL
+# OR-AVR-M32-D (its MCU and clock: board.h, read by the Makefile).
 # Drivers after introspection, in register order (docs/board-m32d.md).
 BOARD_DRIVERS := gpio spi adc motor servo
 # Servo pulse hardware: one MCU pin per channel, edges as planned.

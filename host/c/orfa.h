@@ -1,6 +1,7 @@
 /*
  * ORFA host C library: the calls of the manual's chapter 5 on a serial port
- * to an ORFA gateway (POSIX termios, no other dependency). docs/c-library.md
+ * to an ORFA gateway (POSIX termios, and Linux's termios2 for the rates up to
+ * 4000000 that termios has no name for: orfa_speed.h). docs/c-library.md
  * has the whole story; in short:
  *
  *     orfa_t *o;

@@ -155,6 +155,37 @@ def _codes(key: str) -> Dict[int, Code]:
     return {c["code"]: Code(**c) for c in _read(BOARDS[0])[key]}
 
 
+def _shared(key: str):
+    """A fact every board's map holds alike: its value (a ValueError names
+    the boards if they differ)."""
+    values = {board: _read(board)[key] for board in BOARDS}
+    if any(v != values[BOARDS[0]] for v in values.values()):
+        raise ValueError("the board maps differ in %r: %s" % (key, values))
+    return values[BOARDS[0]]
+
+
+#: The clock of every board in Hz (board.h's BOARD_CLOCK_HZ): one for all,
+#: as the simulator steps its boards by one cycle count.
+F_CPU: int = _shared("f_cpu")
+
+#: The bus addresses a slave board or a part may be given, 8-bit form
+#: (firmware/i2c_addr.h): even, ADDRESS_MIN..ADDRESS_MAX, which leaves out
+#: the addresses I2C reserves.
+ADDRESS_MIN: int = _shared("bus_address")["min"]
+ADDRESS_MAX: int = _shared("bus_address")["max"]
+#: The rule in words, for messages and help: "even, 0x10..0xEE".
+ADDRESS_TEXT = "even, 0x%02X..0x%02X" % (ADDRESS_MIN, ADDRESS_MAX)
+
+
+def address_ok(addr8: int) -> bool:
+    """Whether addr8 is a bus address a slave board or a part may have."""
+    return addr8 % 2 == 0 and ADDRESS_MIN <= addr8 <= ADDRESS_MAX
+
+
+#: The functions a board may give a pin (firmware/board_fn.h), the names
+#: of Pin.function.
+PIN_FUNCTIONS: Tuple[str, ...] = tuple(_shared("pin_functions"))
+
 #: The status register's values: code -> Code(code, name, text).
 STATUS: Dict[int, Code] = _codes("status")
 #: The protocol's error codes: code -> Code(code, name, text).

@@ -228,7 +228,10 @@ def register_error(status: int, addr: int, register: str, action: str,
 # --- the simulator, files, the tools ----------------------------------------------
 
 class SimError(OrfaError, RuntimeError):
-    """The simulator could not be started or died (orfa.sim)."""
+    """The simulator could not be started or died (orfa.sim). `.refused`:
+    the simulator's own one-line reason when it refused its arguments (exit
+    status 2: a part's address or options), else None."""
+    refused = None
 
 
 class SimControlError(OrfaError, RuntimeError):

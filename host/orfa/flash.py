@@ -93,9 +93,9 @@ def slave_elf(board: str, addr: int) -> Path:
     (what `make flash MODE=slave` writes) when it was built for that
     address, else the test robot's robot/<board>-0x<ADDR>/ (`make robot`);
     a FlashError says how to build one."""
-    if addr & 1 or not 0x10 <= addr <= 0xEE:
-        raise FlashError("--addr 0x%02X: a slave's 8-bit bus address is even, 0x10..0xEE"
-                         % addr)
+    if not boardmap.address_ok(addr):
+        raise FlashError("--addr 0x%02X: a slave's 8-bit bus address is %s"
+                         % (addr, boardmap.ADDRESS_TEXT))
     for d in firmware_dirs():
         packaged = d / ("%s-slave" % board) / "orfa.elf"
         if packaged.is_file() and built_address(packaged) == addr:

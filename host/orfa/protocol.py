@@ -11,6 +11,7 @@ import re
 from dataclasses import dataclass
 from typing import Iterable, List, Optional, Sequence, Union
 
+from .boardmap import F_CPU  # noqa: F401 (the boards' clock, from board.h through the map)
 # The protocol's errors live in orfa.errors with the rest of the tree; they
 # are this module's names too (orfa.protocol.OrfaError, p.HexError).
 from .errors import (  # noqa: F401
@@ -32,7 +33,6 @@ REQUEST_TERMINATOR = "\n"
 REPLY_TERMINATOR = "\r\n"
 
 DEFAULT_LOCAL_ADDRESS = 0xAA
-F_CPU = 7372800
 #: The clock asked for at reset (100 kHz; the TWI makes 99.632 kHz).
 DEFAULT_CLOCK_KHZ = 0x64
 

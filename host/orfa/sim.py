@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
-from . import locate
+from . import boardmap, locate
 from .errors import SimError
 from .gateway import Gateway
 from .protocol import AUTOBAUD_PREAMBLE, DEFAULT_BAUD, F_CPU, autobaud_wait_s
@@ -77,9 +77,9 @@ def slave_spec(spec) -> Tuple[str, int, Union[str, Path, None]]:
     board, addr = spec[0], spec[1]
     if board not in BOARDS:
         raise ValueError("slave board %r: one of %s" % (board, ", ".join(BOARDS)))
-    if addr & 1 or not 0x10 <= addr <= 0xEE:
-        raise ValueError("slave address %s: an 8-bit address, even, 0x10..0xEE"
-                         % ("0x%02X" % addr if addr >= 0 else addr))
+    if not boardmap.address_ok(addr):
+        raise ValueError("slave address %s: an 8-bit address, %s"
+                         % ("0x%02X" % addr if addr >= 0 else addr, boardmap.ADDRESS_TEXT))
     return (board, addr, spec[2] if len(spec) == 3 else None)
 
 
@@ -88,6 +88,41 @@ def slave_option(spec: SlaveSpec) -> str:
     board, addr, elf = slave_spec(spec)
     path = Path(elf) if elf else slave_firmware_path(board, addr)
     return "%s:0x%02X:%s" % (board, addr, path)
+
+
+#: A part on the I2C bus: (kind, 8-bit address) or (kind, address, options).
+PartSpec = Union[Tuple[str, int], Tuple[str, int, str]]
+
+
+def part_option(spec: PartSpec) -> str:
+    """("bmp280", 0xEC) -> "bmp280@0xEC"; ("24lc32", 0xA8, "wp") -> "24lc32@0xA8:wp"."""
+    if isinstance(spec, str) or not 2 <= len(spec) <= 3:
+        raise ValueError("a part is (KIND, ADDR) or (KIND, ADDR, OPTIONS), not %r" % (spec,))
+    kind, addr = spec[0], spec[1]
+    opts = spec[2] if len(spec) == 3 else ""
+    if not isinstance(addr, int) or not 0 <= addr <= 0xFF:
+        raise ValueError("part %r: ADDR must be an 8-bit bus address (0xEC)" % (spec,))
+    return "%s@0x%02X%s" % (kind, addr, ":" + opts if opts else "")
+
+
+_part_kinds: Dict[str, Tuple[str, ...]] = {}
+
+
+def part_kinds() -> Tuple[str, ...]:
+    """The kinds of I2C parts the simulator makes (`orfa-sim --help` lists
+    them); () when there is no simulator to ask."""
+    path = str(sim_path())
+    if path not in _part_kinds:
+        try:
+            text = subprocess.run([path, "--help"], stdout=subprocess.DEVNULL,
+                                  stderr=subprocess.PIPE, timeout=10,
+                                  universal_newlines=True).stderr
+        except (OSError, subprocess.SubprocessError):
+            return ()
+        section = text.partition("Parts on the I2C bus")[2].partition("Parts on a board")[0]
+        _part_kinds[path] = tuple(line.split()[0].split("[")[0]
+                                  for line in section.splitlines()[1:] if line.strip())
+    return _part_kinds[path]
 
 
 def _die_with(parent: int):
@@ -116,7 +151,9 @@ class SimBoard:
     `.vcd_path`; spi=["eeprom25@B4", "mcp3008@B3:mode=0"], adc={0: 1000},
     avcc/aref (mV) set the board's SPI devices and analog inputs; srf08=[0xE0]
     puts SRF08 range finders on the I2C bus (their `srf08` control request
-    sets what they sense).
+    sets what they sense). parts=[("bmp280", 0xEC), ("24lc32", 0xA8, "wp")]
+    puts parts of any kind on the I2C bus (`--part KIND@0xADDR[:OPTIONS]`;
+    `orfa-sim --help` lists the kinds); control.sense() sets what they sense.
 
     slaves=[("m128s", 0x10), ("m32d", 0x12, elf_path), ...] puts further
     boards, each running its own firmware (without an ELF, or None: the
@@ -131,12 +168,13 @@ class SimBoard:
                  control: bool = False, vcd: bool = False, spi: Sequence[str] = (),
                  adc: Optional[Dict[int, int]] = None, avcc: Optional[int] = None,
                  aref: Optional[int] = None, srf08: Sequence[int] = (),
-                 slaves: Sequence[SlaveSpec] = ()):
+                 slaves: Sequence[SlaveSpec] = (), parts: Sequence[PartSpec] = ()):
         if board not in BOARDS:
             raise ValueError("board must be one of %s" % (BOARDS,))
         self.board = board
         self.eeproms = tuple(eeproms)
         self.srf08 = tuple(srf08)
+        self.part_options = [part_option(spec) for spec in parts]
         self.firmware = Path(firmware) if firmware else firmware_path(board)
         self.start_timeout = start_timeout
         self.extra_args = tuple(extra_args)
@@ -163,6 +201,7 @@ class SimBoard:
     def command(self) -> List[str]:
         options = ([("--eeprom", "0x%02X" % addr) for addr in self.eeproms]
                    + [("--srf08", "0x%02X" % addr) for addr in self.srf08]
+                   + [("--part", opt) for opt in self.part_options]
                    + [("--trace", self.trace_path), ("--control", self.control_path),
                       ("--vcd", self.vcd_path)]
                    + [("--spi", spec) for spec in self.spi]
@@ -201,7 +240,7 @@ class SimBoard:
         while not os.path.exists(self.port):
             if self.proc.poll() is not None:
                 msg = "orfa-sim exited with %d before its link appeared" % self.proc.returncode
-                self._fail(msg)
+                self._fail(msg, refused=self.proc.returncode == 2)
             if time.monotonic() > deadline:
                 self._fail("orfa-sim made no link within %.0f s" % self.start_timeout)
             time.sleep(0.01)
@@ -219,11 +258,14 @@ class SimBoard:
         except OSError:
             return ""
 
-    def _fail(self, msg: str) -> None:
+    def _fail(self, msg: str, refused: bool = False) -> None:
         cmd = " ".join(self.command())
         stderr = self._read("stderr")
         self.stop()
-        raise SimError("%s\n  command: %s\n  stderr: %s" % (msg, cmd, stderr.strip() or "(empty)"))
+        err = SimError("%s\n  command: %s\n  stderr: %s" % (msg, cmd, stderr.strip() or "(empty)"))
+        if refused and stderr.strip() and "\n" not in stderr.strip():
+            err.refused = stderr.strip()
+        raise err
 
     def stop(self, keep_dir: bool = False) -> Optional[int]:
         """SIGTERM the simulator, wait for it; returns its exit status."""

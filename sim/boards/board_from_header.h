@@ -15,13 +15,14 @@
 #define BOARD_SERVO_PER_COUNTER 0
 #endif
 
-#define SIM_PIN_ENTRY(port, bit, fn, index) { port, bit, SIM_PIN_##fn, index },
+#define SIM_PIN_ENTRY(port, bit, fn, index) { port, bit, BF_##fn, index },
 static const sim_pin_t sim_board_pins[] = { BOARD_PINS(SIM_PIN_ENTRY) };
 
 const sim_board_desc_t SIM_BOARD = {
 	.name = BOARD_ID,
 	.title = BOARD_NAME,
 	.mcu = BOARD_MCU_NAME,
+	.hz = BOARD_CLOCK_HZ,
 	.wiring = {
 		.pins = sim_board_pins,
 		.npins = sizeof(sim_board_pins) / sizeof(sim_board_pins[0]),

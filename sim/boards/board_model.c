@@ -463,7 +463,7 @@ int board_model_init(board_model_t *bm, avr_t *avr, const sim_board_desc_t *boar
 	board_model_set_aref(bm, 5000);
 
 	for (int k = 0; k < 2; k++) {
-		const sim_pin_t *bp = sim_wiring_pin(w, k ? SIM_PIN_SPI_MOSI : SIM_PIN_SPI_SCK, 0);
+		const sim_pin_t *bp = sim_wiring_pin(w, k ? BF_SPI_MOSI : BF_SPI_SCK, 0);
 
 		bm->spi_port[k] = bp ? board_model_port(bm, bp->port) : NULL;
 		bm->spi_bit[k] = bp ? bp->bit : 0;
@@ -488,8 +488,8 @@ static void bm_twi_lines(void *param, uint64_t cycle)
 
 int board_model_wire_twi(board_model_t *bm, twi_bus_t *bus)
 {
-	const sim_pin_t *scl = sim_wiring_pin(bm->wiring, SIM_PIN_TWI_SCL, 0);
-	const sim_pin_t *sda = sim_wiring_pin(bm->wiring, SIM_PIN_TWI_SDA, 0);
+	const sim_pin_t *scl = sim_wiring_pin(bm->wiring, BF_TWI_SCL, 0);
+	const sim_pin_t *sda = sim_wiring_pin(bm->wiring, BF_TWI_SDA, 0);
 	bm_port_t *p = scl && sda ? board_model_port(bm, scl->port) : NULL;
 
 	if (!p || sda->port != scl->port || twi_bus_listen(bus, bm_twi_lines, bm) < 0) {

@@ -17,11 +17,11 @@ static void bm_servo_mirror(void *param, signal_t *s, uint64_t cycle, int level)
 static int bm_counters(board_model_t *bm)
 {
 	const sim_wiring_t *w = bm->wiring;
-	const sim_pin_t *rst = sim_wiring_pin(w, SIM_PIN_SERVO_RST, 0);
+	const sim_pin_t *rst = sim_wiring_pin(w, BF_SERVO_RST, 0);
 	char name[16];
 
 	for (int c = 0; c < w->servo_counters && c < 4; c++) {
-		const sim_pin_t *clk = sim_wiring_pin(w, SIM_PIN_SERVO_CLK, c);
+		const sim_pin_t *clk = sim_wiring_pin(w, BF_SERVO_CLK, c);
 		bm_port_t *cp = clk ? board_model_port(bm, clk->port) : NULL;
 
 		snprintf(name, sizeof(name), "cnt%d", c);
@@ -59,7 +59,7 @@ static int bm_servo_pins(board_model_t *bm)
 	char name[16];
 
 	for (int n = 0; n < 32; n++) {
-		const sim_pin_t *p = sim_wiring_pin(w, SIM_PIN_SERVO, n);
+		const sim_pin_t *p = sim_wiring_pin(w, BF_SERVO, n);
 		bm_port_t *port = p ? board_model_port(bm, p->port) : NULL;
 
 		if (!port) {

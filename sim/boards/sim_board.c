@@ -90,7 +90,7 @@ int sim_board_init(sim_board_t *b, const sim_board_desc_t *board, const char *el
 		return 2;
 	}
 	avr_load_firmware(b->avr, &fw);
-	b->avr->frequency = SIM_FREQUENCY;	/* our ELFs carry no .mmcu */
+	b->avr->frequency = board->hz;	/* our ELFs carry no .mmcu */
 	b->avr->sleep = sim_board_sleep;
 
 	usart_init(&b->usart, b->avr, &b->mcu->usart[board->wiring.host_usart],
@@ -102,8 +102,8 @@ int sim_board_init(sim_board_t *b, const sim_board_desc_t *board, const char *el
 	}
 	/* SCL/SDA as pins: the firmware's port drivers and the line levels */
 	{
-		const sim_pin_t *scl = sim_wiring_pin(&board->wiring, SIM_PIN_TWI_SCL, 0);
-		const sim_pin_t *sda = sim_wiring_pin(&board->wiring, SIM_PIN_TWI_SDA, 0);
+		const sim_pin_t *scl = sim_wiring_pin(&board->wiring, BF_TWI_SCL, 0);
+		const sim_pin_t *sda = sim_wiring_pin(&board->wiring, BF_TWI_SDA, 0);
 
 		if (!scl || !sda || sim_twi_wire_pins(&b->twi, scl->port, scl->bit, sda->bit) < 0 ||
 		    board_model_wire_twi(&b->bm, bus) < 0) {
@@ -112,7 +112,7 @@ int sim_board_init(sim_board_t *b, const sim_board_desc_t *board, const char *el
 		}
 	}
 	if (!addr) {
-		const sim_pin_t *rxd = sim_wiring_pin(&board->wiring, SIM_PIN_UART_RX, 0);
+		const sim_pin_t *rxd = sim_wiring_pin(&board->wiring, BF_UART_RX, 0);
 
 		b->rxd_port = rxd ? board_model_port(&b->bm, rxd->port) : NULL;
 		if (b->rxd_port) {

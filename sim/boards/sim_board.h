@@ -22,7 +22,8 @@
 #include "periph/usart.h"
 #include "simavr16/watchdog.h"
 
-#define SIM_FREQUENCY 7372800u
+/* The world's clock in Hz: every board's BOARD_CLOCK_HZ (sim_boards.h). */
+#define SIM_FREQUENCY (sim_boards_hz())
 
 typedef struct sim_board_t {
 	const sim_board_desc_t *board;

@@ -15,6 +15,7 @@ typedef struct sim_board_desc_t {
 	const char *name;	/* --board value: BOARD_ID, "m32d" */
 	const char *title;	/* BOARD_NAME, "OR-AVR-M32-D" */
 	const char *mcu;	/* BOARD_MCU_NAME, simavr's MCU name */
+	uint32_t hz;		/* BOARD_CLOCK_HZ */
 	sim_wiring_t wiring;
 } sim_board_desc_t;
 
@@ -23,6 +24,11 @@ extern const sim_board_desc_t sim_board_m128s;
 
 /* The board called NAME, or NULL. */
 const sim_board_desc_t *sim_board_find(const char *name);
+
+/* The clock of the simulated world: the boards' BOARD_CLOCK_HZ, which must
+ * agree, since the world steps every board by one cycle count (world.h); a
+ * board that differs stops the simulator here with a message (exit 2). */
+uint32_t sim_boards_hz(void);
 
 /* "m32d|m128s", for usage messages. */
 const char *sim_board_names(void);

@@ -7,17 +7,12 @@
 
 #include <stdint.h>
 
-/* The function names of board.h's BOARD_PINS(X), prefixed. */
-typedef enum sim_pin_fn_t {
-	SIM_PIN_UART_RX, SIM_PIN_UART_TX, SIM_PIN_TWI_SCL, SIM_PIN_TWI_SDA,
-	SIM_PIN_SPI_SS, SIM_PIN_SPI_MOSI, SIM_PIN_SPI_MISO, SIM_PIN_SPI_SCK,
-	SIM_PIN_MOTOR_PWM, SIM_PIN_MOTOR_DIR, SIM_PIN_SERVO, SIM_PIN_SERVO_CLK, SIM_PIN_SERVO_RST,
-} sim_pin_fn_t;
+#include "firmware/board_fn.h"		/* board.h's pin functions, BF_* */
 
 typedef struct sim_pin_t {
 	char port;			/* 'A'.. */
 	uint8_t bit;
-	sim_pin_fn_t fn;
+	board_fn_t fn;
 	uint8_t index;
 } sim_pin_t;
 
@@ -31,6 +26,6 @@ typedef struct sim_wiring_t {
 } sim_wiring_t;
 
 /* The pin with function FN and INDEX, or NULL. */
-const sim_pin_t *sim_wiring_pin(const sim_wiring_t *w, sim_pin_fn_t fn, int index);
+const sim_pin_t *sim_wiring_pin(const sim_wiring_t *w, board_fn_t fn, int index);
 
 #endif

@@ -23,6 +23,7 @@
 #include "sim_avr.h"
 
 #include "boards/sim_boards.h"
+#include "firmware/i2c_addr.h"
 #include "harness/control.h"
 #include "periph/pty.h"
 #include "boards/sim_board.h"
@@ -88,7 +89,7 @@ static void sim_usage(void)
 		"\n"
 		"GATEWAY.elf runs on the --board board, whose serial port is the pty at\n"
 		"--link. Each --slave adds a board (%s) running ELF on the same\n"
-		"I2C bus; ADDR is its 8-bit address (0x10..0xEE, even): it names the\n"
+		"I2C bus; ADDR is its 8-bit address (0x%02X..0x%02X, even): it names the\n"
 		"board's signals in the control interface (`10/servo3`, `@10`) and is\n"
 		"checked against the firmware's TWAR (the firmware decides). The\n"
 		"--adc/--avcc/--aref options set up the gateway board, --spi too\n"
@@ -98,7 +99,7 @@ static void sim_usage(void)
 		"--part eeprom24@ADDR[:wp], --srf08 ADDR for --part srf08@ADDR.\n"
 		"See docs/simulator.md.\n"
 		"\nParts on the I2C bus (--part KIND@ADDR[:OPTIONS]):\n",
-		sim_board_names(), sim_board_names());
+		sim_board_names(), sim_board_names(), I2C_ADDR_MIN, I2C_ADDR_MAX);
 	sim_usage_kinds(PART_I2C);
 	fprintf(stderr, "Parts on a board's SPI bus (--spi KIND@PIN[:mode=N][:lsb]):\n");
 	sim_usage_kinds(PART_SPI);
@@ -218,13 +219,6 @@ typedef struct sim_args_t {
 	int slave_count;
 } sim_args_t;
 
-/* The I2C addresses a slave may not take (8-bit 0x00-0x0F, 0xF0-0xFF;
- * docs/registers.md, "On a slave board"). */
-static int sim_addr_reserved(uint8_t addr8)
-{
-	return addr8 < 0x10 || addr8 >= 0xf0;
-}
-
 /* --part KIND@ADDR[:OPTIONS], or its shorthands --eeprom ADDR[:wp] (KIND
  * eeprom24) and --srf08 ADDR (KIND srf08). 0, or -1 after printing why. */
 static int sim_parse_part(sim_args_t *args, const char *opt, const char *spec)
@@ -304,10 +298,10 @@ static int sim_parse_slave(sim_args_t *args, const char *spec)
 			board, sim_board_names());
 		return -1;
 	}
-	if (sim_parse_addr(addr, &args->slave_addr[n]) < 0 ||
-	    sim_addr_reserved(args->slave_addr[n])) {
+	/* a slave's address: firmware/i2c_addr.h (docs/registers.md, "On a slave board") */
+	if (sim_parse_addr(addr, &args->slave_addr[n]) < 0 || !I2C_ADDR_OK(args->slave_addr[n])) {
 		fprintf(stderr, "orfa-sim: bad --slave '%s': ADDR must be an even 8-bit address"
-			" 0x10..0xEE like 0x10\n", spec);
+			" 0x%02X..0x%02X like 0x10\n", spec, I2C_ADDR_MIN, I2C_ADDR_MAX);
 		return -1;
 	}
 	for (int i = 0; i < n; i++) {

@@ -10,6 +10,8 @@
 
 extern const part_kind_t eeprom24_kind, srf08_kind, eeprom25_kind, mcp3008_kind;
 extern const part_kind_t mpu6050_kind, hmc5883l_kind, lis3mdl_kind;
+extern const part_kind_t bmp280_kind;
+extern const part_kind_t ee24lc32_kind;
 
 const part_kind_t *const part_kinds[] = {
 	&eeprom24_kind,
@@ -17,6 +19,8 @@ const part_kind_t *const part_kinds[] = {
 	&mpu6050_kind,
 	&hmc5883l_kind,
 	&lis3mdl_kind,
+	&bmp280_kind,
+	&ee24lc32_kind,
 	&eeprom25_kind,
 	&mcp3008_kind,
 	NULL,

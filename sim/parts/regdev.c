@@ -33,7 +33,11 @@ static int regdev_write(twi_dev_t *dev, uint8_t byte)
 		return 1;
 	}
 	d->ops->write(d, d->ptr, byte);
-	d->ptr = regdev_next(d, d->ptr);
+	if (d->ops->pairs) {
+		d->want_ptr = 1;	/* the next byte is a register address again */
+	} else {
+		d->ptr = regdev_next(d, d->ptr);
+	}
 	return 1;
 }
 

@@ -2,7 +2,8 @@
  * regdev.h: the I2C side of a register-addressed sensor part. The first
  * byte of a write transfer sets the register pointer; each further byte
  * written or read goes to the part's register callbacks and moves the
- * pointer on by the part's rule; the pointer stays across STOP and repeated
+ * pointer on by the part's rule (or, with `pairs`, a write alternates
+ * register and value and does not move on); the pointer stays across STOP and repeated
  * START. When the part is addressed (a transfer begins) it is told to catch
  * up with its measurements, so the registers change only between transfers.
  */
@@ -24,6 +25,7 @@ typedef struct regdev_ops_t {
 	/* The pointer after an access to REG (NULL: REG + 1, 8 bits). */
 	uint8_t (*next)(uint8_t reg);
 	uint8_t ptr_mask;		/* bits of the written pointer kept */
+	uint8_t pairs;			/* writes are register/value pairs (the BMP280) */
 } regdev_ops_t;
 
 struct regdev_t {

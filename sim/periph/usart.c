@@ -736,7 +736,7 @@ void usart_init(usart_t *u, avr_t *avr, const sim_mcu_usart_t *regs,
 
 void usart_set_host_baud(usart_t *u, uint32_t baud)
 {
-	uint32_t f = u->avr->frequency ? u->avr->frequency : 7372800u;
+	uint32_t f = u->avr->frequency;	/* board.h's clock, set before usart_init */
 
 	if (baud == 0 || baud == u->host_baud) {
 		return;

@@ -1,6 +1,7 @@
 """The build's own checks: a slave's bus address (docs/registers.md, "On a
 slave board"), the mode."""
 
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -68,3 +69,59 @@ def test_host_knows_the_rates_the_build_knows():
                        cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert tuple(int(x) for x in r.stdout.split()) == BAUD_RATES
     assert DEFAULT_BAUD in BAUD_RATES
+
+
+@pytest.mark.parametrize("board", ["m32d", "m128s"])
+def test_mcu_and_clock_come_from_board_h(board, tmp_path):
+    """board.h holds the MCU and the clock (the simulator and tools/mapgen.c
+    read it too); the build compiles with what the map says, and board.mk
+    does not say them again (its value would be overridden unseen)."""
+    from orfa import boardmap
+    m = boardmap.load(board)
+    r = make("BOARD=" + board, "MODE=gate", tmp_path=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "-mmcu=%s -DF_CPU=%dUL " % (m.mcu, m.f_cpu) in r.stdout
+    board_mk = (ROOT / "boards" / board / "board.mk").read_text()
+    assert "BOARD_MCU" not in board_mk and "F_CPU" not in board_mk
+
+
+def copy_build_files(tmp_path):
+    """What make reads before it compiles, into tmp_path, for a header to break."""
+    for name in ("Makefile", "tools/board_facts.mk", "boards/m32d/board.mk",
+                 "boards/m32d/board.h", "firmware/i2c_addr.h"):
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(ROOT / name, tmp_path / name)
+
+
+@pytest.mark.parametrize("name, file", [
+    ("BOARD_MCU_NAME", "boards/m32d/board.h"), ("BOARD_CLOCK_HZ", "boards/m32d/board.h"),
+    ("I2C_ADDR_MIN", "firmware/i2c_addr.h"),
+])
+def test_a_header_without_its_fact_stops_the_build(name, file, tmp_path):
+    copy_build_files(tmp_path)
+    header = tmp_path / file
+    text = header.read_text()
+    assert "#define " + name in text
+    header.write_text(text.replace("#define " + name, "#define NOT_" + name))
+    r = subprocess.run(["make", "--no-print-directory", "-n", "MODE=slave", "ADDR=0x10"],
+                       cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert r.returncode != 0
+    assert "%s: no #define %s" % (file, name) in r.stderr, r.stderr
+    assert r.stderr.count("\n") == 1 and "avr-gcc" not in r.stdout
+
+
+def test_the_slave_address_rule_is_i2c_addr_h_s(tmp_path):
+    """make takes its limits from firmware/i2c_addr.h: moved there, they
+    move the build's check (and its message) too."""
+    copy_build_files(tmp_path)
+    header = tmp_path / "firmware" / "i2c_addr.h"
+    header.write_text(header.read_text().replace("I2C_ADDR_MIN 0x10", "I2C_ADDR_MIN 0x20"))
+
+    def run(addr):      # a target that needs no sources: the check is all
+        return subprocess.run(["make", "--no-print-directory", "-s", "MODE=slave",
+                               "ADDR=" + addr, "print-baud-rates"],
+                              cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    r = run("0x1E")
+    assert r.returncode != 0 and "ADDR=0x1E is reserved by I2C: use 0x20..0xEE" in r.stderr
+    r = run("0x20")
+    assert r.returncode == 0 and r.stderr == "", r.stderr

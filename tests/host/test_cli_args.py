@@ -235,6 +235,35 @@ def test_eeprom_addresses_are_checked_as_slave_addresses_are(argv, option, capsy
         assert "the gateway's own address" in err
 
 
+@pytest.mark.parametrize("argv", [
+    ["--sim", "m32d", "--part", "bmp280@0xED", "version"],
+    ["--sim", "m32d", "--part", "24lc32@0xAA", "version"],
+    ["--sim", "m32d", "--part", "bmp280@0x02", "version"],
+    ["--sim", "m32d", "--part", "bmp280@EC", "version"],
+    ["--sim", "m32d", "--part", "bmp280", "version"],
+    ["--sim", "m32d", "--part", "@0xEC", "version"],
+    ["sim", "--part", "bmp280@0xEF"] + NO_FIRMWARE,
+    ["sim", "--part", "24lc32@0xF0:wp"] + NO_FIRMWARE,
+])
+def test_part_addresses_are_checked_as_eeprom_addresses_are(argv, capsys):
+    status, out, err = run(argv, capsys)
+    one_usage_error(status, out, err, "--part")
+    assert "command:" not in err
+    if "0xAA" in " ".join(argv):
+        assert "the gateway's own address" in err
+
+
+def test_a_part_describes_a_simulated_board(capsys, monkeypatch):
+    monkeypatch.delenv("ORFA_PORT", raising=False)
+    assert run(["--port", "loop://", "--part", "bmp280@0xEC", "scan"], capsys) == (
+        2, "", "orfa: --part describes a simulated board: give --sim BOARD too\n")
+
+
+def test_a_part_where_another_device_is_is_one_line(capsys):
+    assert run(["--sim", "m32d", "--eeprom", "0xA8", "--part", "24lc32@0xA8", "version"],
+               capsys) == (2, "", "orfa: --part 0xA8: --eeprom put a device there already\n")
+
+
 def test_two_devices_at_one_address_is_one_line(capsys):
     assert run(["--sim", "m32d", "--eeprom", "0xA0", "--slave", "m128s:0xA0", "version"],
                capsys) == (2, "", "orfa: --slave 0xA0: --eeprom put a device there already\n")

@@ -69,3 +69,23 @@ def test_a_slave_that_is_no_slave_is_one_line(spec, message):
     with pytest.raises(ValueError) as exc:
         sim.SimRobot("m32d", slaves=[spec])
     assert str(exc.value).startswith(message) and "\n" not in str(exc.value)
+
+
+def test_parts_become_part_options():
+    board = sim.SimBoard("m32d", parts=[("bmp280", 0xEC), ("24lc32", 0xA8, "wp"),
+                                        ["24lc32", 0xA0, ""]])
+    cmd = board.command()
+    assert [cmd[i + 1] for i, arg in enumerate(cmd) if arg == "--part"] == [
+        "bmp280@0xEC", "24lc32@0xA8:wp", "24lc32@0xA0"]
+
+
+@pytest.mark.parametrize("spec, message", [
+    ("bmp280@0xEC", "a part is (KIND, ADDR) or (KIND, ADDR, OPTIONS), not 'bmp280@0xEC'"),
+    (("bmp280",), "a part is (KIND, ADDR) or (KIND, ADDR, OPTIONS), not ('bmp280',)"),
+    (("bmp280", "0xEC"), "part ('bmp280', '0xEC'): ADDR must be an 8-bit bus address"),
+    (("bmp280", 0x1EC), "part ('bmp280', 492): ADDR must be an 8-bit bus address"),
+])
+def test_a_part_that_is_no_part_is_one_line(spec, message):
+    with pytest.raises(ValueError) as exc:
+        sim.SimBoard("m32d", parts=[spec])
+    assert str(exc.value).startswith(message) and "\n" not in str(exc.value)

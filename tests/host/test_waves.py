@@ -11,7 +11,7 @@ from orfa import boardmap, plot, vcd, waves
 from orfa.cli import main
 from orfa.cli import plot as cli_plot
 
-F = 7372800
+F = boardmap.F_CPU
 PS = 1e12 / F
 
 

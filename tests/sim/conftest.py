@@ -25,6 +25,9 @@ EEPROM_WP = 0xA6         # write-protected 24C02: acknowledges its address and
                          # the word address, not the data bytes
 #: Wall-clock seconds a reply may take (the simulator runs faster than real time).
 REPLY_TIMEOUT = 5.0
+#: The table of sensor readings (test_sensor_drivers.py: the value set, the
+#: value a driver returned), printed at the end of the run.
+SENSOR_READINGS = pytest.StashKey[list]()
 
 
 def require_builds(boards=BOARDS):
@@ -176,6 +179,23 @@ class Bench:
         assert self.sim.running, self.sim.stderr
 
 
+class ControlBench(Bench):
+    """A Bench on a simulator with its control socket (control=True): request
+    lines put on the serial line at chosen cycles, the bus events traced."""
+
+    def __init__(self, sim: SimBoard):
+        super().__init__(sim)
+        self.ctl = sim.control
+
+    def rx(self, cycle: int, line: str) -> int:
+        """Put a request line on the serial line at `cycle`; its end cycle."""
+        return self.ctl.rx(cycle, line.encode("ascii") + b"\n")
+
+    def twi(self, since: int, kind: str):
+        """(cycle, fields) of the bus events of one kind ("addr", "write")."""
+        return [(e.cycle, e.fields) for e in self.events(since, ["twi " + kind])]
+
+
 @contextlib.contextmanager
 def running(sim: SimBoard, make_bench=Bench):
     """Start `sim`, give a bench on it (make_bench(sim)), and stop it after:
@@ -227,9 +247,9 @@ def board(bench):
 # off, SPI bus settings 02, GPIO lines inputs without pull-up, external drives
 # released), so no test sees another's state.
 
-F_CPU = 7372800
+F_CPU = boardmap.F_CPU
 #: One servo frame: 20 ms.
-SERVO_FRAME = 147456
+SERVO_FRAME = F_CPU * 20 // 1000
 
 def _layout(board: str) -> dict:
     """Registers and pins of a board with all its drivers, from its map
@@ -533,3 +553,12 @@ def pytest_collection_modifyitems(config, items):
             if item.nodeid.startswith(prefix) and param in item.nodeid:
                 item.add_marker(pytest.mark.xfail(reason=reason, strict=strict))
                 break
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    """The sensor drivers' readings of this run, with or without -s."""
+    rows = config.stash.get(SENSOR_READINGS, [])
+    if rows:
+        terminalreporter.section("sensor readings (build/sensor-readings.txt)")
+        for row in rows:
+            terminalreporter.write_line(row)

@@ -31,7 +31,7 @@ import random
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
-F_CPU = 7372800
+from orfa.boardmap import F_CPU  # the boards' clock (board.h, through the map)
 LINE_MAX = 128
 REPLY_MAX = 127
 HEXDIGITS = set("0123456789abcdefABCDEF")

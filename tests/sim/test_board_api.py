@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from conftest import (DRV_LAYOUT, REPLY_TIMEOUT, SERVO_FRAME, require_builds,
+from conftest import (DRV_LAYOUT, F_CPU, REPLY_TIMEOUT, SERVO_FRAME, require_builds,
                       require_slave, running, us_to_cycles)
 from orfa import (BadLengthError, BadValueError, Board, DataNackError, Gateway,
                   NoDriverError, NotWritableError, OrfaError, PinBusyError,
@@ -170,12 +170,12 @@ def test_adc_volts_from_the_simulated_input(t):
     adc = t.board.adc
     adc.configure([0, 1], "avcc", 10)
     assert adc.config() == ("avcc", 10, (0, 1))
-    t.ctl.wait(int(0.01 * 7372800))                 # valid within 10 ms
+    t.ctl.wait(int(0.01 * F_CPU))                 # valid within 10 ms
     volts = adc.volts()
     assert abs(volts[0] - ADC_MV / 1000) <= 2 * 5.0 / 1024, volts
     assert volts[2:] == [0.0] * 6                   # not enabled
     adc.configure([0], "internal", 8)
-    t.ctl.wait(int(0.01 * 7372800))
+    t.ctl.wait(int(0.01 * F_CPU))
     raw = adc.read()
     assert abs(raw[0] - ADC_MV / 2560 * 256) <= 2, raw
     assert abs(adc.volts()[0] - ADC_MV / 1000) <= 2 * 2.56 / 256
@@ -298,7 +298,7 @@ def test_reset_cause(t):
     b.clear_reset_cause()
     assert b.reset_cause() == frozenset()
     t.ctl.reset("external")
-    t.ctl.wait(int(0.05 * 7372800))                 # the slave starts again
+    t.ctl.wait(int(0.05 * F_CPU))                 # the slave starts again
     assert b.reset_cause() == {"external"}
     b.clear_reset_cause(["external"])
     assert b.reset_cause() == frozenset()

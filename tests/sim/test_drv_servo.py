@@ -8,7 +8,7 @@ must be within 1.1 us = 8 cycles of the commanded width, the period 20 ms
 
 import pytest
 
-from conftest import SERVO_FRAME, us_to_cycles
+from conftest import F_CPU, SERVO_FRAME, us_to_cycles
 
 WIDTH_TOL = 8                       # cycles: 1.1 us at 7.3728 MHz
 PERIOD_TOL = SERVO_FRAME // 1000    # 0.1 %: 147 cycles
@@ -251,7 +251,7 @@ def test_widths_under_uart_load(drv):
             if period is not None and rise + period <= t1 and abs(period - SERVO_FRAME) > PERIOD_TOL:
                 bad.append("%s at %d: period %d" % (sig, rise, period))
     print("\n%s: servo width error under UART load: max %.1f cycles = %.2f us "
-          "over %d frames" % (drv.board, worst, worst * 1e6 / 7372800,
+          "over %d frames" % (drv.board, worst, worst * 1e6 / F_CPU,
                               (t1 - t0) // SERVO_FRAME))
     assert bad == [], "%d pulses off (max error %.1f cycles): %s" % (
         len(bad), worst, "; ".join(bad[:12]))

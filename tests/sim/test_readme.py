@@ -47,11 +47,15 @@ def test_demo_session():
 
 
 def test_robot_session():
-    """`make demo-robot`: slaves M128-S at 0x10 and M32-D at 0x12, EEPROM at A0."""
+    """`make demo-robot`: slaves M128-S at 0x10 and M32-D at 0x12, EEPROM at A0,
+    the sensors (MPU-6050 D0, HMC5883L 3C, LIS3MDL 38, BMP280 EC, 24LC32 A8)."""
     require_builds(["m32d"])
     slaves = [("m128s", 0x10, require_slave("m128s", 0x10)),
               ("m32d", 0x12, require_slave("m32d", 0x12))]
-    with running(SimBoard("m32d", eeproms=(0xA0,), trace=True, slaves=slaves)) as gw:
+    parts = [("mpu6050", 0xD0), ("hmc5883l", 0x3C), ("lis3mdl", 0x38), ("bmp280", 0xEC),
+             ("24lc32", 0xA8)]
+    with running(SimBoard("m32d", eeproms=(0xA0,), trace=True, slaves=slaves,
+                          parts=parts)) as gw:
         replay(gw, sessions()["A simulated robot"])
 
 

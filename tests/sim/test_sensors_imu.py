@@ -35,10 +35,9 @@ import pytest
 from orfa.sim import SimBoard, sim_path
 from orfa.simctl import SimControlError
 
-from conftest import Bench, require_builds, running
+from conftest import F_CPU, Bench, require_builds, running
 
 MPU, MPU2, HMC, LIS = 0xD0, 0xD2, 0x3C, 0x38
-F_CPU = 7372800
 G = 9.80665                             # m/s^2 per g
 LEAD = F_CPU // 2                       # how far ahead requests are put on the line
 

@@ -12,7 +12,7 @@ import time
 import pytest
 import serial
 
-from conftest import REPLY_TIMEOUT, board_sent, require_builds
+from conftest import F_CPU, REPLY_TIMEOUT, board_sent, require_builds
 from orfa.sim import BOARDS, SimBoard
 from orfa.simctl import RX_MAX, SimControlError
 
@@ -115,7 +115,7 @@ def test_pty_bytes_queue_behind_scheduled_bytes():
         writer.start()
         try:
             ctl.wait_taken(before + 1, step=100)
-            end = ctl.rx_after(7372800, b"V\r")
+            end = ctl.rx_after(F_CPU, b"V\r")
         finally:
             writer.join()
         at = end - 2 * BYTE

@@ -15,14 +15,14 @@ import re
 
 import pytest
 
+from orfa.protocol import F_CPU
 from orfa.sim import BOARDS, SimBoard
 from orfa.simctl import SimControlError
 
-from conftest import Bench, require_builds, running
+from conftest import ControlBench, require_builds, running
 
 SRF = 0xE0
-F_CPU = 7372800
-MS65 = F_CPU * 65 // 1000            # 479232 cycles: a ranging at range 255
+MS65 = F_CPU * 65 // 1000            # a ranging at range 255
 RANGE24 = MS65 * 25 // 256           # 46800 cycles: at range 24 (0x18)
 REVISION = 0x0A                      # sim/parts/srf08.h (the document names none)
 #: How far ahead of "now" bytes are scheduled with `rx`: half a simulated
@@ -33,18 +33,7 @@ POLL = "S E0 00 S E1 01 P"
 POLL_OK = b"SWASR%02XP\r\n" % REVISION
 
 
-class SrfBench(Bench):
-    def __init__(self, sim):
-        super().__init__(sim)
-        self.ctl = sim.control
-
-    def rx(self, cycle: int, line: str) -> int:
-        """Put a request line on the serial line at `cycle`; its end cycle."""
-        return self.ctl.rx(cycle, line.encode("ascii") + b"\n")
-
-    def twi(self, since: int, kind: str):
-        """(cycle, fields) of the bus events of one kind ("addr", "write")."""
-        return [(e.cycle, e.fields) for e in self.events(since, ["twi " + kind])]
+SrfBench = ControlBench
 
 
 @pytest.fixture(scope="module", params=BOARDS)

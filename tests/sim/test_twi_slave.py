@@ -11,6 +11,7 @@ import subprocess
 
 import pytest
 
+from orfa import boardmap
 from orfa.gateway import Gateway
 from orfa.sim import BOARDS, REPO_ROOT, SimRobot, sim_path
 
@@ -159,6 +160,18 @@ def test_bad_slave_option(value, why):
                             capture_output=True, text=True, timeout=30)
     assert result.returncode == 2
     assert result.stderr.count("\n") == 1 and why in result.stderr, result.stderr
+
+
+@pytest.mark.parametrize("addr", [boardmap.ADDRESS_MIN + d for d in (-2, -1, 0, 1)]
+                         + [boardmap.ADDRESS_MAX + d for d in (-1, 0, 1, 2)])
+def test_slave_addresses_are_the_rule_of_i2c_addr_h(addr):
+    """--slave takes the addresses of firmware/i2c_addr.h, as the host does."""
+    require_builds(["m32d"])
+    result = subprocess.run([str(sim_path()), "--board", "m32d", "--link", "/nonexistent/tty",
+                             "--slave", "m32d:0x%02X:x.elf" % addr, "x.elf"],
+                            capture_output=True, text=True, timeout=30)
+    rule = "even 8-bit address 0x%02X..0x%02X" % (boardmap.ADDRESS_MIN, boardmap.ADDRESS_MAX)
+    assert (rule in result.stderr) == (not boardmap.address_ok(addr)), result.stderr
 
 
 def test_control_reaches_every_board(robot):

@@ -114,7 +114,7 @@ bool twi_clear_bus(void)
 
 uint16_t twi_set_khz(uint16_t khz)
 {
-	return twi_rate_for_khz(7372800UL, khz).khz;
+	return twi_rate_for_khz(F_CPU, khz).khz;
 }
 
 /* --- the test driver ---------------------------------------------------- */

@@ -163,12 +163,12 @@ static void test_rates(void)
 		{ 1, 230, 2, 0 }, { 0xFFFF, 0, 0, 460 },
 	};
 	for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
-		twi_rate_t r = twi_rate_for_khz(7372800UL, t[i].khz);
+		twi_rate_t r = twi_rate_for_khz(F_CPU, t[i].khz);
 		char d[120];
 		snprintf(d, sizeof d, "khz=%u twbr=%u twps=%u got=%u", t[i].khz, r.twbr, r.twps, r.khz);
 		check(r.twbr == t[i].twbr && r.twps == t[i].twps && r.khz == t[i].got, "rate", d);
 		/* never above the rate asked */
-		check(7372800UL / r.period <= t[i].khz * 1000UL || t[i].khz == 0, "rate<=asked", d);
+		check(F_CPU / r.period <= t[i].khz * 1000UL || t[i].khz == 0, "rate<=asked", d);
 	}
 	/* Every rate from 1 to 1000 kHz against a search of all TWBR/TWPS:
 	 * the shortest period whose rate is not above the one asked (a
@@ -179,7 +179,7 @@ static void test_rates(void)
 		for (uint32_t ps = 0; ps < 4 && !best; ps++) {
 			for (uint32_t twbr = 0; twbr < 256; twbr++) {
 				uint32_t period = 16 + 2 * twbr * (1u << (2 * ps));
-				if (7372800UL <= khz * 1000UL * period) {  /* rate <= asked */
+				if (F_CPU <= khz * 1000UL * period) {  /* rate <= asked */
 					best = period;
 					break;
 				}
@@ -188,8 +188,8 @@ static void test_rates(void)
 		if (!best) {
 			best = 16 + 2 * 255 * 64;
 		}
-		twi_rate_t r = twi_rate_for_khz(7372800UL, (uint16_t)khz);
-		if (r.period != best || r.khz != 7372800UL / (best * 1000UL)) {
+		twi_rate_t r = twi_rate_for_khz(F_CPU, (uint16_t)khz);
+		if (r.period != best || r.khz != F_CPU / (best * 1000UL)) {
 			char d[120];
 			snprintf(d, sizeof d, "khz=%u period=%lu want %lu", (unsigned)khz,
 				 (unsigned long)r.period, (unsigned long)best);

@@ -13,8 +13,8 @@
 
 #include "parts/srf08.h"
 
-#define HZ 7372800u
-#define MS65 479232u		/* 65 ms at HZ */
+#define HZ ((uint32_t)F_CPU)	/* the boards' clock (make passes board.h's) */
+#define MS65 ((uint32_t)((uint64_t)HZ * 65u / 1000u))	/* 65 ms at HZ */
 
 static int passed, failed;
 static twi_bus_t bus;

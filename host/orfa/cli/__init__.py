@@ -40,7 +40,7 @@ def _connection_options(parser, suppress: bool) -> None:
                        help="serial port or pyserial URL (/dev/ttyUSB0, socket://host:port);"
                             " default $%s" % PORT_ENV)
     where.add_argument("--sim", choices=BOARDS, metavar="BOARD", default=default(None),
-                       help="start a simulated board (%s) for this one command; --eeprom,"
+                       help="start a simulated board (%s) for this one command; --eeprom, --part,"
                             " --slave, --adc, --spi (before the command) add devices"
                             % "|".join(BOARDS))
     group.add_argument("--baud", type=baud_rate, default=default(p.DEFAULT_BAUD),

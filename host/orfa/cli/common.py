@@ -10,10 +10,11 @@ import math
 import os
 from typing import Iterator, List, Optional
 
+from .. import boardmap
 from .. import protocol as p
 from ..errors import UsageError, explain  # noqa: F401 (the commands' errors, one line each)
 from ..gateway import Gateway, os_reason
-from ..sim import BOARDS, SimBoard, SimError
+from ..sim import BOARDS, SimBoard, SimError, part_kinds
 
 #: The environment variable that gives --port its default.
 PORT_ENV = "ORFA_PORT"
@@ -155,11 +156,30 @@ def eeprom_spec(text: str) -> int:
     return addr
 
 
+def part_spec(text: str):
+    """`KIND@ADDR[:OPTIONS]` of --part -> (kind, addr, options); ADDR checked
+    as --eeprom's, KIND against the simulator's kinds."""
+    kind, at, rest = text.partition("@")
+    addr_text, _, opts = rest.partition(":")
+    kinds = part_kinds()
+    if not at or not kind:
+        raise argparse.ArgumentTypeError("%r: KIND@ADDR[:OPTIONS] like bmp280@0xEC" % text)
+    if kinds and kind not in kinds:
+        raise argparse.ArgumentTypeError("%r: no part %r (the simulator's: %s)"
+                                         % (text, kind, ", ".join(kinds)))
+    try:
+        addr = int(addr_text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r: ADDR like 0xEC" % text) from None
+    _check_device_address(text, addr)
+    return (kind, addr, opts)
+
+
 def _check_device_address(text: str, addr: int) -> None:
     """A simulated device's 8-bit bus address: even, outside the addresses
     I2C reserves, and not the gateway's own (its requests never reach the bus)."""
-    if addr & 1 or not 0x10 <= addr <= 0xEE:
-        raise argparse.ArgumentTypeError("%r: ADDR must be even, 0x10..0xEE" % text)
+    if not boardmap.address_ok(addr):
+        raise argparse.ArgumentTypeError("%r: ADDR must be %s" % (text, boardmap.ADDRESS_TEXT))
     if addr == p.DEFAULT_LOCAL_ADDRESS:
         raise argparse.ArgumentTypeError("%r: 0x%02X is the gateway's own address (its"
                                          " requests never reach the bus)" % (text, addr))
@@ -183,13 +203,20 @@ def add_sim_devices(parser, suppress: bool = False) -> None:
     parser.add_argument("--eeprom", type=eeprom_spec, action="append", default=default or [],
                         metavar="ADDR",
                         help="a 24C02-like EEPROM at the 8-bit bus address ADDR (0xA0;"
-                             " even, 0x10..0xEE, not the gateway's 0xAA), repeatable")
+                             " %s, not the gateway's 0xAA), repeatable"
+                             % boardmap.ADDRESS_TEXT)
+    parser.add_argument("--part", type=part_spec, action="append", default=default or [],
+                        metavar="KIND@ADDR[:OPTIONS]",
+                        help="a part of KIND on the I2C bus at the 8-bit ADDR, checked as"
+                             " --eeprom's (bmp280@0xEC, 24lc32@0xA8:wp; `orfa-sim --help`"
+                             " lists the kinds), repeatable")
     parser.add_argument("--slave", type=slave_spec, action="append", default=default or [],
                         metavar="BOARD:ADDR[:ELF]",
-                        help="a slave board on the bus at the 8-bit ADDR (even, 0x10..0xEE,"
+                        help="a slave board on the bus at the 8-bit ADDR (%s,"
                              " not the gateway's 0xAA; repeatable); ELF"
                              " defaults to build/robot/<board>-<ADDR>/orfa.elf (make robot)"
-                             " if built, else build/<board>-slave/orfa.elf")
+                             " if built, else build/<board>-slave/orfa.elf"
+                             % boardmap.ADDRESS_TEXT)
     parser.add_argument("--adc", type=adc_spec, action="append", default=default or [],
                         metavar="CH=MV", help="analog input CH (0-7) at MV millivolts,"
                                               " repeatable")
@@ -203,14 +230,16 @@ def sim_board(board: str, args, **kw) -> SimBoard:
     """A SimBoard with the devices of args (not started); two devices at
     one address are a UsageError."""
     seen = {}
+    parts = getattr(args, "part", None) or ()
     for opt, addr in ([("--eeprom", a) for a in getattr(args, "eeprom", None) or ()]
+                      + [("--part", q[1]) for q in parts]
                       + [("--slave", s[1]) for s in getattr(args, "slave", None) or ()]):
         if addr in seen:
             raise UsageError("%s 0x%02X: %s put a device there already"
                              % (opt, addr, seen[addr]))
         seen[addr] = opt
     return SimBoard(board, eeproms=getattr(args, "eeprom", None) or (),
-                    slaves=getattr(args, "slave", None) or (),
+                    slaves=getattr(args, "slave", None) or (), parts=parts,
                     adc=dict(getattr(args, "adc", None) or ()),
                     spi=getattr(args, "spi", None) or (), **kw)
 
@@ -220,7 +249,8 @@ def connect(args) -> Iterator[Gateway]:
     """The Gateway of --port URL (or $ORFA_PORT), or of a board --sim starts
     for this one command (stopped when the command ends). An explicit --sim
     wins over $ORFA_PORT; --port and --sim both given is a usage error."""
-    devices = [opt for opt in ("eeprom", "slave", "adc", "spi") if getattr(args, opt, None)]
+    devices = [opt for opt in ("eeprom", "part", "slave", "adc", "spi")
+               if getattr(args, opt, None)]
     if args.sim is None and devices:
         raise UsageError("--%s describes a simulated board: give --sim BOARD too" % devices[0])
     if args.sim is not None:
@@ -229,7 +259,7 @@ def connect(args) -> Iterator[Gateway]:
         try:
             sim = sim_board(args.sim, args, trace=False, control=args.autobaud).start()
         except (SimError, ValueError) as exc:
-            raise UsageError(str(exc)) from None
+            raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
         try:
             # the preamble's quiet passes in simulated time, not on the wall clock
             with sim.gateway(args.baud, autobaud=args.autobaud, timeout=args.timeout) as gw:

@@ -51,7 +51,7 @@ def cmd_sim(args) -> int:
         board = sim_board(args.board, args, trace=False, firmware=args.firmware,
                           control=control, extra_args=extra).start()
     except (SimError, ValueError) as exc:
-        raise UsageError(str(exc)) from None
+        raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
     link = None
     signal.signal(signal.SIGTERM, _raise_interrupt)
     # for a program, the bare paths (`port=$(orfa sim | head -1)`); with
