@@ -11,6 +11,7 @@ missing sensor end it with one line."""
 
 import math
 import os
+import re
 import subprocess
 import sys
 
@@ -157,13 +158,18 @@ def test_robot_steers_by_its_sensors(sim, scene):
 
 def test_sim_option_runs_the_same_program():
     """--sim: the program starts its own simulated robot (upright, facing
-    60 degrees in 20 microtesla, a wall at 80 cm) and runs on it."""
+    60 degrees in 20 microtesla, a wall at 80 cm) and runs on it; it prints
+    what docs/sensors.md shows, the law's values."""
     require_builds(["m32d"])
-    status, out, err = robot("--sim", "--iterations", 2)
+    status, out, err = robot("--sim", "--iterations", 3)
     assert status == 0 and err == "", err
     heading, turn, cm, _ = readings(60, 20, 0, 800, (0, 0, G))
     assert out == ["%3d heading %5.1f turn %+6.1f deg/s range %3d cm upright -> steer -30.0 deg"
-                   " (1300 us) motors 92 172" % (n, heading, turn, cm) for n in (1, 2)]
+                   " (1300 us) motors 92 172" % (n, heading, turn, cm) for n in (1, 2, 3)]
+    docs = (ROOT / "docs" / "sensors.md").read_text()
+    shown = re.search(r"\n    \$ python3 examples/robot.py --sim --iterations 3\n((?:    .*\n)+)",
+                      docs)
+    assert shown and [line[4:] for line in shown.group(1).splitlines()] == out
 
 
 @pytest.mark.parametrize("parts, message", [
