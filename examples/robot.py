@@ -41,14 +41,13 @@ ranger never answering), 2 for wrong arguments, 130 after Ctrl-C.
 """
 
 import argparse
+import importlib.util
 import math
 import sys
 import time
 from pathlib import Path
 
-try:
-    import orfa  # noqa: F401
-except ImportError:                       # run from the repository, not installed
+if importlib.util.find_spec("orfa") is None:      # run from the repository, not installed
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "host"))
 
 from orfa import Board, Gateway, OrfaError, ServoRange  # noqa: E402
@@ -78,10 +77,10 @@ HMC5883L_ID = b"H43"
 COMPASS_WAIT_S = 0.5      # it measures every 13 ms
 HMC5883L_OVERFLOW = -4096
 
-#: The simulated robot of --sim (the sensors of `make demo-robot`) and what
-#: it senses: upright, facing 60 degrees in a 20 microtesla field, a wall
+#: The simulated robot of --sim (the IMU and the compass as `make demo-robot`
+#: has them, and the ranger) and what it senses: upright, facing 60 degrees in a 20 microtesla field, a wall
 #: 80 cm ahead.
-SIM_PARTS = ["mpu6050@0xD0", "hmc5883l@0x3C"]
+SIM_PARTS = [("mpu6050", IMU << 1), ("hmc5883l", COMPASS << 1), ("srf08", RANGER << 1)]
 SIM_FACING, SIM_FIELD_UT, SIM_OBSTACLE_MM = 60.0, 20.0, 800
 
 
@@ -210,7 +209,7 @@ def run(gw, target, iterations, out=sys.stdout):
             step += 1
             print("%3d heading %s turn %+6.1f deg/s range %3d cm %s -> steer %+5.1f deg"
                   " (%d us) motors %d %d"
-                  % (step, "  none" if heading is None else "%5.1f" % heading, turn, range_cm,
+                  % (step, " none" if heading is None else "%5.1f" % heading, turn, range_cm,
                      "upright" if upright(accel) else "TIPPED ", steer,
                      STEERING.width(steer), left, right), file=out, flush=True)
     except BaseException:                          # Ctrl-C, a fault: the robot stops
@@ -224,8 +223,7 @@ def run(gw, target, iterations, out=sys.stdout):
 def simulated_robot():
     """The robot of --sim, started, sensing its world (see SIM_*)."""
     from orfa.sim import SimBoard
-    sim = SimBoard("m32d", srf08=[RANGER << 1], control=True, trace=False,
-                   extra_args=[a for p in SIM_PARTS for a in ("--part", p)]).start()
+    sim = SimBoard("m32d", parts=SIM_PARTS, control=True, trace=False).start()
     c = sim.control
     c.sense(IMU << 1, "accel", 0, 0, G)
     rad = math.radians(SIM_FACING)
@@ -277,7 +275,7 @@ def main(argv=None):
         print("robot: %s" % e, file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print("robot: stopped (motors off)", file=sys.stderr)
+        print("robot: stopped (Ctrl-C)", file=sys.stderr)
         return 130
     finally:
         if sim is not None:

@@ -12,6 +12,7 @@ missing sensor end it with one line."""
 import math
 import os
 import re
+import signal
 import subprocess
 import sys
 
@@ -154,6 +155,29 @@ def test_robot_steers_by_its_sensors(sim, scene):
         board = Board(gw)
         assert board.servo.width(0) == width
         assert board.motor.duties() == [left, right]
+
+
+def test_ctrl_c_stops_the_motors(sim):
+    """Without --iterations it runs until Ctrl-C (SIGINT), which stops the
+    motors: exit status 130, one line, both duties 0 on the board."""
+    c = sim.control
+    c.sense(IMU, "accel", 0, 0, G)
+    c.sense(IMU, "gyro", 0, 0, 0)
+    c.sense(COMPASS, "field", 20, 0, 0)
+    c.sense(RANGER, "range", 3000)
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "host"))
+    proc = subprocess.Popen([sys.executable, str(EXAMPLE), "--port", sim.port],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        first = proc.stdout.readline()              # a step done: the motors run
+        assert first.endswith("(1500 us) motors 180 180\n"), first
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert (proc.returncode, err) == (130, "robot: stopped (Ctrl-C)\n")
+    with Gateway(sim.port) as gw:
+        assert Board(gw).motor.duties() == [0, 0]
 
 
 def test_sim_option_runs_the_same_program():
