@@ -36,7 +36,8 @@ sys.path.insert(0, str(ROOT / "host"))
 import serial  # noqa: E402
 
 from orfa import boardmap  # noqa: E402
-from orfa.sim import SimBoard, firmware_path, parse_trace, slave_firmware_path  # noqa: E402
+from orfa.sim import (SimBoard, firmware_path, parse_trace, sent_lines,  # noqa: E402
+                      slave_firmware_path)
 from orfa.simctl import RX_MAX, SimControlError  # noqa: E402
 
 F_CPU = boardmap.F_CPU
@@ -483,21 +484,6 @@ def wd_stream(ctl, start, line, until):
     return ctl.rx_stream(start, line, until, 20 * WD_MS)
 
 
-def wd_replies(events, since):
-    """[(cycle of the first byte, line)] the gateway sent from `since` on."""
-    out, cur, first = [], bytearray(), None
-    for e in events:
-        if e.kind != "uart tx" or e.cycle < since:
-            continue
-        if not cur:
-            first = e.cycle
-        cur.append(int(e.fields[0], 16))
-        if cur.endswith(b"\r\n"):
-            out.append((first, bytes(cur[:-2]).decode("ascii", "replace")))
-            cur = bytearray()
-    return out
-
-
 def bench_watchdog(board, slave):
     """{"reset": hang to the watchdog's reset, "answer": hang to the first
     correct reply (cycles), "servo"/"motor": failsafe trip latency, from
@@ -530,7 +516,7 @@ def bench_watchdog(board, slave):
         ctl.wait(end - ctl.time() + 20 * WD_MS)
         events = parse_trace(sim.trace_text())
         resets = [e.cycle for e in events if e.kind == "reset" and e.cycle >= t0]
-        good = [c for c, text in wd_replies(events, t0) if text == want]
+        good = [c for c, text in sent_lines(events, t0) if text == want]
         if not resets or not good:
             raise SystemExit("bench: %s%s did not come back from a hang" % (tag, board))
         rows["reset"], rows["answer"] = resets[0] - t0, good[0] - t0

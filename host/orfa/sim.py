@@ -67,6 +67,23 @@ def parse_trace(text: str) -> List[TraceEvent]:
 SlaveSpec = Union[Tuple[str, int], Tuple[str, int, Union[str, Path, None]]]
 
 
+def sent_lines(events: Iterable[TraceEvent], since: int = 0) -> List[Tuple[int, str]]:
+    """The lines the gateway sent (its `uart tx` trace events) from cycle
+    `since` on, as (the cycle of the line's first byte, the line without its
+    CR LF)."""
+    out, cur, first = [], bytearray(), 0
+    for e in events:
+        if e.kind != "uart tx" or e.cycle < since:
+            continue
+        if not cur:
+            first = e.cycle
+        cur.append(int(e.fields[0], 16))
+        if cur.endswith(b"\r\n"):
+            out.append((first, bytes(cur[:-2]).decode("ascii", "replace")))
+            cur = bytearray()
+    return out
+
+
 def slave_spec(spec) -> Tuple[str, int, Union[str, Path, None]]:
     """(board, addr) or (board, addr, elf) -> (board, addr, elf or None);
     anything else is a ValueError that says what a slave is."""

@@ -293,17 +293,19 @@ const char *board_model_add_spi(board_model_t *bm, const char *spec)
 			 part_kind_names(PART_SPI, ", ", names, sizeof(names)));
 		return unknown;
 	}
-	part_env_t env = { .mode = mode, .lsb_first = lsb, .adc_mv = bm->adc_mv,
-			   .avcc = &bm->avcc };
+	part_env_t env = { .adc_mv = bm->adc_mv, .avcc = &bm->avcc, .opts = "" };
 	const char *err = NULL;
 
 	if (bm->spi.ndev == SPI_MAX_DEVICES) {
 		return "too many SPI devices";
 	}
-	d = part_make(kind, &env, "", &err);
+	d = part_make(kind, &env, &err);
 	if (!d) {
 		return err;
 	}
+	d->kind = kind->name;
+	d->mode = mode;
+	d->lsb_first = lsb;
 	if (spi_attach(&bm->spi, d, &p->pin[bit]) < 0) {
 		return "too many SPI devices";
 	}

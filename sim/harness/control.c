@@ -673,7 +673,8 @@ static int req_sense(control_req_ctx_t *q)
 	const char *a = argv[1];
 	uint64_t addr;
 	double v[8];
-	char err[160], *end;
+	char err[160], senses_buf[80], *end;
+	const char *senses;
 	int n = q->argc - 3;
 	const part_t *p;
 
@@ -694,7 +695,8 @@ static int req_sense(control_req_ctx_t *q)
 		reply_printf(q->r, "ERR sense: no part at %02X", (unsigned)addr);
 		return 0;
 	}
-	if (!p->kind->sense) {
+	senses = part_kind_senses(p->kind, senses_buf, sizeof(senses_buf));
+	if (!senses) {
 		reply_printf(q->r, "ERR sense: the %s at %02X senses nothing", p->kind->name,
 			     (unsigned)p->addr8);
 		return 0;
@@ -712,11 +714,11 @@ static int req_sense(control_req_ctx_t *q)
 	}
 	if (!part_sense_units(argv[2])) {
 		reply_printf(q->r, "ERR sense: no quantity '%s' (the %s at %02X senses: %s)",
-			     argv[2], p->kind->name, (unsigned)p->addr8, p->kind->senses);
+			     argv[2], p->kind->name, (unsigned)p->addr8, senses);
 		return 0;
 	}
 	err[0] = 0;
-	if (p->kind->sense(p->self, q->c->avr->cycle, argv[2], v, n, err, sizeof(err)) < 0) {
+	if (part_sense(p->kind, p->self, q->c->avr->cycle, argv[2], v, n, err, sizeof(err)) < 0) {
 		reply_printf(q->r, "ERR sense: %s", err[0] ? err : "refused");
 		return 0;
 	}

@@ -64,16 +64,17 @@ static void sim_usage_kinds(part_attach_t attach)
 {
 	for (int i = 0; part_kinds[i]; i++) {
 		const part_kind_t *k = part_kinds[i];
-		char name[40];
+		char name[40], addrs_buf[64], senses_buf[80];
+		const char *addrs = part_kind_addrs(k, addrs_buf, sizeof(addrs_buf));
+		const char *senses = part_kind_senses(k, senses_buf, sizeof(senses_buf));
 
 		if (k->attach != attach) {
 			continue;
 		}
 		snprintf(name, sizeof(name), "%s%s%s%s", k->name, *k->options ? "[:" : "", k->options,
 			 *k->options ? "]" : "");
-		fprintf(stderr, "  %-14s %s%s%s%s%s\n", name, k->about, k->addrs ? "; at " : "",
-			k->addrs ? k->addrs : "", k->senses ? "; senses " : "",
-			k->senses ? k->senses : "");
+		fprintf(stderr, "  %-14s %s%s%s%s%s\n", name, k->about, addrs ? "; at " : "",
+			addrs ? addrs : "", senses ? "; senses " : "", senses ? senses : "");
 	}
 }
 
@@ -223,7 +224,7 @@ typedef struct sim_args_t {
  * eeprom24) and --srf08 ADDR (KIND srf08). 0, or -1 after printing why. */
 static int sim_parse_part(sim_args_t *args, const char *opt, const char *spec)
 {
-	char kind_name[24], addr[16], names[128];
+	char kind_name[24], addr[16], names[128], addrs[64];
 	const char *a = spec, *colon;
 	const part_kind_t *kind;
 	sim_part_arg_t *pa;
@@ -258,9 +259,11 @@ static int sim_parse_part(sim_args_t *args, const char *opt, const char *spec)
 	}
 	memcpy(addr, a, alen);
 	addr[alen] = 0;
-	if (sim_parse_addr(addr, &pa->addr8) < 0 || (kind->addr_ok && !kind->addr_ok(pa->addr8))) {
+	if (sim_parse_addr(addr, &pa->addr8) < 0 || !part_kind_addr_ok(kind, pa->addr8)) {
+		const char *text = part_kind_addrs(kind, addrs, sizeof(addrs));
+
 		fprintf(stderr, "orfa-sim: bad --%s '%s' (ADDR: %s)\n", opt, spec,
-			kind->addrs ? kind->addrs : "an even 8-bit address like 0xA0");
+			text ? text : "an even 8-bit address like 0xA0");
 		return -1;
 	}
 	pa->kind = kind;

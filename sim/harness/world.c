@@ -14,19 +14,20 @@ void world_init(world_t *w)
 
 const char *world_add_part(world_t *w, const part_kind_t *kind, uint8_t addr8, const char *opts)
 {
-	part_env_t env = { .bus = &w->bus, .hz = SIM_FREQUENCY, .addr8 = addr8 };
+	part_env_t env = { .bus = &w->bus, .hz = SIM_FREQUENCY, .addr8 = addr8, .opts = opts };
 	const char *err = "too many parts";
 	void *self;
 
 	if (w->parts.n == PART_LIST_MAX) {
 		return err;
 	}
-	self = part_make(kind, &env, opts, &err);
+	self = part_make(kind, &env, &err);
 	if (!self) {
 		return err;
 	}
 	part_list_add(&w->parts, kind, self, addr8);
-	twi_bus_attach(&w->bus, self);	/* its first member: the twi_dev_t */
+	((twi_dev_t *)self)->name = kind->name;	/* its first member: the twi_dev_t */
+	twi_bus_attach(&w->bus, self);
 	return NULL;
 }
 

@@ -344,25 +344,14 @@ static const regdev_ops_t bmp280_ops = {
 
 /* --- descriptor ------------------------------------------------------------ */
 
-static int bmp280_addr_ok(uint8_t addr8)
-{
-	return addr8 == 0xEC || addr8 == 0xEE;
-}
-
-static int bmp280_part_init(void *self, const part_env_t *env, const char *opts,
-			    const char **err)
+static void bmp280_part_init(void *self, const part_env_t *env)
 {
 	bmp280_t *b = self;
 
-	if (*opts) {
-		*err = "no options";
-		return -1;
-	}
-	regdev_init(&b->rd, env, "bmp280", &bmp280_ops);
+	regdev_init(&b->rd, env, &bmp280_ops);
 	b->temp_c = 25.0;	/* a room at sea level until told otherwise */
 	b->press_pa = 101325.0;
 	bmp280_reset(b, 0);
-	return 0;
 }
 
 /* The datasheet's operating range: -40..85 degrees C, 300..1100 hPa. */
@@ -399,8 +388,7 @@ const part_kind_t bmp280_kind = {
 	.attach = PART_I2C,
 	.options = "",
 	.about = "a Bosch BMP280 barometer (datasheet calibration)",
-	.addr_ok = bmp280_addr_ok,
-	.addrs = "0xEC, 0xEE",
+	.addrs = { { 0xEC, 0xEC }, { 0xEE, 0xEE } },
 	.size = sizeof(bmp280_t),
 	.init = bmp280_part_init,
 	.sense = bmp280_sense,

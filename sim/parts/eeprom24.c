@@ -62,29 +62,17 @@ static const twi_dev_ops_t eeprom24_ops = {
 	.stop = eeprom24_stop,
 };
 
-void eeprom24_init(eeprom24_t *e, uint8_t addr8)
-{
-	memset(e, 0, sizeof(*e));
-	memset(e->mem, 0xff, sizeof(e->mem));
-	e->dev.ops = &eeprom24_ops;
-	e->dev.name = "eeprom24";
-	e->addr8 = addr8 & 0xfe;
-}
-
 /* --- descriptor ------------------------------------------------------------ */
 
-static int eeprom24_part_init(void *self, const part_env_t *env, const char *opts,
-			      const char **err)
+/* Erased (FF), at ENV's address; option wp: WP high. */
+static void eeprom24_init(void *self, const part_env_t *env)
 {
-	int wp = !strcmp(opts, "wp");
+	eeprom24_t *e = self;
 
-	if (*opts && !wp) {
-		*err = "bad option (wp)";
-		return -1;
-	}
-	eeprom24_init(self, env->addr8);
-	((eeprom24_t *)self)->write_protect = (uint8_t)wp;
-	return 0;
+	memset(e->mem, 0xff, sizeof(e->mem));
+	e->dev.ops = &eeprom24_ops;
+	e->addr8 = env->addr8 & 0xfe;
+	e->write_protect = !strcmp(env->opts, "wp");
 }
 
 const part_kind_t eeprom24_kind = {
@@ -93,5 +81,5 @@ const part_kind_t eeprom24_kind = {
 	.options = "wp",
 	.about = "a 256-byte EEPROM like a 24C02 (wp: its WP pin high, data NACKed)",
 	.size = sizeof(eeprom24_t),
-	.init = eeprom24_part_init,
+	.init = eeprom24_init,
 };

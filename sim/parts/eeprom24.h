@@ -24,7 +24,4 @@ typedef struct eeprom24_t {
 	uint8_t write_protect;		/* WP high: data bytes are not acknowledged */
 } eeprom24_t;
 
-/* Erased (FF) EEPROM answering at ADDR8 (0xA0). */
-void eeprom24_init(eeprom24_t *e, uint8_t addr8);
-
 #endif

@@ -116,29 +116,16 @@ static const twi_dev_ops_t ee24lc32_ops = {
 
 /* --- descriptor ------------------------------------------------------------ */
 
-static int ee24lc32_addr_ok(uint8_t addr8)
-{
-	return (addr8 & 0xf0) == 0xA0;
-}
-
-static int ee24lc32_part_init(void *self, const part_env_t *env, const char *opts,
-			      const char **err)
+static void ee24lc32_part_init(void *self, const part_env_t *env)
 {
 	ee24lc32_t *e = self;
-	int wp = !strcmp(opts, "wp");
 
-	if (*opts && !wp) {
-		*err = "bad option (wp)";
-		return -1;
-	}
 	e->dev.ops = &ee24lc32_ops;
-	e->dev.name = "24lc32";
 	e->bus = env->bus;
 	e->hz = env->hz;
 	e->addr8 = env->addr8 & 0xfe;
-	e->write_protect = (uint8_t)wp;
+	e->write_protect = !strcmp(env->opts, "wp");
 	memset(e->mem, 0xff, sizeof(e->mem));
-	return 0;
 }
 
 const part_kind_t ee24lc32_kind = {
@@ -147,8 +134,7 @@ const part_kind_t ee24lc32_kind = {
 	.options = "wp",
 	.about = "a 4 KB EEPROM like a 24LC32A, 32-byte pages, 5 ms write cycle"
 		 " (wp: WP high, writes ignored)",
-	.addr_ok = ee24lc32_addr_ok,
-	.addrs = "0xA0 .. 0xAE",
+	.addrs = { { 0xA0, 0xAE } },
 	.size = sizeof(ee24lc32_t),
 	.init = ee24lc32_part_init,
 };

@@ -123,29 +123,20 @@ static int ee_dump(spi_dev_t *d, char *buf, int size)
 	return n;
 }
 
-void eeprom25_init(eeprom25_t *e, int mode, int lsb_first)
+/* --- descriptor ------------------------------------------------------------ */
+
+/* Erased (FF). */
+static void eeprom25_init(void *self, const part_env_t *env)
 {
-	memset(e, 0, sizeof(*e));
+	eeprom25_t *e = self;
+
+	(void)env;
 	memset(e->mem, 0xff, sizeof(e->mem));
-	e->dev.kind = "eeprom25";
-	e->dev.mode = mode;
-	e->dev.lsb_first = lsb_first;
 	e->dev.byte = ee_byte;
 	e->dev.reset_state = ee_reset_state;
 	e->dev.end = ee_end;
 	e->dev.dump = ee_dump;
 	spi_dev_byte_init(&e->dev);
-}
-
-/* --- descriptor ------------------------------------------------------------ */
-
-static int eeprom25_part_init(void *self, const part_env_t *env, const char *opts,
-			      const char **err)
-{
-	(void)opts;
-	(void)err;
-	eeprom25_init(self, env->mode, env->lsb_first);
-	return 0;
 }
 
 const part_kind_t eeprom25_kind = {
@@ -154,5 +145,5 @@ const part_kind_t eeprom25_kind = {
 	.options = "",
 	.about = "a 128-byte SPI EEPROM like a 25LC010A",
 	.size = sizeof(eeprom25_t),
-	.init = eeprom25_part_init,
+	.init = eeprom25_init,
 };

@@ -31,6 +31,4 @@ typedef struct eeprom25_t {
 	uint64_t (*now)(void *);
 } eeprom25_t;
 
-void eeprom25_init(eeprom25_t *e, int mode, int lsb_first);
-
 #endif

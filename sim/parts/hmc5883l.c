@@ -240,56 +240,33 @@ static const regdev_ops_t hmc5883l_rd_ops = {
 
 /* --- descriptor ------------------------------------------------------------ */
 
-static int hmc5883l_addr_ok(uint8_t addr8)
-{
-	return addr8 == 0x3C;
-}
-
-static int hmc5883l_part_init(void *self, const part_env_t *env, const char *opts,
-			      const char **err)
+static void hmc5883l_part_init(void *self, const part_env_t *env)
 {
 	hmc5883l_t *h = self;
 
-	if (*opts) {
-		*err = "no options";
-		return -1;
-	}
-	regdev_init(&h->rd, env, "hmc5883l", &hmc5883l_rd_ops);
+	regdev_init(&h->rd, env, &hmc5883l_rd_ops);
 	h->reg[HMC5883L_CRA] = 0x10;
 	h->reg[HMC5883L_CRB] = 0x20;
 	h->reg[HMC5883L_MODE] = HMC5883L_MD_SINGLE;
 	h->gain = 1;
 	hmc5883l_schedule(h, env->bus->cycle, HMC5883L_POWER_UP_US);
-	return 0;
 }
 
 /* Its field range: +-8 gauss. */
 static const part_sense_t hmc5883l_senses[] = {
-	{ "field", 3, -800, 800, "+-8 gauss" },
+	{ "field", 3, -800, 800, "+-8 gauss", offsetof(hmc5883l_t, field) },
 };
-
-static int hmc5883l_sense(void *self, uint64_t now, const char *quantity, const double *v, int n,
-			  char *err, size_t cap)
-{
-	hmc5883l_t *h = self;
-
-	if (part_sense_pick("an HMC5883L", hmc5883l_senses, 1, quantity, v, n, err, cap) < 0) {
-		return -1;
-	}
-	hmc5883l_catch_up(&h->rd, now);
-	memcpy(h->field, v, sizeof(h->field));
-	return 0;
-}
 
 const part_kind_t hmc5883l_kind = {
 	.name = "hmc5883l",
 	.attach = PART_I2C,
 	.options = "",
 	.about = "a Honeywell HMC5883L three-axis compass",
-	.addr_ok = hmc5883l_addr_ok,
-	.addrs = "0x3C",
+	.addrs = { { 0x3C, 0x3C } },
 	.size = sizeof(hmc5883l_t),
 	.init = hmc5883l_part_init,
-	.sense = hmc5883l_sense,
-	.senses = "field",
+	.sense_table = hmc5883l_senses,
+	.nsense = 1,
+	.who = "an HMC5883L",
+	.before_sense = regdev_catch_up,
 };

@@ -251,55 +251,31 @@ static const regdev_ops_t lis3mdl_rd_ops = {
 
 /* --- descriptor ------------------------------------------------------------ */
 
-static int lis3mdl_addr_ok(uint8_t addr8)
-{
-	return addr8 == 0x38 || addr8 == 0x3C;
-}
-
-static int lis3mdl_part_init(void *self, const part_env_t *env, const char *opts,
-			     const char **err)
+static void lis3mdl_part_init(void *self, const part_env_t *env)
 {
 	lis3mdl_t *l = self;
 
-	if (*opts) {
-		*err = "no options";
-		return -1;
-	}
-	regdev_init(&l->rd, env, "lis3mdl", &lis3mdl_rd_ops);
+	regdev_init(&l->rd, env, &lis3mdl_rd_ops);
 	l->temp = 25.0;
 	lis3mdl_reset_regs(l);
-	return 0;
 }
 
 /* Its widest range, +-16 gauss; the temperature sensor's. */
 static const part_sense_t lis3mdl_senses[] = {
-	{ "field", 3, -1600, 1600, "+-16 gauss, its widest range" },
-	{ "temp", 1, -40, 85, "its operating range" },
+	{ "field", 3, -1600, 1600, "+-16 gauss, its widest range", offsetof(lis3mdl_t, field) },
+	{ "temp", 1, -40, 85, "its operating range", offsetof(lis3mdl_t, temp) },
 };
-
-static int lis3mdl_sense(void *self, uint64_t now, const char *quantity, const double *v, int n,
-			 char *err, size_t cap)
-{
-	lis3mdl_t *l = self;
-	int i = part_sense_pick("an LIS3MDL", lis3mdl_senses, 2, quantity, v, n, err, cap);
-
-	if (i < 0) {
-		return -1;
-	}
-	lis3mdl_catch_up(&l->rd, now);
-	memcpy(i == 0 ? l->field : &l->temp, v, (size_t)n * sizeof(*v));
-	return 0;
-}
 
 const part_kind_t lis3mdl_kind = {
 	.name = "lis3mdl",
 	.attach = PART_I2C,
 	.options = "",
 	.about = "an ST LIS3MDL three-axis magnetometer + thermometer",
-	.addr_ok = lis3mdl_addr_ok,
-	.addrs = "0x38, 0x3C",
+	.addrs = { { 0x38, 0x38 }, { 0x3C, 0x3C } },
 	.size = sizeof(lis3mdl_t),
 	.init = lis3mdl_part_init,
-	.sense = lis3mdl_sense,
-	.senses = "field, temp",
+	.sense_table = lis3mdl_senses,
+	.nsense = 2,
+	.who = "an LIS3MDL",
+	.before_sense = regdev_catch_up,
 };

@@ -93,32 +93,21 @@ static int mcp_dump(spi_dev_t *d, char *buf, int size)
 	return n;
 }
 
-void mcp3008_init(mcp3008_t *m, int mode, int lsb_first, const uint32_t *mv,
-		  const uint32_t *vref)
+/* --- descriptor ------------------------------------------------------------ */
+
+/* Converting the board's analog inputs against its AVCC (ENV). */
+static void mcp3008_init(void *self, const part_env_t *env)
 {
-	memset(m, 0, sizeof(*m));
-	m->dev.kind = "mcp3008";
-	m->dev.mode = mode;
-	m->dev.lsb_first = lsb_first;
+	mcp3008_t *m = self;
+
 	m->dev.select = mcp_select;
 	m->dev.deselect = mcp_deselect;
 	m->dev.in_bit = mcp_in;
 	m->dev.next_out = mcp_out;
 	m->dev.dump = mcp_dump;
-	m->mv = mv;
-	m->vref = vref;
+	m->mv = env->adc_mv;
+	m->vref = env->avcc;
 	m->last_code = -1;
-}
-
-/* --- descriptor ------------------------------------------------------------ */
-
-static int mcp3008_part_init(void *self, const part_env_t *env, const char *opts,
-			     const char **err)
-{
-	(void)opts;
-	(void)err;
-	mcp3008_init(self, env->mode, env->lsb_first, env->adc_mv, env->avcc);
-	return 0;
 }
 
 const part_kind_t mcp3008_kind = {
@@ -127,5 +116,5 @@ const part_kind_t mcp3008_kind = {
 	.options = "",
 	.about = "an 8-channel 10-bit SPI ADC like an MCP3008 (the board's analog inputs)",
 	.size = sizeof(mcp3008_t),
-	.init = mcp3008_part_init,
+	.init = mcp3008_init,
 };

@@ -27,7 +27,4 @@ typedef struct mcp3008_t {
 	int last_code;
 } mcp3008_t;
 
-void mcp3008_init(mcp3008_t *m, int mode, int lsb_first, const uint32_t *mv,
-		  const uint32_t *vref);
-
 #endif

@@ -253,56 +253,33 @@ static const regdev_ops_t mpu6050_rd_ops = {
 
 /* --- descriptor ------------------------------------------------------------ */
 
-static int mpu6050_addr_ok(uint8_t addr8)
-{
-	return addr8 == 0xD0 || addr8 == 0xD2;
-}
-
-static int mpu6050_part_init(void *self, const part_env_t *env, const char *opts,
-			     const char **err)
+static void mpu6050_part_init(void *self, const part_env_t *env)
 {
 	mpu6050_t *m = self;
 
-	if (*opts) {
-		*err = "no options";
-		return -1;
-	}
-	regdev_init(&m->rd, env, "mpu6050", &mpu6050_rd_ops);
+	regdev_init(&m->rd, env, &mpu6050_rd_ops);
 	m->temp = 25.0;
 	mpu6050_reset(m);
-	return 0;
 }
 
 /* The widest ranges: +-16 g, +-2000 degrees/s; the temperature sensor's. */
 static const part_sense_t mpu6050_senses[] = {
-	{ "accel", 3, -16 * MPU6050_G, 16 * MPU6050_G, "+-16 g, its widest range" },
-	{ "gyro", 3, -2000, 2000, "its widest range" },
-	{ "temp", 1, -40, 85, "the temperature sensor's range" },
+	{ "accel", 3, -16 * MPU6050_G, 16 * MPU6050_G, "+-16 g, its widest range",
+	  offsetof(mpu6050_t, accel) },
+	{ "gyro", 3, -2000, 2000, "its widest range", offsetof(mpu6050_t, gyro) },
+	{ "temp", 1, -40, 85, "the temperature sensor's range", offsetof(mpu6050_t, temp) },
 };
-
-static int mpu6050_sense(void *self, uint64_t now, const char *quantity, const double *v, int n,
-			 char *err, size_t cap)
-{
-	mpu6050_t *m = self;
-	int i = part_sense_pick("an MPU-6050", mpu6050_senses, 3, quantity, v, n, err, cap);
-
-	if (i < 0) {
-		return -1;
-	}
-	mpu6050_catch_up(&m->rd, now);	/* samples before NOW saw the old values */
-	memcpy(i == 0 ? m->accel : i == 1 ? m->gyro : &m->temp, v, (size_t)n * sizeof(*v));
-	return 0;
-}
 
 const part_kind_t mpu6050_kind = {
 	.name = "mpu6050",
 	.attach = PART_I2C,
 	.options = "",
 	.about = "an InvenSense MPU-6050 accelerometer + gyroscope + thermometer",
-	.addr_ok = mpu6050_addr_ok,
-	.addrs = "0xD0, 0xD2",
+	.addrs = { { 0xD0, 0xD0 }, { 0xD2, 0xD2 } },
 	.size = sizeof(mpu6050_t),
 	.init = mpu6050_part_init,
-	.sense = mpu6050_sense,
-	.senses = "accel, gyro, temp",
+	.sense_table = mpu6050_senses,
+	.nsense = 3,
+	.who = "an MPU-6050",
+	.before_sense = regdev_catch_up,
 };

@@ -31,15 +31,18 @@ typedef struct part_env_t {
 	struct twi_bus_t *bus;		/* I2C: the bus (its `cycle` is the time) */
 	uint32_t hz;			/* cycles per second */
 	uint8_t addr8;			/* I2C: its 8-bit address */
-	int mode, lsb_first;		/* SPI: the mode and bit order it speaks */
 	const uint32_t *adc_mv;		/* SPI: the board's 8 analog inputs, mV */
 	const uint32_t *avcc;		/* SPI: the board's AVCC, mV */
+	const char *opts;		/* the option text after KIND@ADDR: ("" for
+					 * none; part_make lets only the kind's
+					 * options word through) */
 } part_env_t;
 
 struct part_kind_t;
 
 /* One part made: its kind and its context struct, whose first member is
- * the bus's view of it (twi_dev_t or spi_dev_t). */
+ * the bus's view of it (twi_dev_t or spi_dev_t; what attaches the part
+ * names that view after its kind and sets how it speaks SPI). */
 typedef struct part_t {
 	const struct part_kind_t *kind;
 	void *self;
@@ -63,54 +66,81 @@ typedef struct part_request_t {
 		   char *out, size_t cap);
 } part_request_t;
 
+/* Even 8-bit addresses FIRST, FIRST + 2, .. LAST: where an I2C part can be. */
+typedef struct part_addr_span_t {
+	uint8_t first, last;
+} part_addr_span_t;
+
+#define PART_ADDR_SPANS 4
+
+/* One quantity a part senses: N values, each within MIN..MAX (its units),
+ * RANGE the same for errors ("+-16 g"), stored as N doubles at byte AT of
+ * the part's context struct (offsetof). */
+typedef struct part_sense_t {
+	const char *quantity;
+	int n;
+	double min, max;
+	const char *range;
+	size_t at;
+} part_sense_t;
+
 typedef struct part_kind_t {
 	const char *name;		/* KIND in the options: "eeprom24" */
 	part_attach_t attach;
-	const char *options;		/* its OPTIONS for --help: "wp", or "" */
+	const char *options;		/* the one option it takes, a flag word:
+					 * "wp", or "" for none (part_make refuses
+					 * any other); --help shows it */
 	const char *about;		/* one line for --help */
-	/* I2C: the addresses it can have (NULL: any even one), and their text */
-	int (*addr_ok)(uint8_t addr8);
-	const char *addrs;
+	/* I2C: the addresses it can have, spans in the order --help names them
+	 * (the unused ones 0; none: any even address); part_kind_addr_ok */
+	part_addr_span_t addrs[PART_ADDR_SPANS];
 	/* Its context struct: SIZE bytes, zeroed, then set up by INIT from
-	 * ENV and OPTS (the option text after KIND@ADDR:, or ""; SPI: mode and
-	 * bit order are in ENV). INIT returns 0, or -1 with *ERR saying why. */
+	 * ENV (its option already checked). */
 	size_t size;
-	int (*init)(void *self, const part_env_t *env, const char *opts, const char **err);
+	void (*init)(void *self, const part_env_t *env);
 	const part_request_t *requests;
 	int nrequests;
-	/* What it senses (NULL: nothing), set by the control request `sense
-	 * @ADDR QUANTITY V...`: QUANTITY ("accel", "gyro", "field", "temp",
+	/* What it senses, set by the control request `sense @ADDR QUANTITY
+	 * V...` (part_sense): QUANTITY ("accel", "gyro", "field", "temp",
 	 * "pressure", "range", ...) with its N values in physical units (m/s^2,
-	 * degrees/s, microtesla, degrees C, Pa, ...; part_sense_units), at
-	 * cycle NOW. 0, or -1 with ERR (CAP bytes) saying why: a quantity the
-	 * part does not sense, the wrong number of values, a value outside
-	 * the part's range. */
+	 * degrees/s, microtesla, degrees C, Pa, ...; part_sense_units).
+	 * Either a table, SENSE_TABLE (NSENSE entries, WHO naming the part in
+	 * errors: "an MPU-6050"), whose values part_sense checks and stores
+	 * after BEFORE_SENSE (NULL: none) brought the part up to cycle NOW; or
+	 * a function of its own, SENSE, with SENSES its quantities for --help
+	 * ("temp, pressure"). Neither: it senses nothing. */
+	const part_sense_t *sense_table;
+	int nsense;
+	const char *who;
+	void (*before_sense)(void *self, uint64_t now);
 	int (*sense)(void *self, uint64_t now, const char *quantity, const double *v, int n,
 		     char *err, size_t cap);
-	const char *senses;		/* its quantities for --help: "accel gyro temp" */
+	const char *senses;
 } part_kind_t;
 
 /* The quantities `sense` knows and their units, for help and errors:
  * "accel" -> "m/s^2", NULL for an unknown one. */
 const char *part_sense_units(const char *quantity);
 
+/* KIND's quantities for --help and errors, "accel, gyro, temp", or NULL
+ * when it senses nothing. */
+const char *part_kind_senses(const part_kind_t *kind, char *buf, size_t cap);
+
+/* Tell the part SELF of KIND that it senses QUANTITY with its N values V
+ * from cycle NOW. 0, or -1 with ERR (CAP bytes) saying why: a quantity the
+ * part does not sense, the wrong number of values, a value outside the
+ * part's range. */
+int part_sense(const part_kind_t *kind, void *self, uint64_t now, const char *quantity,
+	       const double *v, int n, char *err, size_t cap);
+
+/* ADDR8 is one of KIND's addresses (any even one when it names none). */
+int part_kind_addr_ok(const part_kind_t *kind, uint8_t addr8);
+
+/* KIND's addresses for --help and errors ("0xE0, 0xE2 .. 0xFE"), or NULL
+ * when it names none. */
+const char *part_kind_addrs(const part_kind_t *kind, char *buf, size_t cap);
+
 /* --- helpers for sensor parts ---------------------------------------------- */
-
-/* One quantity a part senses: N values, each within MIN..MAX (its units),
- * RANGE the same for errors ("+-16 g"). */
-typedef struct part_sense_t {
-	const char *quantity;
-	int n;
-	double min, max;
-	const char *range;
-} part_sense_t;
-
-/* The entry of TABLE (COUNT entries) that QUANTITY with its N values V
- * fits: its index, or -1 with ERR (CAP bytes) saying why: WHO ("an
- * MPU-6050") does not sense it, the wrong number of values, a value
- * outside the range. */
-int part_sense_pick(const char *who, const part_sense_t *table, int count, const char *quantity,
-		    const double *v, int n, char *err, size_t cap);
 
 /* VALUE times PER_UNIT, rounded to nearest, held within MIN..MAX: the raw
  * reading of a sensor with PER_UNIT LSB per unit that saturates there. */
@@ -149,9 +179,10 @@ const part_kind_t *part_kind_find(const char *name, part_attach_t attach);
 /* The names of the kinds that attach to ATTACH, joined by SEP. */
 const char *part_kind_names(part_attach_t attach, const char *sep, char *buf, size_t cap);
 
-/* A new part of KIND (part_kind_t.init) or NULL with *ERR saying why. */
-void *part_make(const part_kind_t *kind, const part_env_t *env, const char *opts,
-		const char **err);
+/* A new part of KIND (part_kind_t.init) made with ENV, or NULL with *ERR
+ * saying why: "no options" when KIND takes none and ENV's opts is not "",
+ * "bad option (wp)" when it is not KIND's options word either. */
+void *part_make(const part_kind_t *kind, const part_env_t *env, const char **err);
 
 /* Add a made part to LIST. 0, or -1 when full. */
 int part_list_add(part_list_t *list, const part_kind_t *kind, void *self, uint8_t addr8);

@@ -58,19 +58,26 @@ const char *part_kind_names(part_attach_t attach, const char *sep, char *buf, si
 	return buf;
 }
 
-void *part_make(const part_kind_t *kind, const part_env_t *env, const char *opts,
-		const char **err)
+void *part_make(const part_kind_t *kind, const part_env_t *env, const char **err)
 {
-	void *self = calloc(1, kind->size);
+	static char bad[64];
+	void *self;
 
+	if (*env->opts && strcmp(env->opts, kind->options) != 0) {
+		if (!*kind->options) {
+			*err = "no options";
+		} else {
+			snprintf(bad, sizeof(bad), "bad option (%s)", kind->options);
+			*err = bad;
+		}
+		return NULL;
+	}
+	self = calloc(1, kind->size);
 	if (!self) {
 		*err = "out of memory";
 		return NULL;
 	}
-	if (kind->init(self, env, opts, err) < 0) {
-		free(self);
-		return NULL;
-	}
+	kind->init(self, env);
 	return self;
 }
 
@@ -119,11 +126,65 @@ const part_t *part_list_find(const part_list_t *list, const part_kind_t *kind, u
 	return NULL;
 }
 
-/* --- helpers for sensor parts ---------------------------------------------- */
-
-int part_sense_pick(const char *who, const part_sense_t *table, int count, const char *quantity,
-		    const double *v, int n, char *err, size_t cap)
+int part_kind_addr_ok(const part_kind_t *kind, uint8_t addr8)
 {
+	const part_addr_span_t *a = kind->addrs;
+
+	if (!a[0].first) {
+		return !(addr8 & 1);
+	}
+	for (int i = 0; i < PART_ADDR_SPANS && a[i].first; i++) {
+		if (addr8 >= a[i].first && addr8 <= a[i].last && !((addr8 - a[i].first) & 1)) {
+			return 1;
+		}
+	}
+	return 0;
+}
+
+const char *part_kind_addrs(const part_kind_t *kind, char *buf, size_t cap)
+{
+	const part_addr_span_t *a = kind->addrs;
+	size_t len = 0;
+
+	if (!a[0].first) {
+		return NULL;
+	}
+	buf[0] = 0;
+	for (int i = 0; i < PART_ADDR_SPANS && a[i].first && len < cap; i++) {
+		len += (size_t)snprintf(buf + len, cap - len, "%s0x%02X", i ? ", " : "",
+					a[i].first);
+		if (a[i].last != a[i].first && len < cap) {
+			len += (size_t)snprintf(buf + len, cap - len, " .. 0x%02X", a[i].last);
+		}
+	}
+	return buf;
+}
+
+const char *part_kind_senses(const part_kind_t *kind, char *buf, size_t cap)
+{
+	size_t len = 0;
+
+	if (!kind->sense_table) {
+		return kind->sense ? kind->senses : NULL;
+	}
+	buf[0] = 0;
+	for (int i = 0; i < kind->nsense && len < cap; i++) {
+		len += (size_t)snprintf(buf + len, cap - len, "%s%s", i ? ", " : "",
+					kind->sense_table[i].quantity);
+	}
+	return buf;
+}
+
+/* The entry of KIND's table that QUANTITY with its N values V fits: its
+ * index, or -1 with ERR (CAP bytes) saying why. */
+static int part_sense_pick(const part_kind_t *kind, const char *quantity, const double *v, int n,
+			   char *err, size_t cap)
+{
+	const char *who = kind->who;
+	const part_sense_t *table = kind->sense_table;
+	int count = kind->nsense;
+	char names[80];
+
 	for (int i = 0; i < count; i++) {
 		const part_sense_t *s = &table[i];
 
@@ -145,17 +206,31 @@ int part_sense_pick(const char *who, const part_sense_t *table, int count, const
 		}
 		return i;
 	}
-	{
-		size_t len = (size_t)snprintf(err, cap, "%s does not sense %s; it senses", who,
-					      quantity);
-
-		for (int i = 0; i < count && len < cap; i++) {
-			len += (size_t)snprintf(err + len, cap - len, "%s %s", i ? "," : "",
-						table[i].quantity);
-		}
-	}
+	snprintf(err, cap, "%s does not sense %s; it senses %s", who, quantity,
+		 part_kind_senses(kind, names, sizeof(names)));
 	return -1;
 }
+
+int part_sense(const part_kind_t *kind, void *self, uint64_t now, const char *quantity,
+	       const double *v, int n, char *err, size_t cap)
+{
+	int i;
+
+	if (!kind->sense_table) {
+		return kind->sense(self, now, quantity, v, n, err, cap);
+	}
+	i = part_sense_pick(kind, quantity, v, n, err, cap);
+	if (i < 0) {
+		return -1;
+	}
+	if (kind->before_sense) {
+		kind->before_sense(self, now);	/* what came before NOW saw the old values */
+	}
+	memcpy((char *)self + kind->sense_table[i].at, v, (size_t)n * sizeof(*v));
+	return 0;
+}
+
+/* --- helpers for sensor parts ---------------------------------------------- */
 
 int32_t part_raw(double value, double per_unit, int32_t min, int32_t max)
 {

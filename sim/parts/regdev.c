@@ -70,10 +70,16 @@ static const twi_dev_ops_t regdev_twi_ops = {
 	.stop = regdev_stop,
 };
 
-void regdev_init(regdev_t *d, const part_env_t *env, const char *name, const regdev_ops_t *ops)
+void regdev_catch_up(void *self, uint64_t now)
+{
+	regdev_t *d = self;
+
+	d->ops->catch_up(d, now);
+}
+
+void regdev_init(regdev_t *d, const part_env_t *env, const regdev_ops_t *ops)
 {
 	d->dev.ops = &regdev_twi_ops;
-	d->dev.name = name;
 	d->ops = ops;
 	d->bus = env->bus;
 	d->hz = env->hz;

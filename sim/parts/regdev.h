@@ -38,7 +38,11 @@ struct regdev_t {
 	uint8_t selected, want_ptr;
 };
 
+/* Bring the part SELF (whose first member is its regdev_t) up to cycle
+ * NOW: its catch_up; a sensor part's part_kind_t.before_sense. */
+void regdev_catch_up(void *self, uint64_t now);
+
 /* Set up D (the first member of the part's context) at ENV's address. */
-void regdev_init(regdev_t *d, const part_env_t *env, const char *name, const regdev_ops_t *ops);
+void regdev_init(regdev_t *d, const part_env_t *env, const regdev_ops_t *ops);
 
 #endif

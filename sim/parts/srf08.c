@@ -377,21 +377,9 @@ static void srf08_control(const part_list_t *list, uint64_t now, int argc, char 
 
 /* --- descriptor ------------------------------------------------------------ */
 
-/* The 16 addresses an SRF08 can be set to: E0, E2 .. FE. */
-static int srf08_addr_ok(uint8_t addr8)
+static void srf08_part_init(void *self, const part_env_t *env)
 {
-	return addr8 >= 0xE0 && !(addr8 & 1);
-}
-
-static int srf08_part_init(void *self, const part_env_t *env, const char *opts,
-			   const char **err)
-{
-	if (*opts) {
-		*err = "no options";
-		return -1;
-	}
 	srf08_init(self, env->addr8, env->hz, env->bus);
-	return 0;
 }
 
 /* `sense @E0 range MM [MM2]` (millimetres, 0: nothing there), `sense @E0
@@ -435,8 +423,8 @@ const part_kind_t srf08_kind = {
 	.attach = PART_I2C,
 	.options = "",
 	.about = "a Devantech SRF08 ultrasonic range finder (request srf08)",
-	.addr_ok = srf08_addr_ok,
-	.addrs = "0xE0, 0xE2 .. 0xFE",
+	/* the 16 addresses it can be set to, the one it ships with first */
+	.addrs = { { 0xE0, 0xE0 }, { 0xE2, 0xFE } },
 	.size = sizeof(srf08_t),
 	.init = srf08_part_init,
 	.requests = srf08_requests,

@@ -216,26 +216,48 @@ def running(sim: SimBoard, make_bench=Bench):
             assert resets == [], "the board reset: %r" % resets
 
 
+def bench_running(board: str, make_bench=Bench, **sim_options):
+    """The body of a module's fixture (`yield from`): a simulated BOARD
+    (SimBoard's SIM_OPTIONS; trace=True, for the checks of `for_each_test`)
+    built and started, its bench made by MAKE_BENCH, stopped after the
+    module (`running`)."""
+    require_builds([board])
+    with running(SimBoard(board, **sim_options), make_bench) as b:
+        yield b
+
+
+def for_each_test(bench, prepare=None, tidy=None, settle=False):
+    """The body of a test's fixture over a module's BENCH (`yield from`): the
+    simulator alive, the serial input flushed, PREPARE(bench) run; after the
+    test, with SETTLE the replies a test left coming skipped, TIDY(bench)
+    putting back what the module changes, restore() the board's defaults;
+    the MCU must not have reset meanwhile."""
+    assert bench.sim.running, "the simulator died: %s" % bench.sim.stderr
+    bench.gw.serial.reset_input_buffer()
+    mark = bench.mark()
+    if prepare:
+        prepare(bench)
+    yield bench
+    if settle:
+        bench.settle()
+    if tidy:
+        tidy(bench)
+    bench.restore()
+    resets = bench.events(mark, ["reset"])
+    assert resets == [], "the MCU reset during the test: %r" % resets
+
+
 @pytest.fixture(scope="module", params=BOARDS)
 def bench(request):
-    require_builds([request.param])
     # and a write-protected one that refuses data bytes (ERROR 07)
-    sim = SimBoard(request.param, eeproms=(EEPROM,), trace=True,
-                   extra_args=("--eeprom", "0x%02X:wp" % EEPROM_WP))
-    with running(sim) as b:
-        yield b
+    yield from bench_running(request.param, eeproms=(EEPROM,), trace=True,
+                             extra_args=("--eeprom", "0x%02X:wp" % EEPROM_WP))
 
 
 @pytest.fixture
 def board(bench):
     """The module's board, idle and in its default state."""
-    assert bench.sim.running, "the simulator died: %s" % bench.sim.stderr
-    bench.gw.serial.reset_input_buffer()
-    mark = bench.mark()
-    yield bench
-    bench.restore()
-    resets = bench.events(mark, ["reset"])
-    assert resets == [], "the MCU reset during the test: %r" % resets
+    yield from for_each_test(bench)
 
 
 # --- driver suites (tests/sim/test_drv_*.py) ----------------------------------
@@ -532,15 +554,7 @@ def pytest_generate_tests(metafunc):
 @pytest.fixture
 def drv(drv_sim):
     """The module's board for a driver test; every driver is put back after."""
-    bench = drv_sim
-    assert bench.sim.running, "the simulator died: %s" % bench.sim.stderr
-    bench.gw.serial.reset_input_buffer()
-    mark = bench.mark()
-    yield bench
-    bench.drv_restore()
-    bench.restore()
-    resets = bench.events(mark, ["reset"])
-    assert resets == [], "the MCU reset during the test: %r" % resets
+    yield from for_each_test(drv_sim, tidy=DrvBench.drv_restore)
 
 
 # --- known defects (open work of issue 3) -----------------------------------
@@ -570,3 +584,21 @@ def pytest_terminal_summary(terminalreporter, config):
         terminalreporter.section("sensor readings (build/sensor-readings.txt)")
         for row in rows:
             terminalreporter.write_line(row)
+
+
+def cli_runner(port: str, capsys, monkeypatch):
+    """run(*argv, stdin="") runs the `orfa` command in this process on
+    `port` and gives (exit status, stdout, stderr)."""
+    import io
+
+    from orfa import cli
+
+    def run(*argv, stdin=""):
+        monkeypatch.setattr("sys.stdin", io.StringIO(stdin))
+        try:
+            status = cli.main(["--port", port, "--timeout", "5"] + list(argv))
+        except SystemExit as exc:
+            status = exc.code
+        out, err = capsys.readouterr()
+        return status, out, err
+    return run

@@ -7,7 +7,8 @@ with up to nine SCL pulses, seen on the pin; the board never resets."""
 
 import pytest
 
-from conftest import DRV_LAYOUT, EEPROM, F_CPU, require_builds, require_slave, running
+from conftest import (DRV_LAYOUT, EEPROM, F_CPU, bench_running, for_each_test, require_builds,
+                      require_slave, running)
 from orfa.sim import BOARDS, SimBoard
 
 MS = F_CPU // 1000
@@ -24,26 +25,19 @@ READ = "S A0 70 S A1 01 P"
 
 @pytest.fixture(scope="module", params=BOARDS)
 def stuck_bench(request):
-    require_builds([request.param])
-    sim = SimBoard(request.param, eeproms=(EEPROM,), trace=True, control=True)
-    with running(sim) as b:
-        yield b
+    yield from bench_running(request.param, eeproms=(EEPROM,), trace=True, control=True)
+
+
+def free_bus(b):
+    b.sim.control.i2c_stuck(0)
+    b.sim.control.i2c_hold_scl(False)
 
 
 @pytest.fixture
 def sb(stuck_bench):
     """The board with a free bus, put back free after the test."""
-    b = stuck_bench
-    assert b.sim.running, b.sim.stderr
-    b.gw.serial.reset_input_buffer()
-    mark = b.mark()
-    yield b
-    ctl = b.sim.control
-    ctl.i2c_stuck(0)
-    ctl.i2c_hold_scl(False)
-    b.restore()
-    assert b.ask("X") == b"X\r\n"
-    assert b.events(mark, ["reset"]) == [], "a stuck bus reset the board"
+    yield from for_each_test(stuck_bench, tidy=free_bus)
+    assert stuck_bench.ask("X") == b"X\r\n"
 
 
 def latency(b, mark):

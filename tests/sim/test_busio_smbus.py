@@ -13,7 +13,7 @@ import subprocess
 
 import pytest
 
-from conftest import require_builds, require_slave, running
+from conftest import bench_running, for_each_test, require_builds, require_slave, running
 from orfa import boardmap
 from orfa.busio import I2C
 from orfa.sim import SimBoard, sim_path
@@ -32,21 +32,14 @@ def need(module: str, package: str):
 
 @pytest.fixture(scope="module")
 def robot_bench():
-    require_builds(["m32d"])
-    sim = SimBoard("m32d", eeproms=(EEPROM << 1,), srf08=(SRF08 << 1,), trace=True,
-                   extra_args=("--eeprom", "0x%02X:wp" % (EEPROM_WP << 1)),
-                   slaves=[("m128s", SLAVE << 1, require_slave("m128s", SLAVE << 1))])
-    with running(sim) as b:
-        yield b
+    yield from bench_running("m32d", eeproms=(EEPROM << 1,), srf08=(SRF08 << 1,), trace=True,
+                             extra_args=("--eeprom", "0x%02X:wp" % (EEPROM_WP << 1)),
+                             slaves=[("m128s", SLAVE << 1, require_slave("m128s", SLAVE << 1))])
 
 
 @pytest.fixture
 def bench(robot_bench):
-    b = robot_bench
-    assert b.sim.running, b.sim.stderr
-    b.gw.serial.reset_input_buffer()
-    yield b
-    b.restore()
+    yield from for_each_test(robot_bench)
 
 
 @pytest.fixture

@@ -4,7 +4,7 @@ against one simulated robot (M32-D gateway, EEPROM 0xA0, an M128-S slave at
 
 import pytest
 
-from conftest import require_builds
+from conftest import cli_runner, require_builds
 from orfa import cli
 from orfa.sim import SimRobot
 
@@ -22,16 +22,9 @@ def robot():
 
 
 @pytest.fixture
-def orfa(robot, capsys):
+def orfa(robot, capsys, monkeypatch):
     """orfa(*argv) on the robot's port: (exit status, stdout, stderr)."""
-    def run(*argv):
-        try:
-            status = cli.main(["--port", robot.port, "--timeout", "5"] + list(argv))
-        except SystemExit as exc:
-            status = exc.code
-        out, err = capsys.readouterr()
-        return status, out, err
-    return run
+    return cli_runner(robot.port, capsys, monkeypatch)
 
 
 def test_version(orfa):
@@ -141,13 +134,11 @@ def test_request_prints_every_reply_and_exits_1_on_an_error(orfa):
     assert orfa("request", "V", "S A0 P") == (0, "V1.1\nSWP\n", "")
 
 
-def test_console_from_a_pipe(orfa, monkeypatch):
-    import io
+def test_console_from_a_pipe(orfa):
     comment = "#" + "c" * 199
     lines = ["V", comment, "S A0 40 41 P", "#" + "d" * 999, "S A0 40 S A1 01 P",
              "V" * 129, "", "   ", "l", "Q", "caf\u00e9"]
-    monkeypatch.setattr("sys.stdin", io.StringIO("\n".join(lines) + "\n"))
-    status, out, err = orfa("console")
+    status, out, err = orfa("console", stdin="\n".join(lines) + "\n")
     assert (status, out) == (0, "\n".join([
         "V1.1", "SWAAP", "SWASR41P", "ERROR 04", "LAA", "ERROR 02",
         "host: a request is ASCII text", ""]))

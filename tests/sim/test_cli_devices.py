@@ -3,11 +3,10 @@ robot (M32-D gateway with a 25-series EEPROM on SPI at PC2, analog inputs
 preset; an M128-S slave at 0x10), checked on the pins through the control
 socket, in simulated time."""
 
-import io
 
 import pytest
 
-from conftest import SERVO_FRAME, require_builds, us_to_cycles
+from conftest import SERVO_FRAME, cli_runner, require_builds, us_to_cycles
 from orfa import boardmap, cli
 from orfa.sim import SimRobot
 
@@ -31,15 +30,7 @@ def robot():
 @pytest.fixture
 def orfa(robot, capsys, monkeypatch):
     """orfa(*argv) on the robot's port: (exit status, stdout, stderr)."""
-    def run(*argv, stdin=""):
-        monkeypatch.setattr("sys.stdin", io.StringIO(stdin))
-        try:
-            status = cli.main(["--port", robot.port, "--timeout", "5"] + list(argv))
-        except SystemExit as exc:
-            status = exc.code
-        out, err = capsys.readouterr()
-        return status, out, err
-    return run
+    return cli_runner(robot.port, capsys, monkeypatch)
 
 
 def pulse_width(sim, signal):

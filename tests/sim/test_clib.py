@@ -231,13 +231,18 @@ class FakeGateway:
         os.close(self.slave)
 
 
-@pytest.mark.parametrize("ndrivers", [1, 9, 10, 11, 20, 200])
-def test_many_drivers(get_drivers, ndrivers):
-    fake = FakeGateway(ndrivers)
+
+def drivers_of(get_drivers, fake):
+    """get_drivers run against a scripted gateway `fake`, which is closed
+    after: (fake, its result)."""
     try:
-        r = get_drivers(fake.path)
+        return fake, get_drivers(fake.path)
     finally:
         fake.close()
+
+@pytest.mark.parametrize("ndrivers", [1, 9, 10, 11, 20, 200])
+def test_many_drivers(get_drivers, ndrivers):
+    fake, r = drivers_of(get_drivers, FakeGateway(ndrivers))
     assert (r.returncode, r.stderr) == (0, "")
     assert r.stdout == listing(fake.records)
     # the count, then the records ten at a time from driver 1: never a read
@@ -294,11 +299,7 @@ I = Record(0x0000, 1, 0, 0x00, 2)
 def test_implausible_driver_list(get_drivers, records, why):
     """The reference model serving a driver list that breaks one rule of the
     layout (a driver 1 that is not introspection: the EEPROM test above)."""
-    fake = FakeGateway(records=records)
-    try:
-        r = get_drivers(fake.path)
-    finally:
-        fake.close()
+    fake, r = drivers_of(get_drivers, FakeGateway(records=records))
     assert (r.returncode, r.stdout) == (1, "")
     assert r.stderr == "get_drivers: %s: address 0xAA: not an ORFA board: %s\n" % (fake.path, why)
 
@@ -306,11 +307,7 @@ def test_implausible_driver_list(get_drivers, records, why):
 def test_plausible_edges(get_drivers):
     """What a board may have: a driver with no registers, registers up to 0xFF."""
     records = [I, Record(0x0101, 1, 1, 0x02, 0), Record(0x0102, 1, 1, 0x02, 0xFE)]
-    fake = FakeGateway(records=records)
-    try:
-        r = get_drivers(fake.path)
-    finally:
-        fake.close()
+    fake, r = drivers_of(get_drivers, FakeGateway(records=records))
     assert (r.returncode, r.stderr) == (0, "")
     assert r.stdout == listing(records)
 

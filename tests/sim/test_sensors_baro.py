@@ -26,7 +26,7 @@ import pytest
 from orfa.sim import SimBoard, part_kinds
 from orfa.simctl import SimControlError
 
-from conftest import F_CPU, ControlBench, require_builds, running
+from conftest import F_CPU, ControlBench, bench_running, for_each_test, require_builds
 
 BARO = 0xEC
 EE = 0xA8
@@ -184,24 +184,19 @@ class PartBench(ControlBench):
 
 @pytest.fixture(scope="module")
 def parts_bench():
-    require_builds(["m32d"])
-    sim = SimBoard("m32d", trace=True, control=True,
-                   parts=[("bmp280", BARO), ("24lc32", EE), ("24lc32", EE_WP, "wp")])
-    with running(sim, PartBench) as b:
-        yield b
+    yield from bench_running("m32d", PartBench, trace=True, control=True,
+                             parts=[("bmp280", BARO), ("24lc32", EE), ("24lc32", EE_WP, "wp")])
+
+
+def reset_baro(b):
+    b.baro_set(0xE0, 0xB6)
+    b.ctl.wait(max(STARTUP, TWC))
 
 
 @pytest.fixture
 def parts(parts_bench):
     """The board with the BMP280 just reset and idle, the EEPROMs ready."""
-    b = parts_bench
-    assert b.sim.running, "the simulator died: %s" % b.sim.stderr
-    b.gw.serial.reset_input_buffer()
-    b.baro_set(0xE0, 0xB6)
-    b.ctl.wait(max(STARTUP, TWC))
-    yield b
-    b.settle()
-    b.restore()
+    yield from for_each_test(parts_bench, prepare=reset_baro, settle=True)
 
 
 # --- BMP280 ---------------------------------------------------------------------------------

@@ -31,10 +31,10 @@ import subprocess
 
 import pytest
 
-from orfa.sim import SimBoard, sim_path
+from orfa.sim import sim_path
 from orfa.simctl import SimControlError
 
-from conftest import F_CPU, Bench, raw, require_builds, running
+from conftest import F_CPU, Bench, bench_running, for_each_test, raw
 
 MPU, MPU2, HMC, LIS = 0xD0, 0xD2, 0x3C, 0x38
 G = 9.80665                             # m/s^2 per g
@@ -92,22 +92,14 @@ class SensorBench(Bench):
 
 @pytest.fixture(scope="module")
 def bench():
-    require_builds(["m32d"])
-    parts = ["mpu6050@0x%02X" % MPU, "mpu6050@0x%02X" % MPU2, "hmc5883l@0x%02X" % HMC,
-             "lis3mdl@0x%02X" % LIS]
-    sim = SimBoard("m32d", trace=True, control=True,
-                   extra_args=[a for p in parts for a in ("--part", p)])
-    with running(sim, SensorBench) as b:
-        yield b
+    yield from bench_running("m32d", SensorBench, trace=True, control=True,
+                             parts=[("mpu6050", MPU), ("mpu6050", MPU2), ("hmc5883l", HMC),
+                                    ("lis3mdl", LIS)])
 
 
 @pytest.fixture
 def b(bench):
-    assert bench.sim.running, "the simulator died: %s" % bench.sim.stderr
-    bench.gw.serial.reset_input_buffer()
-    yield bench
-    bench.settle()
-    bench.restore()
+    yield from for_each_test(bench, settle=True)
 
 
 @pytest.fixture

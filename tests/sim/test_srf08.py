@@ -16,10 +16,10 @@ import re
 import pytest
 
 from orfa.protocol import F_CPU
-from orfa.sim import BOARDS, SimBoard
+from orfa.sim import BOARDS
 from orfa.simctl import SimControlError
 
-from conftest import ControlBench, require_builds, running
+from conftest import ControlBench, bench_running, for_each_test
 
 SRF = 0xE0
 MS65 = F_CPU * 65 // 1000            # a ranging at range 255
@@ -38,27 +38,21 @@ SrfBench = ControlBench
 
 @pytest.fixture(scope="module", params=BOARDS)
 def srf_bench(request):
-    require_builds([request.param])
-    sim = SimBoard(request.param, trace=True, control=True, srf08=(SRF,))
-    with running(sim, SrfBench) as b:
-        yield b
+    yield from bench_running(request.param, SrfBench, trace=True, control=True, srf08=(SRF,))
+
+
+def srf_power_up(b):
+    """The SRF08 back at its power-up settings, nothing in front."""
+    b.ctl.wait(MS65)                                # any ranging is over
+    assert b.ask("S E0 01 1F FF P") == b"SWAAAP\r\n"  # gain 31, range 255
+    b.ctl.srf08_range(SRF, 0)
+    b.ctl.srf08_light(SRF, 0)
 
 
 @pytest.fixture
 def srf(srf_bench):
     """The board with its SRF08 idle, at power-up settings, nothing in front."""
-    b = srf_bench
-    assert b.sim.running, "the simulator died: %s" % b.sim.stderr
-    b.gw.serial.reset_input_buffer()
-    mark = b.mark()
-    yield b
-    b.settle()
-    b.ctl.wait(MS65)                                # any ranging is over
-    assert b.ask("S E0 01 1F FF P") == b"SWAAAP\r\n"  # gain 31, range 255
-    b.ctl.srf08_range(SRF, 0)
-    b.ctl.srf08_light(SRF, 0)
-    b.restore()
-    assert b.events(mark, ["reset"]) == []
+    yield from for_each_test(srf_bench, tidy=srf_power_up, settle=True)
 
 
 def echo_reply(*values: int) -> bytes:

@@ -14,7 +14,7 @@ import pytest
 from conftest import (DRV_TARGETS, F_CPU, GATEWAY_OF_SLAVES, SERVO_FRAME, DrvBench,
                       require_builds, require_slave, running, target)
 from orfa import boards
-from orfa.sim import SimBoard
+from orfa.sim import SimBoard, sent_lines
 
 MS = F_CPU // 1000                  # cycles per millisecond
 BYTE = 640                          # cycles per byte at 115200 baud
@@ -87,17 +87,7 @@ def stream(b, start, line, until):
 
 def reply_lines(b, since_cycle):
     """[(cycle of the first byte, line)] the gateway sent from since_cycle on."""
-    out, cur, first = [], bytearray(), None
-    for e in b.sim.trace_events(kinds=["uart tx"]):
-        if e.cycle < since_cycle:
-            continue
-        if not cur:
-            first = e.cycle
-        cur.append(int(e.fields[0], 16))
-        if cur.endswith(b"\r\n"):
-            out.append((first, bytes(cur[:-2]).decode("ascii", "replace")))
-            cur = bytearray()
-    return out
+    return sent_lines(b.sim.trace_events(kinds=["uart tx"]), since_cycle)
 
 
 def resets(b, since_cycle=0):
