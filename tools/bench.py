@@ -22,7 +22,9 @@ runs print the same figures, cycle for cycle.
 """
 
 import argparse
+import math
 import re
+import struct
 import subprocess
 import sys
 import time
@@ -691,6 +693,146 @@ def print_bus_faults(boards, width=38):
 # --- end of bus faults ----------------------------------------------------------
 
 
+# --- sensor reads (issue 18): the MPU-6050's 14-byte burst ---------------------
+#
+# A block of its own (bench_sensor_reads, print_sensor_reads), called once from
+# main(). Each board as a gateway with an MPU-6050 at D0, driven by the host
+# package over the simulator's port as a program drives it: one read at a time
+# through orfa.busio (the call adafruit_bus_device's write_then_readinto makes:
+# each read one request, the next sent when its reply is in), then pipelined
+# through Gateway.transactions (the flow rule: under 256 characters of requests
+# unanswered). The figures are simulated cycles from the trace: one at a time,
+# each read's own span (its request's first start bit to its reply's last stop
+# bit) summed, so the PC's time between a reply and the next request, which is
+# the PC's and not the wire's, is left out (an instant host); pipelined, the
+# whole run's span, as the pipelined row above (line_start: a request's bytes
+# counted back to back).
+
+MPU, ACCEL_XOUT_H, BURST = 0xD0, 0x3B, 14
+SENSOR_READS = 200
+G = 9.80665
+#: What the MPU-6050 senses, and the 14 bytes its datasheet gives for it at
+#: the reset ranges (+-2 g: 16384 LSB/g; 250 degrees/s: 131 LSB per degree/s;
+#: TEMP_OUT = (T - 36.53) x 340), rounded to nearest.
+MPU_SENSE = {"accel": (1.0, -2.0, G), "gyro": (10.0, -20.0, 30.0), "temp": (25.0,)}
+
+
+def mpu_burst():
+    codes = ([math.floor(a / G * 16384 + 0.5) for a in MPU_SENSE["accel"]]
+             + [math.floor((MPU_SENSE["temp"][0] - 36.53) * 340 + 0.5)]
+             + [math.floor(w * 131 + 0.5) for w in MPU_SENSE["gyro"]])
+    return struct.pack(">7h", *codes)
+
+
+def lines_of(events, kind, end):
+    """[(first byte's event cycle, last byte's event cycle, bytes)] of the
+    lines (ended by the byte `end`) in the `kind` events."""
+    out, first, count = [], None, 0
+    for e in events:
+        if e.kind != kind:
+            continue
+        if first is None:
+            first, count = e.cycle, 0
+        count += 1
+        if int(e.fields[0], 16) == end:
+            out.append((first, e.cycle, count))
+            first = None
+    return out
+
+
+def line_start(line):
+    """The first start bit of a request line had its bytes come back to back
+    (its last byte's end less its bytes' time): the PC's port hands the
+    simulator a line's bytes when the kernel gets to it, and a pause between
+    them is the PC's, not the wire's."""
+    return line[1] - line[2] * CYCLES_PER_BYTE
+
+
+def bench_sensor_reads(board):
+    """{"one": (correct, cycles summed over the reads' spans), "pipelined":
+    (correct, cycles of the run), "bytes": (request, reply) per read}."""
+    from orfa import protocol as p
+    from orfa.busio import I2C
+    from orfa.gateway import Gateway
+    want = mpu_burst()
+    frames = [p.Write(MPU, bytes([ACCEL_XOUT_H])), p.Read(MPU, BURST)]
+    rows = {}
+    with SimBoard(board, parts=[("mpu6050", MPU)], control=True) as sim, \
+            Gateway(sim.port, timeout=30) as gw:
+        ctl = sim.control
+        gw.write_register(MPU, 0x6B, [0x00])              # PWR_MGMT_1: awake
+        for quantity, values in MPU_SENSE.items():
+            ctl.sense(MPU, quantity, *values)
+        ctl.wait(F_CPU // 100)                             # samples at 1 kHz
+        i2c = I2C(gw)
+        i2c.try_lock()
+        ctl.wait(1)                    # the trace holds every event before the wait's answer
+        mark = len(sim.trace_text().encode())
+        got = bytearray(BURST)
+        correct = 0
+        for _ in range(SENSOR_READS):
+            i2c.writeto_then_readfrom(MPU >> 1, bytes([ACCEL_XOUT_H]), got)
+            correct += got == want
+        ctl.wait(1)
+        events = sim.trace_events(mark, kinds=["uart"])
+        rx, tx = lines_of(events, "uart rx", 0x0A), lines_of(events, "uart tx", 0x0A)
+        rows["one"] = (correct, sum(t[1] + CYCLES_PER_BYTE - line_start(r)
+                                    for r, t in zip(rx, tx)))
+        # the bytes of each read on the wire, requests and replies alike
+        rows["bytes"] = {(r[2], t[2]) for r, t in zip(rx, tx)}
+        mark = len(sim.trace_text().encode())
+        results = gw.transactions([frames] * SENSOR_READS)
+        correct = sum(1 for r in results if not isinstance(r, Exception) and r[1].data == want)
+        ctl.wait(1)
+        events = sim.trace_events(mark, kinds=["uart"])
+        rx = lines_of(events, "uart rx", 0x0A)
+        tx = lines_of(events, "uart tx", 0x0A)
+        rows["pipelined"] = (correct, tx[-1][1] + CYCLES_PER_BYTE - line_start(rx[0]))
+        rows["bytes"] |= {(r[2], t[2]) for r, t in zip(rx, tx)}
+    if len(rows["bytes"]) != 1:
+        raise SystemExit("bench: the %s sensor reads took different lengths on the wire: %r"
+                         % (board, rows["bytes"]))
+    rows["bytes"] = rows["bytes"].pop()
+    return rows
+
+
+def print_sensor_reads(boards, width=38):
+    res = {b: bench_sensor_reads(b) for b in boards}
+    req, rep = res[boards[0]]["bytes"]
+    if any(r["bytes"] != (req, rep) for r in res.values()):
+        raise SystemExit("bench: the boards' sensor reads differ on the wire")
+    wire = F_CPU / (max(req, rep) * CYCLES_PER_BYTE)       # full duplex: the longer way
+    alone = F_CPU / ((req + rep) * CYCLES_PER_BYTE)        # a request, then its reply
+    print()
+    print("Sensor reads: the MPU-6050's 14-byte burst from ACCEL_XOUT_H (issue 18), a")
+    print("request of %d bytes and a reply of %d, bus clock 100 kHz" % (req, rep))
+    print()
+    print("%-*s" % (width, "figure") + "".join("%14s" % b for b in boards) + "%10s" % "wire")
+
+    def row(label, get, target=""):
+        print("%-*s" % (width, label) + "".join("%14s" % get(res[b]) for b in boards)
+              + "%10s" % target)
+
+    n = SENSOR_READS
+    row("one at a time: correct reads", lambda r: "%d/%d" % (r["one"][0], n), "%d/%d" % (n, n))
+    row("one at a time: reads/s", lambda r: "%.1f" % (n * F_CPU / r["one"][1]), "%.1f" % wire)
+    row("one at a time: % of wire", lambda r: "%.1f" % (100.0 * n * F_CPU / r["one"][1] / wire))
+    row("pipelined (Gateway): correct reads", lambda r: "%d/%d" % (r["pipelined"][0], n),
+        "%d/%d" % (n, n))
+    row("pipelined: reads/s", lambda r: "%.1f" % (n * F_CPU / r["pipelined"][1]), "%.1f" % wire)
+    row("pipelined: % of wire", lambda r: "%.1f" % (100.0 * n * F_CPU / r["pipelined"][1] / wire))
+    print()
+    print("One at a time is the way of Adafruit's drivers (each read a request that")
+    print("waits for its reply: busio's writeto_then_readfrom), here with an instant PC;")
+    print("the wire alone then allows %.1f reads/s (%.1f%%), request and reply never" % (
+        alone, 100.0 * alone / wire))
+    print("overlapping. Pipelined: Gateway.transactions within the flow rule. The wire's")
+    print("limit: the %d-byte replies back to back at 115200 baud (10 bits a byte)." % rep)
+    return all(r["one"][0] == n and r["pipelined"][0] == n for r in res.values())
+
+# --- end of sensor reads -----------------------------------------------------------
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--boards", nargs="+", default=["m32d", "m128s"])
@@ -811,6 +953,7 @@ def main():
     ok = ok and all(slaves[b]["pipeline"][0] == SLAVE_PIPELINE for b in args.boards)
     ok = bench_autobaud(args.boards) and ok
     ok = print_bus_faults(args.boards) and ok
+    ok = print_sensor_reads(args.boards) and ok
     print_watchdog(args.boards, width)
     return 0 if ok else 1
 

@@ -7,6 +7,7 @@ sees another's state. Each simulator has its own temp dir and link path.
 """
 
 import contextlib
+import math
 import re
 import subprocess
 import time
@@ -304,6 +305,13 @@ def _layout(board: str) -> dict:
 
 #: Registers and pins of each board (docs/board-<board>.md).
 DRV_LAYOUT = {board: _layout(board) for board in boardmap.BOARDS}
+
+
+def raw(value: float, per_unit: float, lo: int = -32768, hi: int = 32767) -> int:
+    """A sensor register's code for VALUE at PER_UNIT LSB per unit: rounded
+    to nearest (ties upward), saturated, as the simulated parts report it
+    (the datasheets' conversion)."""
+    return max(lo, min(hi, math.floor(value * per_unit + 0.5)))
 
 
 def us_to_cycles(us: float) -> float:

@@ -32,7 +32,8 @@ from pathlib import Path
 
 import pytest
 
-from conftest import SENSOR_READINGS, ControlBench, require_builds, require_slave, running
+from conftest import (SENSOR_READINGS, ControlBench, raw, require_builds, require_slave,
+                      running)
 from orfa import boardmap
 from orfa.busio import I2C
 from orfa.sim import SimBoard
@@ -61,12 +62,6 @@ def ms(t: float) -> int:
 def need(module: str, package: str):
     return pytest.importorskip(module, reason="%s is not installed (tools/setup.sh installs it)"
                                % package)
-
-
-def raw(value: float, per_unit: float, lo: int = -32768, hi: int = 32767) -> int:
-    """A register's code for VALUE at PER_UNIT LSB per unit: rounded to
-    nearest (ties upward), saturated, as the parts report it."""
-    return max(lo, min(hi, math.floor(value * per_unit + 0.5)))
 
 
 # --- the readings table -----------------------------------------------------------------

@@ -25,7 +25,6 @@ formulas, not read back from the model:
 One gateway board suffices: the parts are the simulator's, not the board's.
 """
 
-import math
 import re
 import struct
 import subprocess
@@ -35,7 +34,7 @@ import pytest
 from orfa.sim import sim_path
 from orfa.simctl import SimControlError
 
-from conftest import F_CPU, Bench, bench_running, for_each_test
+from conftest import F_CPU, Bench, bench_running, for_each_test, raw
 
 MPU, MPU2, HMC, LIS = 0xD0, 0xD2, 0x3C, 0x38
 G = 9.80665                             # m/s^2 per g
@@ -44,11 +43,6 @@ LEAD = F_CPU // 2                       # how far ahead requests are put on the 
 
 def cycles_us(us: int) -> int:
     return (F_CPU * us + 999999) // 1000000
-
-
-def raw(value: float, per_unit: float, lo: int = -32768, hi: int = 32767) -> int:
-    """The datasheets' conversion: rounded to nearest, saturated."""
-    return max(lo, min(hi, math.floor(value * per_unit + 0.5)))
 
 
 def s16_be(data: bytes):
