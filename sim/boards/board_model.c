@@ -47,6 +47,9 @@ static int bm_pin_level(const bm_port_t *p, int bit)
 
 		return bit == bm->twi_scl ? bm->twi_bus->scl : bm->twi_bus->sda;
 	}
+	if (p->uart_mask & m) {
+		return !!(p->uart_level & m);
+	}
 	if (p->ddr & m) {
 		if (p->spi_mask & m) {
 			return !!(p->spi_level & m);
@@ -88,7 +91,7 @@ static uint8_t bm_read_pin(avr_t *avr, avr_io_addr_t addr, void *param)
 	for (int b = 0; b < 8; b++) {
 		levels |= (uint8_t)(p->pin[b].level << b);
 	}
-	uint8_t own = (uint8_t)(p->ddr | p->wired);
+	uint8_t own = (uint8_t)(p->ddr | p->wired | p->uart_mask);
 
 	v = (uint8_t)((v & ~own) | (levels & own));
 	avr->data[addr] = v;
@@ -202,13 +205,26 @@ void board_model_drive(board_model_t *bm, bm_port_t *p, int bit, int level)
 	bm->activity++;
 }
 
+void board_model_uart_drive(board_model_t *bm, bm_port_t *p, int bit, int level,
+			    uint64_t cycle)
+{
+	uint8_t m = (uint8_t)(1u << bit);
+
+	p->uart_mask = (uint8_t)(level >= 0 ? (p->uart_mask | m) : (p->uart_mask & ~m));
+	p->uart_level = (uint8_t)(level > 0 ? (p->uart_level | m) : (p->uart_level & ~m));
+	board_model_port_update(p, cycle);
+	bm->activity++;
+}
+
 void board_model_pin_text(board_model_t *bm, bm_port_t *p, int bit, char *buf, int size)
 {
 	uint8_t m = (uint8_t)(1u << bit);
 	const char *how;
 
 	(void)bm;
-	if (p->ddr & m) {
+	if (p->uart_mask & m) {
+		how = "out uart";
+	} else if (p->ddr & m) {
 		how = (p->spi_mask & m) ? "out spi" : bm_pin_oc(p, bit) ? "out oc" : "out";
 	} else if (p->ext_mask & m) {
 		how = "in ext";

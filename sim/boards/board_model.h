@@ -5,7 +5,8 @@
  *  - every port pin as a signal ("A0".."G7") with cycle-exact edges. Level:
  *    output -> PORT, or the compare output while the timer's COM bits are on
  *    (from TIMER_IRQ_OUT_COMP, stamped at the compare's own cycle), or the
- *    SPI master's SCK/MOSI while SPE and MSTR; input -> the external drive,
+ *    SPI master's SCK/MOSI while SPE and MSTR; the USART's transmitter on
+ *    TXD while TXEN, whatever DDR says; input -> the external drive,
  *    else the pull-up (1) or 0 when floating without pull-up (PINx follows);
  *  - external drive of pins (0, 1 or released);
  *  - analog inputs of the ADC port, AVCC and AREF in mV;
@@ -58,6 +59,7 @@ typedef struct bm_port_t {
 	uint8_t ddr, port;		/* shadows of DDRx/PORTx */
 	uint8_t ext_mask, ext_value;	/* driven from outside */
 	uint8_t spi_mask, spi_level;	/* driven by the SPI master */
+	uint8_t uart_mask, uart_level;	/* driven by the USART's transmitter */
 	uint8_t wired;			/* the I2C bus's lines (board_model_wire_twi) */
 	signal_t pin[8];
 	bm_oc_t *oc[8][2];
@@ -129,6 +131,11 @@ int board_model_parse_pin(board_model_t *bm, const char *s, bm_port_t **port, in
 
 /* Drive a pin from outside: 0, 1, or -1 to release it. */
 void board_model_drive(board_model_t *bm, bm_port_t *p, int bit, int level);
+
+/* The USART's transmitter drives a pin over its port (LEVEL 0 or 1 from
+ * CYCLE on), or lets it go (-1). */
+void board_model_uart_drive(board_model_t *bm, bm_port_t *p, int bit, int level,
+			    uint64_t cycle);
 
 /* Analog values in mV. CH 0..7. */
 void board_model_set_adc(board_model_t *bm, int ch, uint32_t mv);

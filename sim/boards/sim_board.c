@@ -48,11 +48,20 @@ static void sim_board_reset_hook(avr_io_t *io)
 }
 
 /* The PC's waveform on the gateway's RXD pin. */
-static void sim_board_rxd(void *param, int level)
+static void sim_board_rxd(void *param, int level, avr_cycle_count_t cycle)
 {
 	sim_board_t *b = param;
 
+	(void)cycle;	/* an edge from outside: PINx sees it now */
 	board_model_drive(&b->bm, b->rxd_port, b->rxd_bit, level);
+}
+
+/* The board's frames on its TXD pin, each edge at its cycle. */
+static void sim_board_txd(void *param, int level, avr_cycle_count_t cycle)
+{
+	sim_board_t *b = param;
+
+	board_model_uart_drive(&b->bm, b->txd_port, b->txd_bit, level, cycle);
 }
 
 int sim_board_init(sim_board_t *b, const sim_board_desc_t *board, const char *elf,
@@ -118,6 +127,15 @@ int sim_board_init(sim_board_t *b, const sim_board_desc_t *board, const char *el
 		if (b->rxd_port) {
 			b->rxd_bit = rxd->bit;
 			usart_set_pin(&b->usart, sim_board_rxd, b);
+		}
+	}
+	{
+		const sim_pin_t *txd = sim_wiring_pin(&board->wiring, BF_UART_TX, 0);
+
+		b->txd_port = txd ? board_model_port(&b->bm, txd->port) : NULL;
+		if (b->txd_port) {
+			b->txd_bit = txd->bit;
+			usart_set_tx_pin(&b->usart, sim_board_txd, b);
 		}
 	}
 	b->reset_watch.kind = "orfa-reset";

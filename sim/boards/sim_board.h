@@ -37,6 +37,8 @@ typedef struct sim_board_t {
 	board_model_t bm;
 	bm_port_t *rxd_port;		/* gateway: its RXD pin, driven by the PC */
 	int rxd_bit;
+	bm_port_t *txd_port;		/* its TXD pin, driven by its USART */
+	int txd_bit;
 	uint8_t addr;			/* slave: 8-bit bus address (--slave); 0: gateway */
 	char prefix[4];			/* "": gateway; "10": a slave's signal prefix */
 } sim_board_t;

@@ -133,45 +133,61 @@ static void usart_rx_deliver(usart_t *u, uint8_t byte, int fe)
 	}
 }
 
-/* --- the PC's waveform: RXD pin and the board's receiver when rates differ */
+/* --- frames on the pins: the PC's on RXD, the board's on TXD ----------- */
 
-static avr_cycle_count_t usart_pin_timer(avr_t *avr, avr_cycle_count_t when,
-					 void *param)
+static avr_cycle_count_t usart_wave_timer(avr_t *avr, avr_cycle_count_t when,
+					  void *param)
 {
-	usart_t *u = param;
-	int level = sim_uart_frame_bit(u->pin_byte, u->pin_k);
+	usart_wave_t *w = param;
+	int level = sim_uart_frame_bit(w->byte, w->k);
 
 	(void)avr;
-	(void)when;
-	if (level != u->pin_level) {
-		u->pin_level = level;
-		u->pin(u->pin_param, level);
+	if (level != w->level) {
+		w->level = level;
+		w->pin(w->param, level, when);
 	}
-	while (++u->pin_k <= 9) {
-		if (sim_uart_frame_bit(u->pin_byte, u->pin_k) != level) {
-			return u->pin_start + (avr_cycle_count_t)u->pin_k * u->pin_bit;
+	while (++w->k <= 9) {
+		if (sim_uart_frame_bit(w->byte, w->k) != level) {
+			return w->start + (avr_cycle_count_t)w->k * w->bit;
 		}
 	}
 	return 0;
 }
 
-/* Draw a frame on RXD from its start bit, which begins now. */
-static void usart_pin_frame(usart_t *u, uint8_t byte, avr_cycle_count_t start)
+/* Draw a frame on W's pin, its start bit from START (now or a few cycles
+ * ago), BIT cycles a bit. */
+static void usart_wave_frame(avr_t *avr, usart_wave_t *w, uint8_t byte,
+			     avr_cycle_count_t start, uint32_t bit)
 {
 	avr_cycle_count_t next;
 
-	if (!u->pin) {
+	if (!w->pin) {
 		return;
 	}
-	avr_cycle_timer_cancel(u->avr, usart_pin_timer, u);
-	u->pin_start = start;
-	u->pin_bit = u->host_bit;
-	u->pin_byte = byte;
-	u->pin_k = 0;
-	next = usart_pin_timer(u->avr, start, u);
+	avr_cycle_timer_cancel(avr, usart_wave_timer, w);
+	w->start = start;
+	w->bit = bit;
+	w->byte = byte;
+	w->k = 0;
+	next = usart_wave_timer(avr, start, w);
 	if (next) {
-		avr_cycle_timer_register(u->avr, next - u->avr->cycle, usart_pin_timer, u);
+		avr_cycle_timer_register(avr, next > avr->cycle ? next - avr->cycle : 0,
+					 usart_wave_timer, w);
 	}
+}
+
+/* Cut off the frame being drawn: the pin goes idle (LEVEL 1) or is let go
+ * (-1) at cycle NOW. */
+static void usart_wave_stop(avr_t *avr, usart_wave_t *w, int level, avr_cycle_count_t now)
+{
+	if (!w->pin) {
+		return;
+	}
+	avr_cycle_timer_cancel(avr, usart_wave_timer, w);
+	if (level < 0 || w->level != level) {
+		w->pin(w->param, level, now);
+	}
+	w->level = 1;
 }
 
 static void usart_rx_dec_emit(void *param, avr_cycle_count_t when,
@@ -243,7 +259,7 @@ static void usart_rx_begin(usart_t *u, uint8_t byte, avr_cycle_count_t start,
 		sim_uart_dec_skip_to(&u->rx_dec, end);
 	}
 	sim_uart_line_push(&u->rx_line, start, u->host_bit, byte, u->rx_wire_fast);
-	usart_pin_frame(u, byte, start);
+	usart_wave_frame(u->avr, &u->rxd, byte, start, u->host_bit);
 	if (!u->rx_wire_fast) {
 		usart_rx_dec_kick(u);
 	}
@@ -417,6 +433,24 @@ static void usart_pc_dec_kick(usart_t *u)
 	}
 }
 
+/* The transmitter owns TXD while TXEN is on or a byte is still going out
+ * (the datasheet lets pending transmissions complete); it idles high. */
+static void usart_txd_update(usart_t *u, avr_cycle_count_t now)
+{
+	int own = (usart_ucsrb(u) & BIT(UCSRB_TXEN)) || u->tx_shift_busy;
+
+	if (own == u->txd_owned || !u->txd.pin) {
+		return;
+	}
+	u->txd_owned = own;
+	if (own) {
+		u->txd.level = 1;
+		u->txd.pin(u->txd.param, 1, now);
+	} else {
+		usart_wave_stop(u->avr, &u->txd, -1, now);
+	}
+}
+
 /* Move the buffer into the idle shifter: the start bit begins at WHEN. */
 static int usart_tx_load(usart_t *u, avr_cycle_count_t when)
 {
@@ -428,6 +462,7 @@ static int usart_tx_load(usart_t *u, avr_cycle_count_t when)
 	u->tx_buf_full = 0;
 	u->ucsra |= BIT(UCSRA_UDRE);
 	trace_event(u->trace, when, "uart tx %02X", u->tx_shift_byte);
+	usart_wave_frame(u->avr, &u->txd, u->tx_shift_byte, when, usart_board_bit(u));
 	/* As on the receive side: equal rates hand the PC the byte whole. */
 	if (u->pc_dec_armed) {
 		usart_pc_dec_kick(u);
@@ -461,6 +496,7 @@ static avr_cycle_count_t usart_tx_timer(avr_t *avr, avr_cycle_count_t when,
 		return when + usart_byte_cycles(u);
 	}
 	u->ucsra |= BIT(UCSRA_TXC);
+	usart_txd_update(u, when);
 	usart_sync(u);
 	return 0;
 }
@@ -556,6 +592,7 @@ static void usart_write_ucsrb(avr_t *avr, avr_io_addr_t addr, uint8_t v,
 		trace_event(u->trace, avr->cycle, "line rxen %u%s", (unsigned)u->ubrr,
 			    (u->ucsra & BIT(UCSRA_U2X)) ? " u2x" : "");
 	}
+	usart_txd_update(u, avr->cycle);
 	if (v & BIT(UCSRB_TXEN)) {
 		usart_tx_kick(u);
 	}
@@ -660,13 +697,11 @@ static void usart_reset(avr_io_t *io)
 	memset(&u->pc_dec, 0, sizeof(u->pc_dec));
 	u->rx_dec.cursor = u->pc_dec.cursor = avr->cycle;
 	u->rxen_since = avr->cycle;
-	if (u->pin && u->pin_level == 0) {
-		u->pin_level = 1;	/* the frame being drawn is cut off */
-		u->pin(u->pin_param, 1);
-	}
+	usart_wave_stop(avr, &u->rxd, 1, avr->cycle);	/* the frame being drawn is cut off */
 	u->tx_buf_full = 0;
 	u->tx_shift_busy = 0;
 	avr->data[r->ucsrb] = 0;
+	usart_txd_update(u, avr->cycle);
 	avr->data[r->ubrrl] = 0;
 	avr->data[r->ubrrh] = 0;
 	if (!sim_mcu_usart_shared_ucsrc(r)) {
@@ -686,7 +721,7 @@ void usart_init(usart_t *u, avr_t *avr, const sim_mcu_usart_t *regs,
 	u->to_host = to_host;
 	u->to_host_param = param;
 	u->io.kind = "orfa-usart";
-	u->pin_level = 1;
+	u->rxd.level = u->txd.level = 1;
 	u->host_baud = 115200;
 	u->host_bit = 64;
 	u->io.reset = usart_reset;
@@ -750,8 +785,18 @@ void usart_set_host_baud(usart_t *u, uint32_t baud)
 
 void usart_set_pin(usart_t *u, usart_pin_t pin, void *param)
 {
-	u->pin = pin;
-	u->pin_param = param;
-	u->pin_level = 1;
-	pin(param, 1);
+	u->rxd.pin = pin;
+	u->rxd.param = param;
+	u->rxd.level = 1;
+	pin(param, 1, u->avr->cycle);
+}
+
+void usart_set_tx_pin(usart_t *u, usart_pin_t pin, void *param)
+{
+	u->txd.pin = pin;
+	u->txd.param = param;
+	u->txd.level = 1;
+	u->txd_owned = 0;
+	pin(param, -1, u->avr->cycle);
+	usart_txd_update(u, u->avr->cycle);
 }

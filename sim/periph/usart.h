@@ -15,6 +15,8 @@
  * a gap long enough for a whole byte.
  * Transmit: UDR buffer plus shift register; a byte reaches the host at the
  * end of its stop bit.
+ * Pins: RXD carries the PC's frames and TXD the board's (usart_set_pin,
+ * usart_set_tx_pin), edge by edge from cycle timers.
  */
 #ifndef SIM_USART_H
 #define SIM_USART_H
@@ -39,8 +41,21 @@
 
 typedef void (*usart_to_host_t)(void *param, uint8_t byte);
 
-/* Drives the RXD pin: LEVEL 0 or 1. */
-typedef void (*usart_pin_t)(void *param, int level);
+/* Drives a pin: LEVEL 0 or 1 from CYCLE on, or -1 to let it go (TXD when
+ * the transmitter is off). */
+typedef void (*usart_pin_t)(void *param, int level, avr_cycle_count_t cycle);
+
+/* One direction's frames drawn on a pin, 8N1: start bit, eight data bits
+ * LSB first, stop bit, each BIT cycles from the start bit's edge. */
+typedef struct usart_wave_t {
+	usart_pin_t pin;		/* NULL: no pin to draw on */
+	void *param;
+	int level;
+	avr_cycle_count_t start;	/* the frame being drawn */
+	uint32_t bit;
+	uint8_t byte;
+	int k;
+} usart_wave_t;
 
 /* One scheduled byte: its start bit begins at START, it takes CYCLES. */
 typedef struct usart_inject_t {
@@ -106,13 +121,9 @@ typedef struct usart_t {
 	sim_uart_dec_t pc_dec;		/* the PC's receiver */
 	int pc_dec_armed;
 	int tx_fast;			/* the byte in the shifter reaches the PC whole */
-	usart_pin_t pin;		/* drives RXD with the PC's waveform */
-	void *pin_param;
-	int pin_level;
-	avr_cycle_count_t pin_start;	/* the frame being drawn on RXD */
-	uint32_t pin_bit;
-	uint8_t pin_byte;
-	int pin_k;
+	usart_wave_t rxd;		/* the PC's frames on RXD */
+	usart_wave_t txd;		/* the board's frames on TXD */
+	int txd_owned;			/* the transmitter drives TXD */
 
 	/* transmitter */
 	int tx_buf_full;
@@ -157,6 +168,12 @@ void usart_set_host_baud(usart_t *u, uint32_t baud);
 
 /* Draw the PC's waveform on RXD through PIN (idle high from now on). */
 void usart_set_pin(usart_t *u, usart_pin_t pin, void *param);
+
+/* Draw the board's frames on TXD through PIN: while TXEN is on (and until
+ * a pending byte has gone out after it went off) the transmitter owns the
+ * pin, idle high, each byte from the cycle its shift register takes it at
+ * the board's bit time; otherwise PIN gets -1 (the port decides). */
+void usart_set_tx_pin(usart_t *u, usart_pin_t pin, void *param);
 
 /* The board's bit time from UBRR/U2X, in cycles. */
 uint32_t usart_board_bit(const usart_t *u);

@@ -16,6 +16,7 @@ from orfa.sim import BOARDS, SimBoard
 from orfa.simctl import SimControlError
 
 RXD = {"m32d": "D0", "m128s": "D2"}
+TXD = {"m32d": "D1", "m128s": "D3"}
 #: A cycle a fresh simulator has not reached when the test asks.
 AT = 1 << 24
 #: Replies to V or a driver count take a few byte times at most.
@@ -59,6 +60,40 @@ def test_rxd_pin_shows_the_pc_waveform(board):
         assert [lv for _, lv in edges] == [lv for _, lv in want]
         assert all(0 <= c - w < 5 for (c, _), (w, _) in zip(edges, want)), edges
         port.close()
+
+
+def frame_edges(start, byte, bit):
+    """The edges of one 8N1 frame whose start bit falls at `start`."""
+    levels = [0] + [(byte >> k) & 1 for k in range(8)] + [1]
+    out, level = [], 1
+    for k, lv in enumerate(levels):
+        if lv != level:
+            out.append((start + k * bit, lv))
+            level = lv
+    return out
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_txd_pin_shows_the_board_frames(board):
+    """The reply to V at 115200 on the board's TXD pin (M32-D TXD = D1,
+    M128-S TXD1 = D3), owned by the transmitter and idle high: each byte's
+    frame from the cycle its shift register took it (the trace's `uart tx`),
+    64 cycles a bit, every edge at its exact cycle."""
+    bit = F_CPU // 115200
+    with sim_for(board) as sim, serial.Serial(sim.port, 115200, timeout=REPLY_TIMEOUT) as port:
+        ctl = sim.control
+        ctl.wait(1000)
+        assert ctl.pin(TXD[board]) == (1, "out uart")
+        assert ctl.rx(AT, b"V\r") == AT + 20 * bit
+        assert port.readline() == b"V1.1\r\n"
+        ctl.wait(AT + 20 * bit + REPLY_CYCLES - ctl.time())
+        sent = [(e.cycle, int(e.fields[0], 16)) for e in sim.trace_events(kinds=["uart tx"])
+                if e.cycle >= AT]
+        assert bytes(b for _, b in sent) == b"V1.1\r\n"
+        want = [e for start, byte in sent for e in frame_edges(start, byte, bit)]
+        assert ctl.edges(TXD[board], AT) == want
+        assert ctl.level(TXD[board]) == 1
+        assert ctl.measure(TXD[board], 20, AT) == {"steady": 1}    # the line stopped
 
 
 def resync(gw):
