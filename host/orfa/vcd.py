@@ -2,10 +2,12 @@
 
 The file holds 1-bit wires, one scope per board (`board`, `board_10` for
 the slave at 0x10, whose names carry the prefix: `10/servo3`) with a comment
-that names the board (`board m32d OR-AVR-M32-D`), a 1 ps timescale and the
-CPU clock in its first comment. Times come back as CPU
-cycles: the simulator rounds each cycle to the nearest picosecond, so
-rounding back gives the exact cycle.
+that names the board (`board m32d OR-AVR-M32-D`), a timescale no longer
+than one cycle (100 ns at 7.3728 MHz; older files 1 ps) and the CPU clock
+in its first comment. Times come back as CPU cycles: the simulator rounds
+each cycle's time to the nearest unit, at most half a unit and so less than
+half a cycle off, so rounding back gives the exact cycle (integer
+arithmetic, exact however long the file).
 
     trace = vcd.load("board.vcd")
     trace.f_cpu, trace.names(), trace.edges("servo3")   # [(cycle, level), ...]
@@ -21,7 +23,8 @@ from .errors import VcdError
 Edge = Tuple[int, int]                   # (cycle, level)
 
 _CLOCK = re.compile(r"(\d+(?:\.\d+)?)\s*Hz")
-_UNITS_PS = {"s": 10 ** 12, "ms": 10 ** 9, "us": 10 ** 6, "ns": 10 ** 3, "ps": 1, "fs": 1e-3}
+_UNITS_FS = {"s": 10 ** 15, "ms": 10 ** 12, "us": 10 ** 9, "ns": 10 ** 6, "ps": 10 ** 3, "fs": 1}
+_FS_PER_S = 10 ** 15
 
 
 class Trace:
@@ -59,15 +62,16 @@ def _tokens(lines: Iterable[str]) -> Iterator[Tuple[int, str]]:
             yield number, tok
 
 
-def _cycles(t: int, ps_per_unit: float, ps_per_cycle: float) -> int:
-    return int(round(t * ps_per_unit / ps_per_cycle))
+def _cycles(t: int, fs_per_unit: int, f_cpu: int) -> int:
+    """Time T in units of FS_PER_UNIT femtoseconds as the nearest cycle."""
+    return (2 * t * fs_per_unit * f_cpu + _FS_PER_S) // (2 * _FS_PER_S)
 
 
 def parse(text: str, where: str = "VCD") -> Trace:
     """A Trace from the text of a VCD file; VcdError names the line at fault."""
     tokens = _tokens(text.splitlines())
     f_cpu: Optional[int] = None
-    ps_per_unit: Optional[float] = None
+    fs_per_unit: Optional[int] = None
     scopes: Dict[str, List[str]] = {}
     boards: Dict[str, str] = {}              # scope -> board ("m32d"), as its comment says
     ids: Dict[str, List[str]] = {}           # id code -> names (one wire may have several)
@@ -98,7 +102,7 @@ def parse(text: str, where: str = "VCD") -> Trace:
             m = re.fullmatch(r"(1|10|100)(s|ms|us|ns|ps|fs)", words)
             if not m:
                 raise VcdError("%s:%d: timescale %r" % (where, line, words))
-            ps_per_unit = int(m.group(1)) * _UNITS_PS[m.group(2)]
+            fs_per_unit = int(m.group(1)) * _UNITS_FS[m.group(2)]
         elif tok == "$scope":
             words = block(line)
             scope.append(words[-1] if words else "?")
@@ -122,9 +126,8 @@ def parse(text: str, where: str = "VCD") -> Trace:
         raise VcdError("%s: no $enddefinitions: not a VCD" % where)
     if not f_cpu:
         raise VcdError("%s: no CPU clock in its comment: not the simulator's VCD" % where)
-    if ps_per_unit is None:
+    if fs_per_unit is None:
         raise VcdError("%s: no $timescale" % where)
-    ps_per_cycle = 1e12 / f_cpu
 
     names = [n for ns in scopes.values() for n in ns]
     initial = {n: 0 for n in names}
@@ -136,7 +139,7 @@ def parse(text: str, where: str = "VCD") -> Trace:
         first = tok[0]
         if first == "#":
             try:
-                now = _cycles(int(tok[1:]), ps_per_unit, ps_per_cycle)
+                now = _cycles(int(tok[1:]), fs_per_unit, f_cpu)
             except ValueError:
                 raise VcdError("%s:%d: time %r" % (where, line, tok)) from None
             if now > 0:

@@ -101,15 +101,47 @@ const signal_edge_t *signal_edge(const signal_t *s, unsigned i)
 
 /* --- VCD ----------------------------------------------------------------- */
 
-/* Picoseconds of CYCLE, rounded: a cycle at 7.3728 MHz is 135633.68 ps, so
- * no VCD timescale holds it exactly; 1 ps keeps the order and the error
- * below half a picosecond. The cycle of every change is also known from
- * the trace and the control interface. */
-static uint64_t vcd_ps(const vcd_t *v, uint64_t cycle)
+/*
+ * A cycle at 7.3728 MHz is 135.6337 ns, which no VCD timescale (1, 10 or
+ * 100 of s, ms, us, ns, ps, fs) holds. sigrok takes the timescale as its
+ * sample rate and walks every sample, so 1 ps made it take minutes over a
+ * simulated second. The file uses the longest power of ten not longer than
+ * a cycle (100 ns: 10 MHz, one simulated second decodes in well under a
+ * second) and rounds each cycle's time to the nearest unit: a unit being
+ * at most a cycle, distinct cycles get distinct times in order, and
+ * rounding time / cycle back gives the exact cycle (the error is at most
+ * half a unit, under half a cycle).
+ */
+uint64_t vcd_timescale_ps(uint32_t frequency)
+{
+	uint64_t unit = 1000000000ull;	/* 1 ms: a clock of 1 kHz or more */
+
+	while (unit > 1 && unit * frequency > 1000000000000ull) {
+		unit /= 10;
+	}
+	return unit;
+}
+
+static const char *vcd_timescale_text(uint64_t unit_ps, char *buf, size_t size)
+{
+	static const char *const names[] = { "ps", "ns", "us", "ms", "s" };
+	int k = 0;
+
+	while (unit_ps >= 1000 && k < 4) {
+		unit_ps /= 1000;
+		k++;
+	}
+	snprintf(buf, size, "%" PRIu64 "%s", unit_ps, names[k]);
+	return buf;
+}
+
+/* CYCLE in timescale units, rounded. */
+static uint64_t vcd_time(const vcd_t *v, uint64_t cycle)
 {
 	unsigned __int128 t = (unsigned __int128)cycle * 1000000000000ull;
+	unsigned __int128 per = (unsigned __int128)v->frequency * v->unit_ps;
 
-	return (uint64_t)((t + v->frequency / 2) / v->frequency);
+	return (uint64_t)((t + per / 2) / per);
 }
 
 static void vcd_id(int index, char *out)
@@ -124,7 +156,7 @@ int vcd_open(vcd_t *v, const char *path, uint32_t frequency, signals_t *const *s
 	     const char *const *scope, const char *const *prefix,
 	     const char *const *about, int n)
 {
-	char id[3];
+	char id[3], unit[32];
 	int base = 0;
 
 	memset(v, 0, sizeof(*v));
@@ -133,9 +165,11 @@ int vcd_open(vcd_t *v, const char *path, uint32_t frequency, signals_t *const *s
 		return -1;
 	}
 	v->frequency = frequency;
-	fprintf(v->file, "$comment orfa-sim, %" PRIu32 " Hz: one CPU cycle is %.3f ps $end\n",
+	v->unit_ps = vcd_timescale_ps(frequency);
+	fprintf(v->file, "$comment orfa-sim, %" PRIu32 " Hz: one CPU cycle is %.3f ps; "
+		"a time is the cycle's, rounded to the timescale $end\n",
 		frequency, 1e12 / frequency);
-	fprintf(v->file, "$timescale 1ps $end\n");
+	fprintf(v->file, "$timescale %s $end\n", vcd_timescale_text(v->unit_ps, unit, sizeof(unit)));
 	for (int k = 0; k < n; k++) {
 		signals_t *set = sets[k];
 
@@ -188,7 +222,7 @@ void vcd_flush(vcd_t *v, uint64_t now, int all)
 		uint64_t cycle = e->cycle < v->last ? v->last : e->cycle;
 
 		if (!v->have_time || cycle != v->last) {
-			fprintf(v->file, "#%" PRIu64 "\n", vcd_ps(v, cycle));
+			fprintf(v->file, "#%" PRIu64 "\n", vcd_time(v, cycle));
 			v->last = cycle;
 			v->have_time = 1;
 		}
@@ -205,7 +239,7 @@ void vcd_close(vcd_t *v, uint64_t now)
 		return;
 	}
 	vcd_flush(v, now, 1);
-	fprintf(v->file, "#%" PRIu64 "\n", vcd_ps(v, now));
+	fprintf(v->file, "#%" PRIu64 "\n", vcd_time(v, now));
 	fclose(v->file);
 	v->file = NULL;
 	free(v->pending);

@@ -55,6 +55,7 @@ typedef struct vcd_event_t {
 typedef struct vcd_t {
 	FILE *file;
 	uint32_t frequency;
+	uint64_t unit_ps;		/* the timescale: 1, 10, 100 ps, 1 ns, ... */
 	vcd_event_t *pending;
 	size_t npending, cap;
 	uint64_t seq, last;
@@ -82,7 +83,9 @@ void signal_listen(signal_t *s, signal_listener_t fn, void *param);
 /* The i-th newest edge held (0 = newest); NULL past the end. */
 const signal_edge_t *signal_edge(const signal_t *s, unsigned i);
 
-/* A VCD at PATH of every signal of the N sets (call after all signal_add):
+/* A VCD at PATH of every signal of the N sets (call after all signal_add),
+ * its timescale the longest power of ten not longer than one cycle at
+ * FREQUENCY (100 ns at 7.3728 MHz; vcd_timescale_ps):
  * set i in scope SCOPE[i], each signal named PREFIX[i] followed by its own
  * name, the scope's comment ABOUT[i] (ABOUT or ABOUT[i] NULL: none). 0 or
  * -1 with errno. */
@@ -94,6 +97,9 @@ int vcd_open(vcd_t *v, const char *path, uint32_t frequency, signals_t *const *s
  * with ALL). */
 #define SIGNALS_VCD_LAG 8192
 void vcd_flush(vcd_t *v, uint64_t now, int all);
+
+/* The timescale vcd_open picks at FREQUENCY, in picoseconds. */
+uint64_t vcd_timescale_ps(uint32_t frequency);
 void vcd_close(vcd_t *v, uint64_t now);
 
 #endif

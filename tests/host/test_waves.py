@@ -13,20 +13,24 @@ from orfa.cli import plot as cli_plot
 
 F = boardmap.F_CPU
 PS = 1e12 / F
+#: The simulator's timescale at 7.3728 MHz: 100 ns, the longest power of
+#: ten not longer than a cycle (135.6 ns). Older files have 1 ps.
+UNITS = {"100ns": 100000, "1ps": 1}
 
 
-def ps(cycle):
-    return int(round(cycle * PS))
+def vcd_time(cycle, unit_ps):
+    """CYCLE's time in units of UNIT_PS, rounded half up as the simulator does."""
+    return (2 * cycle * 10 ** 12 + F * unit_ps) // (2 * F * unit_ps)
 
 
 M32D_PINS = tuple("%s%d" % (p, b) for p in "ABCD" for b in range(8))
 
 
-def make_vcd(changes, names=M32D_PINS + ("servo3", "i2c"), slave=()):
+def make_vcd(changes, names=M32D_PINS + ("servo3", "i2c"), slave=(), timescale="100ns"):
     """A VCD as the simulator writes it: changes {name: [(cycle, level)]}."""
     ids = {}
     out = ["$comment orfa-sim, %d Hz: one CPU cycle is %.3f ps $end" % (F, PS),
-           "$timescale 1ps $end", "$scope module board $end"]
+           "$timescale %s $end" % timescale, "$scope module board $end"]
     for i, n in enumerate(names):
         ids[n] = chr(33 + i) + "!"
         out.append("$var wire 1 %s %s $end" % (ids[n], n))
@@ -44,7 +48,7 @@ def make_vcd(changes, names=M32D_PINS + ("servo3", "i2c"), slave=()):
     last = None
     for c, n, lv in events:
         if c != last:
-            out.append("#%d" % ps(c))
+            out.append("#%d" % vcd_time(c, UNITS[timescale]))
             last = c
         out.append("%d%s" % (lv, ids[n]))
     return "\n".join(out) + "\n"
@@ -59,6 +63,16 @@ def test_vcd_cycles_are_exact():
     assert t.names() == list(M32D_PINS) + ["servo3", "i2c"]
     assert t.edges("servo3") == SERVO
     assert t.initial["servo3"] == 0 and t.end == 306971
+
+
+@pytest.mark.parametrize("timescale", sorted(UNITS))
+def test_vcd_cycles_are_exact_at_both_timescales_over_hours(timescale):
+    """Every cycle of a stretch, consecutive ones included, and cycles ten
+    hours in come back exact from 100 ns (1.36 units a cycle) and 1 ps."""
+    far = 10 * 3600 * F + 1
+    edges = [(c, c % 2) for c in list(range(1, 3001)) + list(range(far, far + 3000))]
+    t = vcd.parse(make_vcd({"servo3": edges}, timescale=timescale))
+    assert t.edges("servo3") == edges
 
 
 def test_vcd_slave_scope_keeps_its_prefixed_names():
@@ -127,7 +141,7 @@ def test_a_zero_clock_is_no_vcd():
 def test_an_edge_at_the_files_last_time_is_drawn(tmp_path, capsys):
     pytest.importorskip("matplotlib")
     src = tmp_path / "t.vcd"
-    src.write_text(make_vcd({"B0": [(73728, 1)]}).replace("#%d\n" % ps(73728), "#%d\n" % ps(73728)))
+    src.write_text(make_vcd({"B0": [(73728, 1)]}))
     assert vcd.parse(src.read_text()).end == 73728
     assert main(["plot", str(src), "--signals", "B0", "-o", str(tmp_path / "t.png")]) == 0
     # the window is trimmed to the edge, 50 us (369 cycles) either side
