@@ -10,8 +10,9 @@ set -eu
 # `make flash`, `make fuses` and `orfa flash` (the tests use a stand-in).
 # chromium and chromium-driver: the dashboard's test drives a real headless
 # browser (Debian's; a browser that a PyPI package downloads cannot be fetched
-# on a closed network).
-APT_PACKAGES="make gcc gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-dev avrdude chromium chromium-driver"
+# on a closed network). sigrok-cli (with its protocol decoders): the tests
+# decode the simulator's VCD with sigrok's own uart decoder.
+APT_PACKAGES="make gcc gcc-avr avr-libc binutils-avr simavr libsimavr-dev libelf-dev clang libclang-rt-dev avrdude chromium chromium-driver sigrok-cli"
 # python module:pip package. matplotlib draws `orfa plot`, flask serves
 # `orfa dash` (the extras orfa[plot] and orfa[dash]), selenium drives the
 # browser in the dashboard's test.
