@@ -612,9 +612,9 @@ def autobaud_detection(board, rate, elf):
 
 def bench_autobaud(boards):
     """Detection time per rate and board (docs/protocol.md, Autobaud)."""
-    from orfa.protocol import BAUD_RATES
+    from orfa.protocol import AUTOBAUD_RATES
     elfs = {b: autobaud_elf(b) for b in boards}
-    res = {(b, r): autobaud_detection(b, r, elfs[b]) for b in boards for r in BAUD_RATES}
+    res = {(b, r): autobaud_detection(b, r, elfs[b]) for b in boards for r in AUTOBAUD_RATES}
     width = 38
     print()
     print("Autobaud (BAUD=auto): cycles from the preamble's first falling edge to the")
@@ -622,7 +622,7 @@ def bench_autobaud(boards):
     print("49152 cycles that ends it, the analysis)")
     print()
     print("%-*s" % (width, "rate") + "".join("%14s" % b for b in boards) + "%14s" % "preamble")
-    for r in BAUD_RATES:
+    for r in AUTOBAUD_RATES:
         cells = []
         for b in boards:
             cyc, right = res[(b, r)]

@@ -64,6 +64,9 @@ static int speed_of(long baud, speed_t *sp)
 	} rates[] = {
 		{2400, B2400}, {4800, B4800}, {9600, B9600}, {19200, B19200},
 		{38400, B38400}, {57600, B57600}, {115200, B115200}, {230400, B230400},
+#ifdef B460800
+		{460800, B460800},      /* Linux's; where termios has none, by number */
+#endif
 	};
 	size_t i;
 

@@ -238,7 +238,8 @@ class SimControl(Closing):
         `bit` its bit time and `board` the board's (UBRR/U2X), in cycles;
         `ubrr`, `rxen`, `since` (the cycle RXEN last went on), `fe` (frames
         with FE the firmware took from UDR), `pty` (bytes the simulator has
-        taken from the PC's port)."""
+        taken from the PC's port), `dor` (frames the
+        receiver lost to overrun: the firmware fell behind)."""
         words = self.request(self._board("line")).split()
         return {k: int(v) for k, v in zip(words[::2], words[1::2])}
 

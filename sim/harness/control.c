@@ -554,10 +554,11 @@ static int req_line(control_req_ctx_t *q)
 {
 	usart_t *u = q->c->usart;
 
-	reply_printf(q->r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u pty %u",
+	reply_printf(q->r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u pty %u dor %u",
 		     (unsigned)u->host_baud, (unsigned)u->host_bit, (unsigned)usart_board_bit(u),
 		     (unsigned)u->ubrr, usart_rxen(u), (uint64_t)u->rxen_since,
-		     (unsigned)u->fe_read, (unsigned)u->host_taken);
+		     (unsigned)u->fe_read, (unsigned)u->host_taken,
+		     (unsigned)u->rx_lost);
 	return 0;
 }
 

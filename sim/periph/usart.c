@@ -130,6 +130,7 @@ static void usart_rx_deliver(usart_t *u, uint8_t byte, int fe)
 		u->rx_shift_byte = byte;
 		u->rx_shift_fe = (uint8_t)fe;
 		u->rx_dor = 1;
+		u->rx_lost++;
 	}
 }
 

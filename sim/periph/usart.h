@@ -107,6 +107,7 @@ typedef struct usart_t {
 	uint8_t rx_last;
 	uint32_t fe_read;		/* frames with FE the firmware took from UDR */
 	uint32_t host_taken;		/* bytes taken from the PC's port (the pty) */
+	uint32_t rx_lost;		/* frames lost to receive overrun (DOR) */
 
 	/* The PC's side of the line: its rate (the pty's termios), the
 	 * waveform of both directions and the receivers at either end that

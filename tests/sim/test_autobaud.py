@@ -12,7 +12,7 @@ import random
 import pytest
 
 from conftest import REPLY_TIMEOUT, board_sent, build_gateway, require_builds
-from orfa.protocol import AUTOBAUD_PREAMBLE, BAUD_RATES, F_CPU
+from orfa.protocol import AUTOBAUD_PREAMBLE, AUTOBAUD_RATES, F_CPU
 from orfa.sim import BOARDS, SimBoard
 
 EEPROM = 0xA0
@@ -38,7 +38,7 @@ def talks(sim, gw, board, rate):
     assert line["board"] == line["bit"] == F_CPU // rate
 
 
-@pytest.mark.parametrize("rate", BAUD_RATES)
+@pytest.mark.parametrize("rate", AUTOBAUD_RATES)
 @pytest.mark.parametrize("board", BOARDS)
 def test_every_rate_is_found(board, rate):
     with start(board) as sim:

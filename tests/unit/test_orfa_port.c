@@ -222,10 +222,11 @@ static void test_open(void)
 
 /* The rates a gateway can be built for that termios has no name for go by
  * number (termios2 on Linux), and a named one after them goes back to a
- * name: the port's rate is what was asked, read on a descriptor of our own. */
+ * name (230400 and 460800: B230400, B460800): the port's rate is what was
+ * asked, read on a descriptor of our own. */
 static void test_rates_by_number(void)
 {
-	static const long rates[] = {14400, 28800, 76800, 115200};
+	static const long rates[] = {14400, 28800, 76800, 115200, 460800, 76800, 230400};
 	int fd = open(slave_path, O_RDWR | O_NOCTTY);
 	size_t i;
 

@@ -41,8 +41,8 @@ def byte(text: str) -> int:
     return value
 
 
-#: The serial rates --baud takes: Linux's named rates go up to 4000000, and
-#: the gateway runs 2400..115200 fixed, up to 460800 with BAUD=auto.
+#: The serial rates --baud takes: Linux's named rates go up to 4000000; the
+#: gateway runs protocol.BAUD_RATES (2400..460800).
 MIN_BAUD, MAX_BAUD = 50, 4000000
 #: The longest --timeout (and adc --watch interval): a reply comes within milliseconds or not at all,
 #: and an hour is far beyond any board's.
