@@ -99,21 +99,28 @@ def test_bad_orfa_baud(get_drivers, value):
                         " second (115200)\n" % value)
 
 
+def leave_in_the_board(b, data: bytes) -> None:
+    """A program writes `data` to the board's port and closes it: decided in
+    simulated time, once the simulator has taken every byte from the port."""
+    ctl = b.sim.control
+    before = ctl.line()["pty"]
+    fd = os.open(b.sim.port, os.O_RDWR | os.O_NOCTTY)
+    try:
+        os.write(fd, data)
+        ctl.wait_taken(before + len(data))
+    finally:
+        os.close(fd)
+
+
 @pytest.mark.parametrize("held", ["S AA 0", "SAA0000SAB01", "V", "# a comment"])
 def test_partial_line_left_in_the_board(get_drivers, held):
     """Someone typed part of a line in a terminal and closed it: the board
     holds it. The library's open ends it and drops its reply, so the first
     request is answered as itself (it was ERROR 03, glued to the partial
     line)."""
-    import time
     require_builds(["m32d"])
-    with running(SimBoard("m32d")) as b:
-        fd = os.open(b.sim.port, os.O_RDWR | os.O_NOCTTY)
-        try:
-            os.write(fd, held.encode())
-            time.sleep(0.3)             # into the board before the port is closed
-        finally:
-            os.close(fd)
+    with running(SimBoard("m32d", control=True)) as b:
+        leave_in_the_board(b, held.encode())
         r = get_drivers(b.sim.port)
         assert (r.returncode, r.stderr) == (0, "")
         assert r.stdout == listing(boardmap.load("m32d").drivers)
@@ -123,15 +130,9 @@ def test_partial_line_left_in_the_board(get_drivers, held):
 def test_a_held_request_without_its_line_end_does_not_run(get_drivers):
     """A whole request lacking only its line end (`S A0 10 77 P`, an EEPROM
     write) is ended by the open as an error: nothing of it runs."""
-    import time
     require_builds(["m32d"])
-    with running(SimBoard("m32d", eeproms=(0xA0,))) as b:
-        fd = os.open(b.sim.port, os.O_RDWR | os.O_NOCTTY)
-        try:
-            os.write(fd, b"S A0 10 77 P")
-            time.sleep(0.3)             # into the board before the port is closed
-        finally:
-            os.close(fd)
+    with running(SimBoard("m32d", eeproms=(0xA0,), control=True)) as b:
+        leave_in_the_board(b, b"S A0 10 77 P")
         r = get_drivers(b.sim.port)
         assert (r.returncode, r.stderr) == (0, "")
         assert b.ask("S A0 10 S A1 01 P") == b"SWASRFFP\r\n"
