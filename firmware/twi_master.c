@@ -43,7 +43,7 @@ static void twi_fence_up(void)
 /* Is the fence still up? It comes down by itself when its time is over,
  * looked at here and from the idle loop (twi_idle), so the 16-bit clock's
  * wrap (18.2 s) never makes an old fence look new. */
-static bool twi_fence_up_still(void)
+static bool twi_fence_is_up(void)
 {
 	if (twi.quiet && (uint16_t)(clock_now() - twi.quiet_t0) > TWI_QUIET_FENCE_TICKS) {
 		twi.quiet = 0;
@@ -53,13 +53,13 @@ static bool twi_fence_up_still(void)
 
 static void twi_fence_wait(void)
 {
-	while (twi_fence_up_still()) {
+	while (twi_fence_is_up()) {
 	}
 }
 
 void twi_idle(void)
 {
-	(void)twi_fence_up_still();
+	(void)twi_fence_is_up();
 }
 
 /* The transaction is given up without a STOP (that would make a slave
@@ -79,7 +79,6 @@ void twi_init(void)
 	TWCR = _BV(TWEN);
 	twi_set_khz(100);
 	/* This board may have reset in the middle of a frame. */
-	twi.open = 0;
 	twi_fence_up();
 }
 
