@@ -73,8 +73,9 @@ ISR(TWI_vect)
 	/* TWIE off before interrupts are on again, or this one would come
 	 * back at once: TWINT is a level. Writing TWINT 0 leaves it set. */
 	TWCR = (uint8_t)(TWCR & ~(_BV(TWINT) | _BV(TWIE)));
-	uint8_t before = slave_seen;
-	slave_seen = clock_now8();
+	uint8_t now = clock_now8();
+	uint8_t quiet = (uint8_t)(now - slave_seen);  /* ticks since the last event */
+	slave_seen = now;
 	sei();
 	uint8_t byte = TWDR;
 	uint8_t status = TW_STATUS;
@@ -87,7 +88,7 @@ ISR(TWI_vect)
 	 * a frame gone quiet, however soon the main loop would have looked:
 	 * then it is dropped, not applied. (A START in the middle of a frame
 	 * is a repeated START to this TWI.) */
-	if (status == TW_SR_STOP && (uint8_t)(slave_seen - before) > TWI_QUIET_DROP_TICKS) {
+	if (status == TW_SR_STOP && quiet > TWI_QUIET_DROP_TICKS) {
 		slave_fsm_drop();
 	}
 	slave_action_t act = slave_fsm_event(status, &byte);
