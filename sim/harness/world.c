@@ -3,6 +3,7 @@
  */
 #include <string.h>
 
+#include "harness/avr_step.h"
 #include "harness/world.h"
 
 void world_init(world_t *w)
@@ -42,14 +43,12 @@ static int world_run_one(world_t *w, uint64_t target)
 {
 	avr_t *avr = w->boards[0]->avr;
 
-	while (avr->cycle < target) {
-		int state = avr_run(avr);
+	int state = avr_step_until(avr, target);
 
-		if (world_state_dead(state)) {
-			w->dead = 0;
-			w->dead_state = state;
-			return 1;
-		}
+	if (world_state_dead(state)) {
+		w->dead = 0;
+		w->dead_state = state;
+		return 1;
 	}
 	w->now = avr->cycle;
 	return 0;
@@ -69,14 +68,12 @@ int world_run(world_t *w, uint64_t target)
 		for (int i = 0; i < w->nboards; i++) {
 			avr_t *avr = w->boards[i]->avr;
 
-			while (avr->cycle < end) {
-				int state = avr_run(avr);
+			int state = avr_step_until(avr, end);
 
-				if (world_state_dead(state)) {
-					w->dead = i;
-					w->dead_state = state;
-					return 1;
-				}
+			if (world_state_dead(state)) {
+				w->dead = i;
+				w->dead_state = state;
+				return 1;
 			}
 		}
 		w->now = end;
