@@ -17,15 +17,10 @@ static inline int avr_step_timer_due(const avr_t *avr)
 	return t && t->when <= avr->cycle;
 }
 
-/* One avr_callback_run_raw(), with the timers skipped when none is due. */
-static inline void avr_step_one(avr_t *avr)
+void avr_step_after(avr_t *avr, avr_flashaddr_t new_pc)
 {
-	avr_flashaddr_t new_pc = avr->pc;
 	avr_cycle_count_t sleep = 0;
 
-	if (avr->state == cpu_Running) {
-		new_pc = avr_run_one(avr);
-	}
 	if (avr->state == cpu_Sleeping || avr_step_timer_due(avr)) {
 		sleep = avr_cycle_timer_process(avr);
 	}
@@ -45,6 +40,17 @@ static inline void avr_step_one(avr_t *avr)
 	if ((avr->state == cpu_Running || avr->state == cpu_Sleeping) && avr->interrupt_state) {
 		avr_service_interrupts(avr);
 	}
+}
+
+/* One avr_callback_run_raw(), with the timers skipped when none is due. */
+static inline void avr_step_one(avr_t *avr)
+{
+	avr_flashaddr_t new_pc = avr->pc;
+
+	if (avr->state == cpu_Running) {
+		new_pc = avr_run_one(avr);
+	}
+	avr_step_after(avr, new_pc);
 }
 
 int avr_step_until(avr_t *avr, uint64_t end)

@@ -13,6 +13,10 @@
 
 #include "sim_avr.h"
 
+/* What avr_callback_run_raw() does after an instruction: the timers due,
+ * the PC to NEW_PC, sleep, the interrupts. */
+void avr_step_after(avr_t *avr, avr_flashaddr_t new_pc);
+
 /* Run AVR until its cycle reaches END (the instruction that crosses it
  * completes). Returns the MCU's state: cpu_Done or cpu_Crashed end the
  * run at once. */

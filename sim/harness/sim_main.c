@@ -49,6 +49,7 @@ typedef struct sim_t {
 	vcd_t vcd;
 	control_t control;
 	int idle_throttle;
+	int no_park;			/* --no-park: run every board every quantum */
 } sim_t;
 
 static volatile sig_atomic_t sim_stop;
@@ -83,7 +84,7 @@ static void sim_usage(void)
 	fprintf(stderr,
 		"usage: orfa-sim --board %s --link PATH [--part KIND@ADDR[:OPTIONS]]...\n"
 		"                [--eeprom ADDR[:wp]]... [--srf08 ADDR]...\n"
-		"                [--trace FILE] [--no-idle-throttle] [--control PATH]\n"
+		"                [--trace FILE] [--no-idle-throttle] [--no-park] [--control PATH]\n"
 		"                [--vcd FILE] [--spi [SLAVE/]KIND@PIN[:mode=N][:lsb]]...\n"
 		"                [--adc CH=MV]... [--avcc MV] [--aref MV]\n"
 		"                [--slave BOARD:ADDR:ELF]... GATEWAY.elf\n"
@@ -344,6 +345,7 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		{ "part", required_argument, NULL, 'P' },
 		{ "trace", required_argument, NULL, 't' },
 		{ "no-idle-throttle", no_argument, NULL, 'n' },
+		{ "no-park", no_argument, NULL, 'N' },
 		{ "control", required_argument, NULL, 'c' },
 		{ "vcd", required_argument, NULL, 'v' },
 		{ "spi", required_argument, NULL, 's' },
@@ -383,6 +385,9 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 			break;
 		case 'n':
 			sim->idle_throttle = 0;
+			break;
+		case 'N':
+			sim->no_park = 1;
 			break;
 		case 'c':
 			args->control = optarg;
@@ -494,6 +499,7 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	int rc;
 
 	world_init(w);
+	w->no_park = sim->no_park;
 	if (args->trace && trace_open(&w->trace, args->trace) < 0) {
 		fprintf(stderr, "orfa-sim: cannot write trace '%s': %s\n",
 			args->trace, strerror(errno));

@@ -54,6 +54,17 @@ static int world_run_one(world_t *w, uint64_t target)
 	return 0;
 }
 
+/* Every parked board leaves its loop: between runs the boards are as
+ * lock-step left them, for the control interface and the next run. */
+static void world_unpark(world_t *w)
+{
+	for (int i = 0; i < w->nboards; i++) {
+		if (w->park[i].parked) {
+			park_leave(&w->park[i], w->boards[i]->avr);
+		}
+	}
+}
+
 int world_run(world_t *w, uint64_t target)
 {
 	if (w->nboards == 1) {
@@ -67,17 +78,26 @@ int world_run(world_t *w, uint64_t target)
 		}
 		for (int i = 0; i < w->nboards; i++) {
 			avr_t *avr = w->boards[i]->avr;
+			park_t *park = &w->park[i];
+			int state;
 
-			int state = avr_step_until(avr, end);
-
+			if (park->parked && !park_advance(park, avr, end)) {
+				continue;
+			}
+			state = avr_step_until(avr, end);
 			if (world_state_dead(state)) {
 				w->dead = i;
 				w->dead_state = state;
+				world_unpark(w);
 				return 1;
+			}
+			if (!w->no_park && avr->cycle >= park->retry_at) {
+				park_try(park, avr);
 			}
 		}
 		w->now = end;
 	}
+	world_unpark(w);
 	return 0;
 }
 

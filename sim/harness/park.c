@@ -1,0 +1,483 @@
+/*
+ * park.c: parked boards (park.h). The trial turn runs instruction by
+ * instruction with simavr's avr_run_one(), each instruction first decoded
+ * here and refused unless it is one a parked loop may hold; timers are not
+ * processed (the trial stops before the first one falls due) and no
+ * interrupt is pending, so avr_run_one() alone is what avr_run() would do.
+ */
+#include <string.h>
+
+#include "harness/park.h"
+
+#include "sim_core.h"
+
+#include "harness/avr_step.h"
+
+#define PARK_BACKOFF_MIN 16
+#define PARK_BACKOFF_MAX 4096
+
+/* --- which instructions a parked loop may hold ------------------------------ */
+
+/* A data address that is plain SRAM: no I/O handler, no IRQ (simavr passes
+ * addresses below 31 + MAX_IOs through the I/O table). */
+static int park_plain(const avr_t *avr, uint32_t a)
+{
+	if (a <= avr->ioend || a > avr->ramend) {
+		return 0;
+	}
+	if (a < 31 + MAX_IOs) {
+		const avr_io_addr_t io = AVR_DATA_TO_IO(a);
+
+		return !avr->io[io].r.c && !avr->io[io].w.c && !avr->io[io].irq;
+	}
+	return 1;
+}
+
+/* A store of V at A that changes nothing. */
+static int park_same(const avr_t *avr, uint32_t a, uint8_t v)
+{
+	return park_plain(avr, a) && avr->data[a] == v;
+}
+
+static uint16_t park_r16(const avr_t *avr, int r)
+{
+	return (uint16_t)(avr->data[r] | avr->data[r + 1] << 8);
+}
+
+static uint16_t park_sp(const avr_t *avr)
+{
+	return park_r16(avr, R_SPL);
+}
+
+/* A call pushes the return address RET (words): low byte at SP, high below. */
+static int park_call(const avr_t *avr, uint32_t ret)
+{
+	uint16_t sp = park_sp(avr);
+
+	return park_same(avr, sp, (uint8_t)ret) && park_same(avr, (uint16_t)(sp - 1), (uint8_t)(ret >> 8));
+}
+
+/* LD/ST through X, Y or Z (with post-increment or pre-decrement) and
+ * LDS/STS, PUSH/POP: the low nibble of 1001 00sd dddd xxxx. */
+static int park_ldst(const avr_t *avr, uint16_t op, uint16_t op2)
+{
+	int d = (op >> 4) & 0x1f, store = op & 0x0200;
+	uint32_t a;
+
+	switch (op & 0x000f) {
+	case 0x0: a = op2; break;				/* LDS, STS */
+	case 0x1: a = park_r16(avr, 30); break;			/* Z+ */
+	case 0x2: a = (uint16_t)(park_r16(avr, 30) - 1); break;	/* -Z */
+	case 0x9: a = park_r16(avr, 28); break;			/* Y+ */
+	case 0xa: a = (uint16_t)(park_r16(avr, 28) - 1); break;	/* -Y */
+	case 0xc: case 0xd: a = park_r16(avr, 26); break;	/* X, X+ */
+	case 0xe: a = (uint16_t)(park_r16(avr, 26) - 1); break;	/* -X */
+	case 0xf: a = store ? park_sp(avr) : park_sp(avr) + 1u; break;	/* PUSH, POP */
+	case 0x4: case 0x5: case 0x6: case 0x7:
+		return !store;					/* LPM, ELPM Z(+) */
+	default:
+		return 0;
+	}
+	return store ? park_same(avr, a, avr->data[d]) : park_plain(avr, a);
+}
+
+/* 1001 0101 xxxx 1000 and 1001 0100 sss 1000: returns, SLEEP, WDR, LPM,
+ * SREG bits (not I). */
+static int park_misc(const avr_t *avr, uint16_t op, int *wdr)
+{
+	uint16_t sp = park_sp(avr);
+
+	switch (op) {
+	case 0x9508:	/* RET */
+		return park_plain(avr, sp + 1u) && park_plain(avr, sp + 2u);
+	case 0x95a8:	/* WDR */
+		*wdr = 1;
+		return 1;
+	case 0x95c8:	/* LPM */
+	case 0x95d8:	/* ELPM */
+		return 1;
+	case 0x9478:	/* SEI */
+	case 0x94f8:	/* CLI */
+		return 0;
+	default:	/* BSET/BCLR of another flag; RETI, SLEEP, BREAK, SPM: no */
+		return (op & 0xff0f) == 0x9408;
+	}
+}
+
+/* 1001 xxxx xxxx xxxx. */
+static int park_op9(const avr_t *avr, avr_flashaddr_t pc, uint16_t op, uint16_t op2, int *wdr)
+{
+	if ((op & 0xfc00) == 0x9000) {
+		return park_ldst(avr, op, op2);
+	}
+	if ((op & 0xfe00) == 0x9400) {
+		switch (op & 0x000f) {
+		case 0x0: case 0x1: case 0x2: case 0x3:	/* COM NEG SWAP INC */
+		case 0x5: case 0x6: case 0x7: case 0xa:	/* ASR LSR ROR DEC */
+		case 0xc: case 0xd:			/* JMP */
+			return 1;
+		case 0xe: case 0xf:			/* CALL */
+			return park_call(avr, (pc + 4) >> 1);
+		case 0x8:
+			return park_misc(avr, op, wdr);
+		case 0x9:
+			if (op == 0x9409) {		/* IJMP */
+				return 1;
+			}
+			return op == 0x9509 && park_call(avr, (pc + 2) >> 1);	/* ICALL */
+		default:
+			return 0;
+		}
+	}
+	if ((op & 0xfe00) == 0x9600) {			/* ADIW, SBIW */
+		return 1;
+	}
+	return (op & 0xfc00) == 0x9c00;			/* MUL; not CBI SBI SBIC SBIS */
+}
+
+/* May the instruction at PC be in a parked loop? WDR sets *WDR. */
+static int park_op_ok(const avr_t *avr, avr_flashaddr_t pc, int *wdr)
+{
+	uint16_t op, op2;
+
+	if (pc + 3 >= avr->flashend) {
+		return 0;
+	}
+	op = (uint16_t)(avr->flash[pc] | avr->flash[pc + 1] << 8);
+	op2 = (uint16_t)(avr->flash[pc + 2] | avr->flash[pc + 3] << 8);
+	switch (op & 0xf000) {
+	case 0x8000: case 0xa000: {			/* LDD, STD (Y/Z + q) */
+		uint16_t q = (uint16_t)(((op >> 8) & 0x20) | ((op >> 7) & 0x18) | (op & 7));
+		uint32_t a = park_r16(avr, (op & 8) ? 28 : 30) + q;
+
+		return (op & 0x0200) ? park_same(avr, a, avr->data[(op >> 4) & 0x1f]) :
+		       park_plain(avr, a);
+	}
+	case 0x9000:
+		return park_op9(avr, pc, op, op2, wdr);
+	case 0xb000:					/* IN from SREG only */
+		return !(op & 0x0800) && (((op >> 5) & 0x30) | (op & 0xf)) == 0x3f;
+	case 0xd000:					/* RCALL */
+		return park_call(avr, (pc + 2) >> 1);
+	default:	/* register and immediate ALU, branches, skips, RJMP, LDI */
+		return 1;
+	}
+}
+
+/* --- the board's state at a boundary ----------------------------------------- */
+
+static void park_save(park_point_t *pt, const avr_t *avr, uint64_t start)
+{
+	pt->pc = avr->pc;
+	pt->off = (uint32_t)(avr->cycle - start);
+	memcpy(pt->regs, avr->data, sizeof(pt->regs));
+	memcpy(pt->io, avr->data + R_SPL, sizeof(pt->io));
+	memcpy(pt->sreg, avr->sreg, sizeof(pt->sreg));
+}
+
+static void park_load(const park_point_t *pt, avr_t *avr)
+{
+	avr->pc = pt->pc;
+	memcpy(avr->data, pt->regs, sizeof(pt->regs));
+	memcpy(avr->data + R_SPL, pt->io, sizeof(pt->io));
+	memcpy(avr->sreg, pt->sreg, sizeof(pt->sreg));
+}
+
+static int park_same_point(const park_point_t *a, const park_point_t *b)
+{
+	return a->pc == b->pc && !memcmp(a->regs, b->regs, sizeof(a->regs)) &&
+	       !memcmp(a->io, b->io, sizeof(a->io)) && !memcmp(a->sreg, b->sreg, sizeof(a->sreg));
+}
+
+/* --- the cycle timers --------------------------------------------------------- */
+
+typedef struct park_timers_t {
+	avr_cycle_timer_t fn[MAX_CYCLE_TIMERS];
+	void *param[MAX_CYCLE_TIMERS];
+	uint64_t when[MAX_CYCLE_TIMERS];
+	int n;
+} park_timers_t;
+
+static void park_timers(park_timers_t *t, const avr_t *avr)
+{
+	t->n = 0;
+	for (const avr_cycle_timer_slot_t *s = avr->cycle_timers.timer;
+	     s && t->n < MAX_CYCLE_TIMERS; s = s->next) {
+		t->fn[t->n] = s->timer;
+		t->param[t->n] = s->param;
+		t->when[t->n] = s->when;
+		t->n++;
+	}
+}
+
+static int park_find(const park_timers_t *t, avr_cycle_timer_t fn, void *param)
+{
+	for (int i = 0; i < t->n; i++) {
+		if (t->fn[i] == fn && t->param[i] == param) {
+			return i;
+		}
+	}
+	return -1;
+}
+
+/* Put every timer of BEFORE whose due cycle changed back where it was. */
+static void park_timers_back(avr_t *avr, const park_timers_t *before)
+{
+	park_timers_t now;
+
+	park_timers(&now, avr);
+	for (int i = 0; i < before->n; i++) {
+		int k = park_find(&now, before->fn[i], before->param[i]);
+
+		if (k < 0 || now.when[k] != before->when[i]) {
+			avr_cycle_timer_register(avr, before->when[i] - avr->cycle, before->fn[i],
+						 before->param[i]);
+		}
+	}
+}
+
+/* After the trial turn: the timers are BEFORE's, but for at most the one
+ * the WDR moved by the turn's length; it and the first timer are noted.
+ * 0 when they are not so. */
+static int park_timers_check(park_t *p, const avr_t *avr, const park_timers_t *before,
+			     int saw_wdr)
+{
+	park_timers_t now;
+	int moved = -1;
+
+	park_timers(&now, avr);
+	if (now.n != before->n || now.n == 0) {
+		return 0;
+	}
+	for (int i = 0; i < now.n; i++) {
+		int k = park_find(before, now.fn[i], now.param[i]);
+
+		if (k < 0) {
+			return 0;
+		}
+		if (now.when[i] != before->when[k]) {
+			if (moved >= 0 || !saw_wdr || now.when[i] != before->when[k] + p->len) {
+				return 0;
+			}
+			moved = i;
+		}
+	}
+	/* the first timer is one the loop leaves alone, and due first */
+	if (moved == 0) {
+		return 0;
+	}
+	p->limit = now.when[0];
+	p->head = avr->cycle_timers.timer;
+	p->head_when = now.when[0];
+	if (moved > 0) {
+		p->wd_fn = now.fn[moved];
+		p->wd_param = now.param[moved];
+		p->wd_when = now.when[moved] - p->len;
+		if (p->wd_when <= p->limit) {
+			return 0;
+		}
+	} else {
+		p->wdr = -1;
+	}
+	return 1;
+}
+
+/* --- trying, advancing, leaving ------------------------------------------------ */
+
+static int park_fail(park_t *p, avr_t *avr, const park_timers_t *before, int ran)
+{
+	if (ran) {
+		park_load(&p->pt[0], avr);
+		avr->cycle = p->first;
+		avr->state = cpu_Running;
+		park_timers_back(avr, before);
+	}
+	p->retry_at = avr->cycle + p->backoff;
+	if (p->backoff < PARK_BACKOFF_MAX) {
+		p->backoff *= 2;
+	}
+	return 0;
+}
+
+int park_try(park_t *p, avr_t *avr)
+{
+	park_timers_t before;
+	int saw_wdr = 0;
+
+	if (avr->cycle < p->retry_at) {
+		return 0;
+	}
+	if (!p->backoff) {
+		p->backoff = PARK_BACKOFF_MIN;
+	}
+	if (avr->state != cpu_Running || avr->interrupt_state || !avr->sreg[S_I] ||
+	    avr->address_size != 2 || avr->run != avr_callback_run_raw || avr->gdb ||
+	    !park_plain(avr, park_sp(avr) - 1u) || !avr->cycle_timers.timer) {
+		return park_fail(p, avr, NULL, 0);
+	}
+	/* SP lives in plain cells: push, pop, call and return change nothing else */
+	for (uint16_t a = R_SPL; a <= R_SPH; a++) {
+		const avr_io_addr_t io = AVR_DATA_TO_IO(a);
+
+		if (avr->io[io].w.c || avr->io[io].irq) {
+			return park_fail(p, avr, NULL, 0);
+		}
+	}
+	park_timers(&before, avr);
+	p->first = avr->cycle;
+	p->wdr = -1;
+	park_save(&p->pt[0], avr, p->first);
+	for (int i = 0; i < PARK_MAX_STEPS; i++) {
+		int wdr = 0;
+
+		if (!park_op_ok(avr, avr->pc, &wdr) || (wdr && saw_wdr)) {
+			return park_fail(p, avr, &before, 1);
+		}
+		if (wdr) {
+			saw_wdr = 1;
+			p->wdr = i;
+		}
+		avr->pc = avr_run_one(avr);
+		if (avr->state != cpu_Running || avr->interrupt_state ||
+		    avr->cycle - p->first > PARK_MAX_CYCLES ||
+		    avr->cycle >= avr->cycle_timers.timer->when) {
+			return park_fail(p, avr, &before, 1);
+		}
+		park_save(&p->pt[i + 1], avr, p->first);
+		if (avr->pc != p->pt[0].pc) {
+			continue;
+		}
+		/* back at the start: the same state, and the timers as they were */
+		p->n = i + 1;
+		p->len = p->pt[i + 1].off;
+		if (!park_same_point(&p->pt[i + 1], &p->pt[0]) ||
+		    !park_timers_check(p, avr, &before, saw_wdr)) {
+			return park_fail(p, avr, &before, 1);
+		}
+		/* parked where the trial began: the lock-step's boundary */
+		for (int k = 0; k <= p->n; k++) {
+			p->off[k] = (uint16_t)p->pt[k].off;
+		}
+		for (uint32_t d = 0, k = 0; d <= p->len; d++) {
+			while (p->off[k] < d) {
+				k++;
+			}
+			p->next[d] = (uint8_t)k;
+		}
+		avr->cycle = p->first;
+		p->start = p->first;
+		p->j = 0;
+		p->parked = 1;
+		p->backoff = PARK_BACKOFF_MIN;
+		return 1;
+	}
+	return park_fail(p, avr, &before, 1);
+}
+
+/* The watchdog timer where the loop's last WDR has put it (the turn at
+ * P->start, boundary P->j). */
+static void park_wd(const park_t *p, avr_t *avr)
+{
+	uint64_t when = p->wd_when + (p->start - p->first) + (p->j > p->wdr ? p->len : 0);
+
+	avr_cycle_timer_register(avr, when - avr->cycle, p->wd_fn, p->wd_param);
+}
+
+/* The first timer, one the loop leaves alone: due first. 0 if not so. */
+static int park_head(park_t *p, const avr_t *avr)
+{
+	const avr_cycle_timer_slot_t *h = avr->cycle_timers.timer;
+
+	if (!h || (p->wdr >= 0 && h->timer == p->wd_fn && h->param == p->wd_param)) {
+		return 0;
+	}
+	p->head = h;
+	p->head_when = h->when;
+	p->limit = h->when;
+	return 1;
+}
+
+/* The boundary at or past cycle CYC, which is past where the board stands. */
+static void park_seek(const park_t *p, uint64_t cyc, uint64_t *start, int *j)
+{
+	uint64_t s = p->start, d = cyc - s;
+	int k;
+
+	while (d > p->len) {
+		s += p->len;
+		d -= p->len;
+	}
+	k = p->next[d];
+	if (k == p->n) {
+		s += p->len;
+		k = 0;
+	}
+	*start = s;
+	*j = k;
+}
+
+/* A timer falls due at boundary J of the turn at START: the board is put
+ * there as the instruction ending there left it, and what avr_run() does
+ * after an instruction is done. 1 when it stays parked: no interrupt, the
+ * loop's PC, and the next timer again one the loop leaves alone. */
+static int park_fire(park_t *p, avr_t *avr, uint64_t start, int j)
+{
+	const park_point_t *pt = &p->pt[j];
+
+	p->start = start;
+	p->j = j;
+	park_load(pt, avr);
+	avr->cycle = start + pt->off;
+	if (p->wdr >= 0) {
+		park_wd(p, avr);
+	}
+	avr->pc = p->pt[j ? j - 1 : p->n - 1].pc;	/* as avr_run_one() left it */
+	avr_step_after(avr, pt->pc);
+	if (avr->state != cpu_Running || avr->interrupt_state || avr->pc != pt->pc ||
+	    !park_head(p, avr)) {
+		p->parked = 0;
+		p->retry_at = 0;
+		return 0;
+	}
+	return 1;
+}
+
+int park_advance(park_t *p, avr_t *avr, uint64_t end)
+{
+	if (avr->interrupt_state || avr->state != cpu_Running ||
+	    avr->cycle_timers.timer != p->head || p->head->when != p->head_when) {
+		park_leave(p, avr);
+		return 1;
+	}
+	while (avr->cycle < end) {
+		uint64_t start;
+		int j;
+
+		park_seek(p, end, &start, &j);
+		if (start + p->off[j] < p->limit) {
+			p->start = start;
+			p->j = j;
+			avr->cycle = start + p->off[j];
+			return 0;
+		}
+		park_seek(p, p->limit, &start, &j);
+		if (!park_fire(p, avr, start, j)) {
+			return 1;
+		}
+	}
+	return 0;
+}
+
+void park_leave(park_t *p, avr_t *avr)
+{
+	const park_point_t *pt = &p->pt[p->j];
+
+	park_load(pt, avr);
+	avr->cycle = p->start + pt->off;
+	if (p->wdr >= 0) {
+		park_wd(p, avr);
+	}
+	p->parked = 0;
+	p->retry_at = 0;
+}
+

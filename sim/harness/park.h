@@ -1,0 +1,80 @@
+/*
+ * park.h: a board idling in a loop is not run, it is parked: its place in
+ * the loop follows world time, exactly (docs/simulator.md, "Parked boards").
+ *
+ * A board is parked once one turn of the loop it is in has been run (on
+ * trial, and undone if it fails) and found to change nothing: every
+ * instruction only reads SRAM, registers, flash and SREG, every store
+ * writes the value already there (a call's return address), no interrupt
+ * is pending, none is enabled or disabled, and the turn ends at the same
+ * PC with the same registers, stack pointer and SREG. Each turn is then
+ * the same instructions with the same cycle counts, until something from
+ * outside the loop happens: one of the board's cycle timers falls due, an
+ * interrupt is raised (by the bus, another board), a cycle timer is set
+ * from outside. Parked, the board moves from one instruction boundary of
+ * the recorded turn to the next as world time passes, and its cycle is the
+ * one lock-step would give it, so the bus and the other boards see it
+ * where they always did. It leaves the loop at the boundary where it
+ * stands (registers, SREG, stack pointer, PC of that boundary put back,
+ * and the watchdog timer that the loop's WDR moves set where the last WDR
+ * would have put it), then runs normally: before a timer falls due, when
+ * an interrupt is pending or a timer was set, and at the end of every
+ * world_run().
+ */
+#ifndef SIM_PARK_H
+#define SIM_PARK_H
+
+#include <stdint.h>
+
+#include "sim_avr.h"
+
+#define PARK_MAX_STEPS 48	/* instructions in a loop's turn */
+#define PARK_MAX_CYCLES 256	/* its cycles */
+
+/* The board at an instruction boundary of the turn. */
+typedef struct park_point_t {
+	avr_flashaddr_t pc;
+	uint32_t off;			/* cycles from the turn's start */
+	uint8_t regs[32];		/* r0..r31 */
+	uint8_t io[3];			/* SPL, SPH and the SREG cell */
+	uint8_t sreg[8];		/* simavr's SREG bits */
+} park_point_t;
+
+typedef struct park_t {
+	/* where the parked board stands (read every quantum: kept together) */
+	int parked;
+	int j;				/* boundary: before instruction j */
+	uint64_t start;			/* the current turn's start */
+	uint64_t limit;			/* the first cycle timer's due cycle */
+	const avr_cycle_timer_slot_t *head;	/* the timer list's head then */
+	uint64_t head_when;
+	uint32_t len;			/* the turn's cycles */
+	int n;				/* its instructions */
+	uint16_t off[PARK_MAX_STEPS + 1];	/* boundary j: cycles from the turn's start */
+	uint8_t next[PARK_MAX_CYCLES + 1];	/* cycle d of the turn: first boundary at or past it */
+
+	/* the turn */
+	int wdr;			/* index of its WDR, -1: none (or no watchdog) */
+	avr_cycle_timer_t wd_fn;	/* the timer the WDR moves */
+	void *wd_param;
+	uint64_t wd_when;		/* its due cycle at the first turn's start */
+	uint64_t first;			/* the first turn's start */
+	park_point_t pt[PARK_MAX_STEPS + 1];
+
+	uint64_t retry_at;		/* no new try before this cycle */
+	uint32_t backoff;		/* cycles to the next try after a failed one */
+} park_t;
+
+/* After a normal run: park AVR if it idles in a loop (and a try is due).
+ * Returns 1 when parked (its cycle unchanged). */
+int park_try(park_t *p, avr_t *avr);
+
+/* A parked board's turn in the lock-step, to quantum END: 0 when it stays
+ * parked (its cycle the first boundary at or past END), 1 when it left the
+ * loop: the caller runs it normally to END. */
+int park_advance(park_t *p, avr_t *avr, uint64_t end);
+
+/* A parked board leaves the loop where it stands. */
+void park_leave(park_t *p, avr_t *avr);
+
+#endif
