@@ -17,13 +17,11 @@ static inline int avr_step_timer_due(const avr_t *avr)
 	return t && t->when <= avr->cycle;
 }
 
-void avr_step_after(avr_t *avr, avr_flashaddr_t new_pc)
+/* The rare part of avr_step_after(): a timer due, or sleep. */
+static void avr_step_slow(avr_t *avr, avr_flashaddr_t new_pc)
 {
-	avr_cycle_count_t sleep = 0;
+	avr_cycle_count_t sleep = avr_cycle_timer_process(avr);
 
-	if (avr->state == cpu_Sleeping || avr_step_timer_due(avr)) {
-		sleep = avr_cycle_timer_process(avr);
-	}
 	avr->pc = new_pc;
 	if (avr->state == cpu_Sleeping) {
 		if (!avr->sreg[S_I]) {
@@ -42,25 +40,41 @@ void avr_step_after(avr_t *avr, avr_flashaddr_t new_pc)
 	}
 }
 
-/* One avr_callback_run_raw(), with the timers skipped when none is due. */
-static inline void avr_step_one(avr_t *avr)
+static inline void avr_step_after_inline(avr_t *avr, avr_flashaddr_t new_pc)
 {
-	avr_flashaddr_t new_pc = avr->pc;
-
-	if (avr->state == cpu_Running) {
-		new_pc = avr_run_one(avr);
+	if (__builtin_expect(avr->state == cpu_Sleeping || avr_step_timer_due(avr), 0)) {
+		avr_step_slow(avr, new_pc);
+		return;
 	}
-	avr_step_after(avr, new_pc);
+	avr->pc = new_pc;
+	if (avr->interrupt_state && avr->state == cpu_Running) {
+		avr_service_interrupts(avr);
+	}
+}
+
+void avr_step_after(avr_t *avr, avr_flashaddr_t new_pc)
+{
+	avr_step_after_inline(avr, new_pc);
 }
 
 int avr_step_until(avr_t *avr, uint64_t end)
 {
-	while (avr->cycle < end) {
-		if (avr->run != avr_callback_run_raw) {
-			avr_run(avr);	/* a gdb or another run loop: simavr's own */
-		} else {
-			avr_step_one(avr);
+	if (avr->run != avr_callback_run_raw) {
+		while (avr->cycle < end) {	/* a gdb or another run loop: simavr's own */
+			avr_run(avr);
+			if (avr->state == cpu_Done || avr->state == cpu_Crashed) {
+				break;
+			}
 		}
+		return avr->state;
+	}
+	while (avr->cycle < end) {
+		avr_flashaddr_t new_pc = avr->pc;
+
+		if (avr->state == cpu_Running) {
+			new_pc = avr_run_one(avr);
+		}
+		avr_step_after_inline(avr, new_pc);
 		if (avr->state == cpu_Done || avr->state == cpu_Crashed) {
 			break;
 		}

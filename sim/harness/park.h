@@ -74,6 +74,36 @@ int park_try(park_t *p, avr_t *avr);
  * loop: the caller runs it normally to END. */
 int park_advance(park_t *p, avr_t *avr, uint64_t end);
 
+/* park_advance(), 0 or 1 the other way round, with its common case
+ * inline: nothing from outside, no timer due before the boundary. */
+static inline int park_stays(park_t *p, avr_t *avr, uint64_t end)
+{
+	uint64_t start = p->start, d = end - start, at;
+	int j;
+
+	if (avr->interrupt_state || avr->cycle_timers.timer != p->head ||
+	    p->head->when != p->head_when || avr->cycle >= end || d > 2 * (uint64_t)p->len) {
+		return !park_advance(p, avr, end);
+	}
+	if (d > p->len) {
+		start += p->len;
+		d -= p->len;
+	}
+	j = p->next[d];
+	if (j == p->n) {
+		start += p->len;
+		j = 0;
+	}
+	at = start + p->off[j];
+	if (at >= p->limit) {
+		return !park_advance(p, avr, end);
+	}
+	p->start = start;
+	p->j = j;
+	avr->cycle = at;
+	return 1;
+}
+
 /* A parked board leaves the loop where it stands. */
 void park_leave(park_t *p, avr_t *avr);
 

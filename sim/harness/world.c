@@ -81,7 +81,7 @@ int world_run(world_t *w, uint64_t target)
 			park_t *park = &w->park[i];
 			int state;
 
-			if (park->parked && !park_advance(park, avr, end)) {
+			if (park->parked && park_stays(park, avr, end)) {
 				continue;
 			}
 			state = avr_step_until(avr, end);
