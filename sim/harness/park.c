@@ -14,7 +14,7 @@
 #include "harness/avr_step.h"
 
 #define PARK_BACKOFF_MIN 16
-#define PARK_BACKOFF_MAX 4096
+#define PARK_BACKOFF_MAX 128
 
 /* --- which instructions a parked loop may hold ------------------------------ */
 
@@ -30,6 +30,34 @@ static int park_plain(const avr_t *avr, uint32_t a)
 
 		return !avr->io[io].r.c && !avr->io[io].w.c && !avr->io[io].irq;
 	}
+	return 1;
+}
+
+/* What an instruction does besides registers and SRAM. */
+typedef struct park_op_t {
+	int wdr;		/* it is a WDR */
+	uint16_t io;		/* the I/O register it reads (0: none) */
+} park_op_t;
+
+/* A load from A: SRAM, SREG, or an I/O register read without a handler
+ * (its value then noted in O->io: the loop depends on it). */
+static int park_read(const avr_t *avr, uint32_t a, park_op_t *o)
+{
+	if (a > avr->ioend) {
+		return park_plain(avr, a);
+	}
+	if (a == R_SREG) {
+		return 1;
+	}
+	if (a < 32) {
+		return 0;
+	}
+	const avr_io_addr_t io = AVR_DATA_TO_IO(a);
+
+	if (avr->io[io].r.c || avr->io[io].irq) {
+		return 0;
+	}
+	o->io = (uint16_t)a;
 	return 1;
 }
 
@@ -59,7 +87,7 @@ static int park_call(const avr_t *avr, uint32_t ret)
 
 /* LD/ST through X, Y or Z (with post-increment or pre-decrement) and
  * LDS/STS, PUSH/POP: the low nibble of 1001 00sd dddd xxxx. */
-static int park_ldst(const avr_t *avr, uint16_t op, uint16_t op2)
+static int park_ldst(const avr_t *avr, uint16_t op, uint16_t op2, park_op_t *o)
 {
 	int d = (op >> 4) & 0x1f, store = op & 0x0200;
 	uint32_t a;
@@ -78,12 +106,12 @@ static int park_ldst(const avr_t *avr, uint16_t op, uint16_t op2)
 	default:
 		return 0;
 	}
-	return store ? park_same(avr, a, avr->data[d]) : park_plain(avr, a);
+	return store ? park_same(avr, a, avr->data[d]) : park_read(avr, a, o);
 }
 
 /* 1001 0101 xxxx 1000 and 1001 0100 sss 1000: returns, SLEEP, WDR, LPM,
  * SREG bits (not I). */
-static int park_misc(const avr_t *avr, uint16_t op, int *wdr)
+static int park_misc(const avr_t *avr, uint16_t op, park_op_t *o)
 {
 	uint16_t sp = park_sp(avr);
 
@@ -91,7 +119,7 @@ static int park_misc(const avr_t *avr, uint16_t op, int *wdr)
 	case 0x9508:	/* RET */
 		return park_plain(avr, sp + 1u) && park_plain(avr, sp + 2u);
 	case 0x95a8:	/* WDR */
-		*wdr = 1;
+		o->wdr = 1;
 		return 1;
 	case 0x95c8:	/* LPM */
 	case 0x95d8:	/* ELPM */
@@ -105,10 +133,11 @@ static int park_misc(const avr_t *avr, uint16_t op, int *wdr)
 }
 
 /* 1001 xxxx xxxx xxxx. */
-static int park_op9(const avr_t *avr, avr_flashaddr_t pc, uint16_t op, uint16_t op2, int *wdr)
+static int park_op9(const avr_t *avr, avr_flashaddr_t pc, uint16_t op, uint16_t op2,
+		    park_op_t *o)
 {
 	if ((op & 0xfc00) == 0x9000) {
-		return park_ldst(avr, op, op2);
+		return park_ldst(avr, op, op2, o);
 	}
 	if ((op & 0xfe00) == 0x9400) {
 		switch (op & 0x000f) {
@@ -119,7 +148,7 @@ static int park_op9(const avr_t *avr, avr_flashaddr_t pc, uint16_t op, uint16_t 
 		case 0xe: case 0xf:			/* CALL */
 			return park_call(avr, (pc + 4) >> 1);
 		case 0x8:
-			return park_misc(avr, op, wdr);
+			return park_misc(avr, op, o);
 		case 0x9:
 			if (op == 0x9409) {		/* IJMP */
 				return 1;
@@ -132,11 +161,15 @@ static int park_op9(const avr_t *avr, avr_flashaddr_t pc, uint16_t op, uint16_t 
 	if ((op & 0xfe00) == 0x9600) {			/* ADIW, SBIW */
 		return 1;
 	}
-	return (op & 0xfc00) == 0x9c00;			/* MUL; not CBI SBI SBIC SBIS */
+	if ((op & 0xfd00) == 0x9900) {			/* SBIC, SBIS */
+		return park_read(avr, ((op >> 3) & 0x1fu) + 32u, o);
+	}
+	return (op & 0xfc00) == 0x9c00;			/* MUL; not CBI, SBI */
 }
 
-/* May the instruction at PC be in a parked loop? WDR sets *WDR. */
-static int park_op_ok(const avr_t *avr, avr_flashaddr_t pc, int *wdr)
+/* May the instruction at PC be in a parked loop? What it does besides
+ * registers and SRAM goes to O. */
+static int park_op_ok(const avr_t *avr, avr_flashaddr_t pc, park_op_t *o)
 {
 	uint16_t op, op2;
 
@@ -151,12 +184,12 @@ static int park_op_ok(const avr_t *avr, avr_flashaddr_t pc, int *wdr)
 		uint32_t a = park_r16(avr, (op & 8) ? 28 : 30) + q;
 
 		return (op & 0x0200) ? park_same(avr, a, avr->data[(op >> 4) & 0x1f]) :
-		       park_plain(avr, a);
+		       park_read(avr, a, o);
 	}
 	case 0x9000:
-		return park_op9(avr, pc, op, op2, wdr);
-	case 0xb000:					/* IN from SREG only */
-		return !(op & 0x0800) && (((op >> 5) & 0x30) | (op & 0xf)) == 0x3f;
+		return park_op9(avr, pc, op, op2, o);
+	case 0xb000:					/* IN; not OUT */
+		return !(op & 0x0800) && park_read(avr, (((op >> 5) & 0x30u) | (op & 0xfu)) + 32u, o);
 	case 0xd000:					/* RCALL */
 		return park_call(avr, (pc + 2) >> 1);
 	default:	/* register and immediate ALU, branches, skips, RJMP, LDI */
@@ -292,11 +325,31 @@ static int park_fail(park_t *p, avr_t *avr, const park_timers_t *before, int ran
 		avr->state = cpu_Running;
 		park_timers_back(avr, before);
 	}
+	if (!ran) {
+		return 0;	/* cheap to ask again (in an interrupt, say) */
+	}
 	p->retry_at = avr->cycle + p->backoff;
 	if (p->backoff < PARK_BACKOFF_MAX) {
 		p->backoff *= 2;
 	}
 	return 0;
+}
+
+/* The loop reads the I/O register at A: its value is watched. */
+static int park_watch(park_t *p, const avr_t *avr, uint16_t a)
+{
+	for (int k = 0; k < p->nio; k++) {
+		if (p->io_addr[k] == a) {
+			return 1;
+		}
+	}
+	if (p->nio == PARK_MAX_IO) {
+		return 0;
+	}
+	p->io_addr[p->nio] = a;
+	p->io_val[p->nio] = avr->data[a];
+	p->nio++;
+	return 1;
 }
 
 int park_try(park_t *p, avr_t *avr)
@@ -327,13 +380,15 @@ int park_try(park_t *p, avr_t *avr)
 	p->first = avr->cycle;
 	p->wdr = -1;
 	park_save(&p->pt[0], avr, p->first);
+	p->nio = 0;
 	for (int i = 0; i < PARK_MAX_STEPS; i++) {
-		int wdr = 0;
+		park_op_t o = { 0, 0 };
 
-		if (!park_op_ok(avr, avr->pc, &wdr) || (wdr && saw_wdr)) {
+		if (!park_op_ok(avr, avr->pc, &o) || (o.wdr && saw_wdr) ||
+		    (o.io && !park_watch(p, avr, o.io))) {
 			return park_fail(p, avr, &before, 1);
 		}
-		if (wdr) {
+		if (o.wdr) {
 			saw_wdr = 1;
 			p->wdr = i;
 		}
@@ -434,7 +489,7 @@ static int park_fire(park_t *p, avr_t *avr, uint64_t start, int j)
 	avr->pc = p->pt[j ? j - 1 : p->n - 1].pc;	/* as avr_run_one() left it */
 	avr_step_after(avr, pt->pc);
 	if (avr->state != cpu_Running || avr->interrupt_state || avr->pc != pt->pc ||
-	    !park_head(p, avr)) {
+	    park_io_moved(p, avr) || !park_head(p, avr)) {
 		p->parked = 0;
 		p->retry_at = 0;
 		return 0;
@@ -445,7 +500,8 @@ static int park_fire(park_t *p, avr_t *avr, uint64_t start, int j)
 int park_advance(park_t *p, avr_t *avr, uint64_t end)
 {
 	if (avr->interrupt_state || avr->state != cpu_Running ||
-	    avr->cycle_timers.timer != p->head || p->head->when != p->head_when) {
+	    avr->cycle_timers.timer != p->head || p->head->when != p->head_when ||
+	    park_io_moved(p, avr)) {
 		park_leave(p, avr);
 		return 1;
 	}

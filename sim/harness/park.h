@@ -30,6 +30,7 @@
 
 #define PARK_MAX_STEPS 48	/* instructions in a loop's turn */
 #define PARK_MAX_CYCLES 256	/* its cycles */
+#define PARK_MAX_IO 4		/* I/O registers it reads */
 
 /* The board at an instruction boundary of the turn. */
 typedef struct park_point_t {
@@ -52,6 +53,9 @@ typedef struct park_t {
 	int n;				/* its instructions */
 	uint16_t off[PARK_MAX_STEPS + 1];	/* boundary j: cycles from the turn's start */
 	uint8_t next[PARK_MAX_CYCLES + 1];	/* cycle d of the turn: first boundary at or past it */
+	int nio;			/* I/O registers the loop reads, */
+	uint16_t io_addr[PARK_MAX_IO];	/* their data addresses */
+	uint8_t io_val[PARK_MAX_IO];	/* and the values it read */
 
 	/* the turn */
 	int wdr;			/* index of its WDR, -1: none (or no watchdog) */
@@ -74,6 +78,17 @@ int park_try(park_t *p, avr_t *avr);
  * loop: the caller runs it normally to END. */
 int park_advance(park_t *p, avr_t *avr, uint64_t end);
 
+/* Has an I/O register the loop reads changed? */
+static inline int park_io_moved(const park_t *p, const avr_t *avr)
+{
+	for (int k = 0; k < p->nio; k++) {
+		if (avr->data[p->io_addr[k]] != p->io_val[k]) {
+			return 1;
+		}
+	}
+	return 0;
+}
+
 /* park_advance(), 0 or 1 the other way round, with its common case
  * inline: nothing from outside, no timer due before the boundary. */
 static inline int park_stays(park_t *p, avr_t *avr, uint64_t end)
@@ -82,7 +97,8 @@ static inline int park_stays(park_t *p, avr_t *avr, uint64_t end)
 	int j;
 
 	if (avr->interrupt_state || avr->cycle_timers.timer != p->head ||
-	    p->head->when != p->head_when || avr->cycle >= end || d > 2 * (uint64_t)p->len) {
+	    p->head->when != p->head_when || avr->cycle >= end || d > 2 * (uint64_t)p->len ||
+	    park_io_moved(p, avr)) {
 		return !park_advance(p, avr, end);
 	}
 	if (d > p->len) {
