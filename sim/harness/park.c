@@ -458,9 +458,11 @@ static void park_seek(const park_t *p, uint64_t cyc, uint64_t *start, int *j)
 	uint64_t s = p->start, d = cyc - s;
 	int k;
 
-	while (d > p->len) {
-		s += p->len;
-		d -= p->len;
+	if (d > p->len) {
+		uint64_t turns = (d - 1) / p->len;
+
+		s += turns * p->len;
+		d -= turns * p->len;
 	}
 	k = p->next[d];
 	if (k == p->n) {

@@ -4,22 +4,24 @@
  *
  * A board is parked once one turn of the loop it is in has been run (on
  * trial, and undone if it fails) and found to change nothing: every
- * instruction only reads SRAM, registers, flash and SREG, every store
- * writes the value already there (a call's return address), no interrupt
- * is pending, none is enabled or disabled, and the turn ends at the same
- * PC with the same registers, stack pointer and SREG. Each turn is then
- * the same instructions with the same cycle counts, until something from
- * outside the loop happens: one of the board's cycle timers falls due, an
- * interrupt is raised (by the bus, another board), a cycle timer is set
- * from outside. Parked, the board moves from one instruction boundary of
- * the recorded turn to the next as world time passes, and its cycle is the
- * one lock-step would give it, so the bus and the other boards see it
- * where they always did. It leaves the loop at the boundary where it
- * stands (registers, SREG, stack pointer, PC of that boundary put back,
- * and the watchdog timer that the loop's WDR moves set where the last WDR
- * would have put it), then runs normally: before a timer falls due, when
- * an interrupt is pending or a timer was set, and at the end of every
- * world_run().
+ * instruction only reads registers, SRAM, flash, SREG and I/O registers
+ * that have no read handler (TWCR, UCSRA: their values are then watched),
+ * every store writes the value already there (a call's return address),
+ * no interrupt is pending, none is enabled or disabled, and the turn ends
+ * at the same PC with the same registers, stack pointer and SREG. Each
+ * turn is then the same instructions with the same cycle counts, until
+ * something from outside the loop happens. Parked, the board moves from
+ * one instruction boundary of the recorded turn to the next as world time
+ * passes, and its cycle is the one lock-step gives it, so the bus and the
+ * other boards see it where they always did. When one of its cycle timers
+ * falls due, the board is put on the boundary where simavr would run it
+ * and the timers run as avr_run() runs them; it stays parked unless that
+ * raised an interrupt or changed a watched register. It leaves the loop,
+ * at the boundary where it stands (registers, SREG, stack pointer, PC of
+ * that boundary put back, and the watchdog timer that the loop's WDR
+ * moves set where the last WDR would have put it), and runs normally when
+ * an interrupt is pending, a cycle timer was set or cancelled from
+ * outside, a watched register changed, and at the end of every world_run().
  */
 #ifndef SIM_PARK_H
 #define SIM_PARK_H

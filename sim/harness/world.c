@@ -37,18 +37,35 @@ static int world_state_dead(int state)
 	return state == cpu_Done || state == cpu_Crashed;
 }
 
-/* One board alone needs no lock-step: the loop stays as tight as the
- * single-board simulator's always was. */
+/* One board alone needs no lock-step: it runs to TARGET at once, parked
+ * (park.h) wherever it idles, tried every WORLD_QUANTUM cycles. */
 static int world_run_one(world_t *w, uint64_t target)
 {
 	avr_t *avr = w->boards[0]->avr;
+	park_t *park = &w->park[0];
 
-	int state = avr_step_until(avr, target);
+	while (avr->cycle < target) {
+		uint64_t end = avr->cycle + WORLD_QUANTUM;
+		int state;
 
-	if (world_state_dead(state)) {
-		w->dead = 0;
-		w->dead_state = state;
-		return 1;
+		if (park->parked && park_stays(park, avr, target)) {
+			break;
+		}
+		if (w->no_park || end > target) {
+			end = target;
+		}
+		state = avr_step_until(avr, end);
+		if (world_state_dead(state)) {
+			w->dead = 0;
+			w->dead_state = state;
+			return 1;
+		}
+		if (!w->no_park && avr->cycle >= park->retry_at) {
+			park_try(park, avr);
+		}
+	}
+	if (park->parked) {
+		park_leave(park, avr);
 	}
 	w->now = avr->cycle;
 	return 0;
