@@ -317,16 +317,19 @@ static int park_timers_check(park_t *p, const avr_t *avr, const park_timers_t *b
 
 /* --- trying, advancing, leaving ------------------------------------------------ */
 
+/* The try failed: after a trial turn (RAN) all is put back as it was and
+ * the next try waits; without one (in an interrupt, say) the next quantum
+ * may ask again. */
 static int park_fail(park_t *p, avr_t *avr, const park_timers_t *before, int ran)
 {
-	if (ran) {
-		park_load(&p->pt[0], avr);
-		avr->cycle = p->first;
-		avr->state = cpu_Running;
-		park_timers_back(avr, before);
-	}
 	if (!ran) {
-		return 0;	/* cheap to ask again (in an interrupt, say) */
+		return 0;
+	}
+	park_load(&p->pt[0], avr);
+	avr->cycle = p->first;
+	avr->state = cpu_Running;
+	if (p->wdr >= 0) {
+		park_timers_back(avr, before);	/* only a WDR moves a timer */
 	}
 	p->retry_at = avr->cycle + p->backoff;
 	if (p->backoff < PARK_BACKOFF_MAX) {
