@@ -421,6 +421,7 @@ int park_try(park_t *p, avr_t *avr)
 				k++;
 			}
 			p->next[d] = (uint8_t)k;
+			p->adv[d] = p->off[k];
 		}
 		avr->cycle = p->first;
 		p->start = p->first;
@@ -502,8 +503,21 @@ static int park_fire(park_t *p, avr_t *avr, uint64_t start, int j)
 	return 1;
 }
 
+/* P->j for where the board stands (park_stays moves only its cycle). */
+static void park_where(park_t *p, const avr_t *avr)
+{
+	uint64_t d = avr->cycle - p->start;
+
+	if (d >= p->len) {
+		p->start += p->len;
+		d -= p->len;
+	}
+	p->j = p->next[d];
+}
+
 int park_advance(park_t *p, avr_t *avr, uint64_t end)
 {
+	park_where(p, avr);
 	if (avr->interrupt_state || avr->state != cpu_Running ||
 	    avr->cycle_timers.timer != p->head || p->head->when != p->head_when ||
 	    park_io_moved(p, avr)) {
@@ -531,8 +545,10 @@ int park_advance(park_t *p, avr_t *avr, uint64_t end)
 
 void park_leave(park_t *p, avr_t *avr)
 {
-	const park_point_t *pt = &p->pt[p->j];
+	const park_point_t *pt;
 
+	park_where(p, avr);
+	pt = &p->pt[p->j];
 	park_load(pt, avr);
 	avr->cycle = p->start + pt->off;
 	if (p->wdr >= 0) {

@@ -46,7 +46,7 @@ typedef struct park_point_t {
 typedef struct park_t {
 	/* where the parked board stands (read every quantum: kept together) */
 	int parked;
-	int j;				/* boundary: before instruction j */
+	int j;				/* boundary: before instruction j (park_where) */
 	uint64_t start;			/* the current turn's start */
 	uint64_t limit;			/* the first cycle timer's due cycle */
 	const avr_cycle_timer_slot_t *head;	/* the timer list's head then */
@@ -54,7 +54,8 @@ typedef struct park_t {
 	uint32_t len;			/* the turn's cycles */
 	int n;				/* its instructions */
 	uint16_t off[PARK_MAX_STEPS + 1];	/* boundary j: cycles from the turn's start */
-	uint8_t next[PARK_MAX_CYCLES + 1];	/* cycle d of the turn: first boundary at or past it */
+	uint16_t adv[PARK_MAX_CYCLES + 1];	/* cycle d of the turn: the first boundary's off[] at or past it */
+	uint8_t next[PARK_MAX_CYCLES + 1];	/* ... and its index (n: the next turn's 0) */
 	int nio;			/* I/O registers the loop reads, */
 	uint16_t io_addr[PARK_MAX_IO];	/* their data addresses */
 	uint8_t io_val[PARK_MAX_IO];	/* and the values it read */
@@ -96,7 +97,6 @@ static inline int park_io_moved(const park_t *p, const avr_t *avr)
 static inline int park_stays(park_t *p, avr_t *avr, uint64_t end)
 {
 	uint64_t start = p->start, d = end - start, at;
-	int j;
 
 	if (avr->interrupt_state || avr->cycle_timers.timer != p->head ||
 	    p->head->when != p->head_when || avr->cycle >= end || d > 2 * (uint64_t)p->len ||
@@ -107,17 +107,11 @@ static inline int park_stays(park_t *p, avr_t *avr, uint64_t end)
 		start += p->len;
 		d -= p->len;
 	}
-	j = p->next[d];
-	if (j == p->n) {
-		start += p->len;
-		j = 0;
-	}
-	at = start + p->off[j];
+	at = start + p->adv[d];
 	if (at >= p->limit) {
 		return !park_advance(p, avr, end);
 	}
-	p->start = start;
-	p->j = j;
+	p->start = start;	/* p->j follows from the cycle (park_where) */
 	avr->cycle = at;
 	return 1;
 }
