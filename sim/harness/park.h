@@ -92,6 +92,15 @@ static inline int park_io_moved(const park_t *p, const avr_t *avr)
 	return 0;
 }
 
+/* A parked board with nothing from outside: no interrupt pending, its
+ * first timer the one it was, the watched registers as the loop read them. */
+static inline int park_quiet(const park_t *p, const avr_t *avr)
+{
+	return p->parked && !avr->interrupt_state && avr->state == cpu_Running &&
+	       avr->cycle_timers.timer == p->head && p->head->when == p->head_when &&
+	       !park_io_moved(p, avr);
+}
+
 /* park_advance(), 0 or 1 the other way round, with its common case
  * inline: nothing from outside, no timer due before the boundary. */
 static inline int park_stays(park_t *p, avr_t *avr, uint64_t end)
