@@ -305,8 +305,15 @@ static int park_timers_check(park_t *p, const avr_t *avr, const park_timers_t *b
 	if (moved > 0) {
 		p->wd_fn = now.fn[moved];
 		p->wd_param = now.param[moved];
-		p->wd_when = now.when[moved] - p->len;
-		if (p->wd_when <= p->limit) {
+		/* the trial's WDR ran at first + its offset: that gives the period */
+		p->wd_period = now.when[moved] - (p->first + p->pt[p->wdr].off);
+		p->wd_before = now.when[moved] - p->len;
+		for (int k = 0; k < before->n; k++) {
+			if (before->fn[k] == p->wd_fn && before->param[k] == p->wd_param) {
+				p->wd_before = before->when[k];
+			}
+		}
+		if (p->wd_before <= p->limit) {
 			return 0;
 		}
 	} else {
@@ -433,11 +440,16 @@ int park_try(park_t *p, avr_t *avr)
 	return park_fail(p, avr, &before, 1);
 }
 
-/* The watchdog timer where the loop's last WDR has put it (the turn at
- * P->start, boundary P->j). */
+/* The watchdog timer where the last WDR has put it (the turn at P->start,
+ * boundary P->j): the loop's, once it has run one since the board was
+ * parked, else the one before, where the timer was then. */
 static void park_wd(const park_t *p, avr_t *avr)
 {
-	uint64_t when = p->wd_when + (p->start - p->first) + (p->j > p->wdr ? p->len : 0);
+	uint64_t when = p->wd_before;
+
+	if (p->start > p->first || p->j > p->wdr) {
+		when = (p->j > p->wdr ? p->start : p->start - p->len) + p->off[p->wdr] + p->wd_period;
+	}
 
 	avr_cycle_timer_register(avr, when - avr->cycle, p->wd_fn, p->wd_param);
 }

@@ -64,7 +64,8 @@ typedef struct park_t {
 	int wdr;			/* index of its WDR, -1: none (or no watchdog) */
 	avr_cycle_timer_t wd_fn;	/* the timer the WDR moves */
 	void *wd_param;
-	uint64_t wd_when;		/* its due cycle at the first turn's start */
+	uint64_t wd_before;		/* its due cycle when the board was parked */
+	uint64_t wd_period;		/* a WDR at cycle c sets it due at c + this */
 	uint64_t first;			/* the first turn's start */
 	park_point_t pt[PARK_MAX_STEPS + 1];
 
