@@ -1,9 +1,9 @@
 /*
- * park.c: parked boards (park.h). The trial turn runs instruction by
- * instruction with simavr's avr_run_one(), each instruction first decoded
- * here and refused unless it is one a parked loop may hold; timers are not
- * processed (the trial stops before the first one falls due) and no
- * interrupt is pending, so avr_run_one() alone is what avr_run() would do.
+ * park.c: parked boards (park.h). A watched turn runs instruction by
+ * instruction as avr_step_until() runs it (simavr's avr_run_one(), then
+ * avr_step_after()), each instruction first decoded here and the watch given
+ * up unless it is one a parked loop may hold: watching changes nothing in
+ * how the board runs.
  */
 #include <string.h>
 
@@ -37,6 +37,10 @@ static int park_plain(const avr_t *avr, uint32_t a)
 typedef struct park_op_t {
 	int wdr;		/* it is a WDR */
 	uint16_t io;		/* the I/O register it reads (0: none) */
+	uint16_t ld[2];		/* the SRAM cells it reads */
+	int nld;
+	uint16_t st[2];		/* the SRAM cells it changes (a value not there yet) */
+	int nst;
 } park_op_t;
 
 /* A load from A: SRAM, SREG, or an I/O register read without a handler
@@ -44,6 +48,7 @@ typedef struct park_op_t {
 static int park_read(const avr_t *avr, uint32_t a, park_op_t *o)
 {
 	if (a > avr->ioend) {
+		o->ld[o->nld++] = (uint16_t)a;
 		return park_plain(avr, a);
 	}
 	if (a == R_SREG) {
@@ -61,10 +66,16 @@ static int park_read(const avr_t *avr, uint32_t a, park_op_t *o)
 	return 1;
 }
 
-/* A store of V at A that changes nothing. */
-static int park_same(const avr_t *avr, uint32_t a, uint8_t v)
+/* A store of V at A: plain SRAM; noted in O->st if it changes the cell. */
+static int park_store(const avr_t *avr, uint32_t a, uint8_t v, park_op_t *o)
 {
-	return park_plain(avr, a) && avr->data[a] == v;
+	if (!park_plain(avr, a)) {
+		return 0;
+	}
+	if (avr->data[a] != v) {
+		o->st[o->nst++] = (uint16_t)a;
+	}
+	return 1;
 }
 
 static uint16_t park_r16(const avr_t *avr, int r)
@@ -78,11 +89,12 @@ static uint16_t park_sp(const avr_t *avr)
 }
 
 /* A call pushes the return address RET (words): low byte at SP, high below. */
-static int park_call(const avr_t *avr, uint32_t ret)
+static int park_call(const avr_t *avr, uint32_t ret, park_op_t *o)
 {
 	uint16_t sp = park_sp(avr);
 
-	return park_same(avr, sp, (uint8_t)ret) && park_same(avr, (uint16_t)(sp - 1), (uint8_t)(ret >> 8));
+	return park_store(avr, sp, (uint8_t)ret, o) &&
+	       park_store(avr, (uint16_t)(sp - 1), (uint8_t)(ret >> 8), o);
 }
 
 /* LD/ST through X, Y or Z (with post-increment or pre-decrement) and
@@ -106,7 +118,7 @@ static int park_ldst(const avr_t *avr, uint16_t op, uint16_t op2, park_op_t *o)
 	default:
 		return 0;
 	}
-	return store ? park_same(avr, a, avr->data[d]) : park_read(avr, a, o);
+	return store ? park_store(avr, a, avr->data[d], o) : park_read(avr, a, o);
 }
 
 /* 1001 0101 xxxx 1000 and 1001 0100 sss 1000: returns, SLEEP, WDR, LPM,
@@ -117,7 +129,7 @@ static int park_misc(const avr_t *avr, uint16_t op, park_op_t *o)
 
 	switch (op) {
 	case 0x9508:	/* RET */
-		return park_plain(avr, sp + 1u) && park_plain(avr, sp + 2u);
+		return park_read(avr, sp + 1u, o) && park_read(avr, sp + 2u, o);
 	case 0x95a8:	/* WDR */
 		o->wdr = 1;
 		return 1;
@@ -146,14 +158,14 @@ static int park_op9(const avr_t *avr, avr_flashaddr_t pc, uint16_t op, uint16_t 
 		case 0xc: case 0xd:			/* JMP */
 			return 1;
 		case 0xe: case 0xf:			/* CALL */
-			return park_call(avr, (pc + 4) >> 1);
+			return park_call(avr, (pc + 4) >> 1, o);
 		case 0x8:
 			return park_misc(avr, op, o);
 		case 0x9:
 			if (op == 0x9409) {		/* IJMP */
 				return 1;
 			}
-			return op == 0x9509 && park_call(avr, (pc + 2) >> 1);	/* ICALL */
+			return op == 0x9509 && park_call(avr, (pc + 2) >> 1, o);	/* ICALL */
 		default:
 			return 0;
 		}
@@ -183,7 +195,7 @@ static int park_op_ok(const avr_t *avr, avr_flashaddr_t pc, park_op_t *o)
 		uint16_t q = (uint16_t)(((op >> 8) & 0x20) | ((op >> 7) & 0x18) | (op & 7));
 		uint32_t a = park_r16(avr, (op & 8) ? 28 : 30) + q;
 
-		return (op & 0x0200) ? park_same(avr, a, avr->data[(op >> 4) & 0x1f]) :
+		return (op & 0x0200) ? park_store(avr, a, avr->data[(op >> 4) & 0x1f], o) :
 		       park_read(avr, a, o);
 	}
 	case 0x9000:
@@ -191,7 +203,7 @@ static int park_op_ok(const avr_t *avr, avr_flashaddr_t pc, park_op_t *o)
 	case 0xb000:					/* IN; not OUT */
 		return !(op & 0x0800) && park_read(avr, (((op >> 5) & 0x30u) | (op & 0xfu)) + 32u, o);
 	case 0xd000:					/* RCALL */
-		return park_call(avr, (pc + 2) >> 1);
+		return park_call(avr, (pc + 2) >> 1, o);
 	default:	/* register and immediate ALU, branches, skips, RJMP, LDI */
 		return 1;
 	}
@@ -221,6 +233,8 @@ static int park_same_point(const park_point_t *a, const park_point_t *b)
 	return a->pc == b->pc && !memcmp(a->regs, b->regs, sizeof(a->regs)) &&
 	       !memcmp(a->io, b->io, sizeof(a->io)) && !memcmp(a->sreg, b->sreg, sizeof(a->sreg));
 }
+
+static int park_head(park_t *p, const avr_t *avr);
 
 /* --- the cycle timers --------------------------------------------------------- */
 
@@ -253,104 +267,41 @@ static int park_find(const park_timers_t *t, avr_cycle_timer_t fn, void *param)
 	return -1;
 }
 
-/* Put every timer of BEFORE whose due cycle changed back where it was. */
-static void park_timers_back(avr_t *avr, const park_timers_t *before)
-{
-	park_timers_t now;
-
-	park_timers(&now, avr);
-	for (int i = 0; i < before->n; i++) {
-		int k = park_find(&now, before->fn[i], before->param[i]);
-
-		if (k < 0 || now.when[k] != before->when[i]) {
-			avr_cycle_timer_register(avr, before->when[i] - avr->cycle, before->fn[i],
-						 before->param[i]);
-		}
-	}
-}
-
-/* After the trial turn: the timers are BEFORE's, but for at most the one
- * the WDR moved by the turn's length; it and the first timer are noted.
- * 0 when they are not so. */
-static int park_timers_check(park_t *p, const avr_t *avr, const park_timers_t *before,
-			     int saw_wdr)
+/* The loop's WDR, begun at cycle AT, has run: the timer it moved (the
+ * watchdog's, if it runs) and its period. 0 if it moved more than one. */
+static int park_wdr_ran(park_t *p, const avr_t *avr, const park_timers_t *before, uint64_t at)
 {
 	park_timers_t now;
 	int moved = -1;
 
 	park_timers(&now, avr);
-	if (now.n != before->n || now.n == 0) {
-		return 0;
-	}
 	for (int i = 0; i < now.n; i++) {
 		int k = park_find(before, now.fn[i], now.param[i]);
 
-		if (k < 0) {
-			return 0;
-		}
-		if (now.when[i] != before->when[k]) {
-			if (moved >= 0 || !saw_wdr || now.when[i] != before->when[k] + p->len) {
+		if (k < 0 || now.when[i] != before->when[k]) {
+			if (moved >= 0) {
 				return 0;
 			}
 			moved = i;
 		}
 	}
-	/* the first timer is one the loop leaves alone, and due first */
-	if (moved == 0) {
-		return 0;
-	}
-	p->limit = now.when[0];
-	p->head = avr->cycle_timers.timer;
-	p->head_when = now.when[0];
-	if (moved > 0) {
+	p->wd_fn = NULL;
+	if (moved >= 0) {
 		p->wd_fn = now.fn[moved];
 		p->wd_param = now.param[moved];
-		/* the trial's WDR ran at first + its offset: that gives the period */
-		p->wd_period = now.when[moved] - (p->first + p->pt[p->wdr].off);
-		p->wd_before = now.when[moved] - p->len;
-		for (int k = 0; k < before->n; k++) {
-			if (before->fn[k] == p->wd_fn && before->param[k] == p->wd_param) {
-				p->wd_before = before->when[k];
-			}
-		}
-		if (p->wd_before <= p->limit) {
-			return 0;
-		}
-	} else {
-		p->wdr = -1;
+		p->wd_period = now.when[moved] - at;
 	}
 	return 1;
 }
 
-/* --- trying, advancing, leaving ------------------------------------------------ */
-
-/* The try failed: after a trial turn (RAN) all is put back as it was and
- * the next try waits; without one (in an interrupt, say) the next quantum
- * may ask again. */
-static int park_fail(park_t *p, avr_t *avr, const park_timers_t *before, int ran)
-{
-	if (!ran) {
-		return 0;
-	}
-	park_load(&p->pt[0], avr);
-	avr->cycle = p->first;
-	avr->state = cpu_Running;
-	if (p->wdr >= 0) {
-		park_timers_back(avr, before);	/* only a WDR moves a timer */
-	}
-	p->retry_at = avr->cycle + p->backoff;
-	if (p->backoff < PARK_BACKOFF_MAX) {
-		p->backoff *= 2;
-	}
-	return 0;
-}
+/* --- watching for a loop ------------------------------------------------------- */
 
 /* The loop reads the I/O register at A: its value is watched. */
-static int park_watch(park_t *p, const avr_t *avr, uint16_t a)
+static int park_note_io(park_t *p, const avr_t *avr, uint16_t a)
 {
 	for (int k = 0; k < p->nio; k++) {
 		if (p->io_addr[k] == a) {
-			return 1;
+			return avr->data[a] == p->io_val[k];
 		}
 	}
 	if (p->nio == PARK_MAX_IO) {
@@ -362,82 +313,187 @@ static int park_watch(park_t *p, const avr_t *avr, uint16_t a)
 	return 1;
 }
 
-int park_try(park_t *p, avr_t *avr)
+/* Can a watch begin where AVR stands? */
+static int park_can_watch(const avr_t *avr)
 {
-	park_timers_t before;
-	int saw_wdr = 0;
-
-	if (avr->cycle < p->retry_at) {
-		return 0;
-	}
-	if (!p->backoff) {
-		p->backoff = PARK_BACKOFF_MIN;
-	}
 	if (avr->state != cpu_Running || avr->interrupt_state || !avr->sreg[S_I] ||
 	    avr->address_size != 2 || avr->run != avr_callback_run_raw || avr->gdb ||
-	    !park_plain(avr, park_sp(avr) - 1u) || !avr->cycle_timers.timer) {
-		return park_fail(p, avr, NULL, 0);
+	    !park_plain(avr, park_sp(avr) - 1u)) {
+		return 0;
 	}
 	/* SP lives in plain cells: push, pop, call and return change nothing else */
 	for (uint16_t a = R_SPL; a <= R_SPH; a++) {
 		const avr_io_addr_t io = AVR_DATA_TO_IO(a);
 
 		if (avr->io[io].w.c || avr->io[io].irq) {
-			return park_fail(p, avr, NULL, 0);
+			return 0;
 		}
 	}
-	park_timers(&before, avr);
-	p->first = avr->cycle;
-	p->wdr = -1;
-	park_save(&p->pt[0], avr, p->first);
-	p->nio = 0;
-	for (int i = 0; i < PARK_MAX_STEPS; i++) {
-		park_op_t o = { 0, 0 };
+	return 1;
+}
 
-		if (!park_op_ok(avr, avr->pc, &o) || (o.wdr && saw_wdr) ||
-		    (o.io && !park_watch(p, avr, o.io))) {
-			return park_fail(p, avr, &before, 1);
+/* The watch failed: try again later (FAR: after the backoff). */
+static void park_unwatch(park_t *p, const avr_t *avr, int far)
+{
+	p->watching = 0;
+	if (!far) {
+		return;
+	}
+	p->retry_at = avr->cycle + p->backoff;
+	if (p->backoff < PARK_BACKOFF_MAX) {
+		p->backoff *= 2;
+	}
+}
+
+/* A whole turn was watched and the board is back where it began: park it
+ * here if the turn repeats. 1 if parked. */
+static int park_settle(park_t *p, avr_t *avr)
+{
+	int n = p->wn;
+
+	if (!park_same_point(&p->pt[n], &p->pt[0]) || park_io_moved(p, avr)) {
+		return 0;
+	}
+	p->n = n;
+	p->len = p->pt[n].off;
+	if (p->wdr >= 0 && !p->wd_fn) {
+		p->wdr = -1;		/* a WDR with the watchdog off: nothing moves */
+	}
+	if (p->wdr >= 0) {
+		const avr_cycle_timer_slot_t *s = avr->cycle_timers.timer;
+
+		while (s && !(s->timer == p->wd_fn && s->param == p->wd_param)) {
+			s = s->next;
 		}
-		if (o.wdr) {
-			saw_wdr = 1;
-			p->wdr = i;
+		if (!s) {
+			return 0;
 		}
-		avr->pc = avr_run_one(avr);
-		if (avr->state != cpu_Running || avr->interrupt_state ||
-		    avr->cycle - p->first > PARK_MAX_CYCLES ||
-		    avr->cycle >= avr->cycle_timers.timer->when) {
-			return park_fail(p, avr, &before, 1);
+		p->wd_before = s->when;
+	}
+	if (!park_head(p, avr) || (p->wdr >= 0 && p->wd_before <= p->limit)) {
+		return 0;
+	}
+	for (int k = 0; k <= n; k++) {
+		p->off[k] = (uint16_t)p->pt[k].off;
+	}
+	for (uint32_t d = 0, k = 0; d <= p->len; d++) {
+		while (p->off[k] < d) {
+			k++;
 		}
-		park_save(&p->pt[i + 1], avr, p->first);
-		if (avr->pc != p->pt[0].pc) {
-			continue;
+		p->next[d] = (uint8_t)k;
+		p->adv[d] = p->off[k];
+	}
+	p->first = p->start = avr->cycle;
+	p->j = 0;
+	p->parked = 1;
+	p->backoff = PARK_BACKOFF_MIN;
+	return 1;
+}
+
+/* The SRAM cells the instruction reads and changes. A cell the turn
+ * changes before it ever reads it (the stack an interrupt used, written
+ * again by a call) does not make the turn's start differ from its end in
+ * anything the turn depends on; a cell read and then changed does
+ * (P->dirty). */
+static void park_note_cells(park_t *p, const park_op_t *o)
+{
+	for (int k = 0; k < o->nst; k++) {
+		int read = p->nread == PARK_MAX_READS;
+
+		for (int i = 0; i < p->nread && !read; i++) {
+			read = p->read[i] == o->st[k];
 		}
-		/* back at the start: the same state, and the timers as they were */
-		p->n = i + 1;
-		p->len = p->pt[i + 1].off;
-		if (!park_same_point(&p->pt[i + 1], &p->pt[0]) ||
-		    !park_timers_check(p, avr, &before, saw_wdr)) {
-			return park_fail(p, avr, &before, 1);
+		p->dirty |= read;
+	}
+	for (int k = 0; k < o->nld; k++) {
+		if (p->nread < PARK_MAX_READS) {
+			p->read[p->nread++] = o->ld[k];
 		}
-		/* parked where the trial began: the lock-step's boundary */
-		for (int k = 0; k <= p->n; k++) {
-			p->off[k] = (uint16_t)p->pt[k].off;
-		}
-		for (uint32_t d = 0, k = 0; d <= p->len; d++) {
-			while (p->off[k] < d) {
-				k++;
-			}
-			p->next[d] = (uint8_t)k;
-			p->adv[d] = p->off[k];
-		}
-		avr->cycle = p->first;
-		p->start = p->first;
-		p->j = 0;
-		p->parked = 1;
-		p->backoff = PARK_BACKOFF_MIN;
+	}
+}
+
+/* A watch of a turn begins where AVR stands. */
+static void park_watch_from(park_t *p, const avr_t *avr)
+{
+	p->watching = 1;
+	p->dirty = 0;
+	p->nread = 0;
+	p->wn = 0;
+	p->nio = 0;
+	p->wdr = -1;
+	p->wd_fn = NULL;
+	p->first = avr->cycle;
+	park_save(&p->pt[0], avr, p->first);
+}
+
+/* One instruction watched (as avr_step_until runs it). 1 while the watch
+ * goes on, 0 when it ended (parked, or given up). */
+static int park_watch_one(park_t *p, avr_t *avr)
+{
+	park_op_t o = { .nld = 0, .nst = 0 };
+	park_timers_t before;
+	uint64_t at = avr->cycle;
+	avr_flashaddr_t new_pc;
+
+	before.n = 0;
+
+	if (p->wn == PARK_MAX_STEPS || !park_op_ok(avr, avr->pc, &o) || (o.wdr && p->wdr >= 0) ||
+	    (o.io && !park_note_io(p, avr, o.io))) {
+		park_unwatch(p, avr, 1);
+		return 0;
+	}
+	if (o.wdr) {
+		p->wdr = p->wn;
+		park_timers(&before, avr);
+	}
+	park_note_cells(p, &o);
+	new_pc = avr_run_one(avr);
+	avr_step_after(avr, new_pc);
+	if (avr->state != cpu_Running || avr->interrupt_state || avr->pc != new_pc) {
+		park_unwatch(p, avr, 0);	/* an interrupt: watch again after it */
+		return 0;
+	}
+	if ((o.wdr && !park_wdr_ran(p, avr, &before, at)) || avr->cycle - p->first > PARK_MAX_CYCLES) {
+		park_unwatch(p, avr, 1);
+		return 0;
+	}
+	park_save(&p->pt[++p->wn], avr, p->first);
+	if (avr->pc != p->pt[0].pc) {
 		return 1;
 	}
-	return park_fail(p, avr, &before, 1);
+	if (p->dirty && !p->warm && park_same_point(&p->pt[p->wn], &p->pt[0])) {
+		/* a store changed SRAM (the stack an interrupt used): the next
+		 * turn, once, may be the loop's */
+		p->warm = 1;
+		park_watch_from(p, avr);
+		return 1;
+	}
+	p->watching = 0;
+	if (p->dirty || !park_settle(p, avr)) {
+		park_unwatch(p, avr, 1);
+	}
+	return 0;
+}
+
+int park_run(park_t *p, avr_t *avr, uint64_t end, int allow)
+{
+	while (p->watching && avr->cycle < end) {
+		if (!park_watch_one(p, avr) && p->parked) {
+			if (park_stays(p, avr, end)) {
+				return avr->state;
+			}
+			break;		/* left again at once: run normally */
+		}
+	}
+	avr_step_until(avr, end);
+	if (allow && !p->watching && avr->cycle >= p->retry_at && park_can_watch(avr)) {
+		if (!p->backoff) {
+			p->backoff = PARK_BACKOFF_MIN;
+		}
+		p->warm = 0;
+		park_watch_from(p, avr);
+	}
+	return avr->state;
 }
 
 /* The watchdog timer where the last WDR has put it (the turn at P->start,

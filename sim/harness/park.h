@@ -2,26 +2,26 @@
  * park.h: a board idling in a loop is not run, it is parked: its place in
  * the loop follows world time, exactly (docs/simulator.md, "Parked boards").
  *
- * A board is parked once one turn of the loop it is in has been run (on
- * trial, and undone if it fails) and found to change nothing: every
- * instruction only reads registers, SRAM, flash, SREG and I/O registers
- * that have no read handler (TWCR, UCSRA: their values are then watched),
- * every store writes the value already there (a call's return address),
- * no interrupt is pending, none is enabled or disabled, and the turn ends
- * at the same PC with the same registers, stack pointer and SREG. Each
- * turn is then the same instructions with the same cycle counts, until
- * something from outside the loop happens. Parked, the board moves from
- * one instruction boundary of the recorded turn to the next as world time
- * passes, and its cycle is the one lock-step gives it, so the bus and the
- * other boards see it where they always did. When one of its cycle timers
- * falls due, the board is put on the boundary where simavr would run it
- * and the timers run as avr_run() runs them; it stays parked unless that
- * raised an interrupt or changed a watched register. It leaves the loop,
- * at the boundary where it stands (registers, SREG, stack pointer, PC of
- * that boundary put back, and the watchdog timer that the loop's WDR
- * moves set where the last WDR would have put it), and runs normally when
- * an interrupt is pending, a cycle timer was set or cancelled from
- * outside, a watched register changed, and at the end of every world_run().
+ * A board is parked once one turn of the loop it is in has been watched
+ * (run normally, each instruction decoded first) and found to repeat:
+ * every instruction only reads registers, SRAM, flash, SREG and I/O
+ * registers that have no read handler (TWCR, UCSRA: their values are then
+ * watched), stores only to SRAM, and no SRAM cell it reads changes; no
+ * interrupt comes, none is enabled or disabled; the turn ends at the same
+ * PC with the same registers, stack pointer and SREG. Each turn is then the
+ * same instructions with the same cycle counts, until something from
+ * outside the loop happens. Parked, the board moves from one instruction
+ * boundary of the recorded turn to the next as world time passes, and its
+ * cycle is the one lock-step gives it, so the bus and the other boards see
+ * it where they always did. When one of its cycle timers falls due, the
+ * board is put on the boundary where simavr would run it and the timers run
+ * as avr_run() runs them; it stays parked unless that raised an interrupt
+ * or changed a watched register. It leaves the loop, at the boundary where
+ * it stands (registers, SREG, stack pointer, PC of that boundary put back,
+ * and the watchdog timer that the loop's WDR moves set where the last WDR
+ * put it), and runs normally when an interrupt is pending, its first cycle
+ * timer is not the one it was (set or cancelled from outside), a watched
+ * register changed, and at the end of every world_run().
  */
 #ifndef SIM_PARK_H
 #define SIM_PARK_H
@@ -30,9 +30,10 @@
 
 #include "sim_avr.h"
 
-#define PARK_MAX_STEPS 48	/* instructions in a loop's turn */
+#define PARK_MAX_STEPS 96	/* instructions in a loop's turn */
 #define PARK_MAX_CYCLES 256	/* its cycles */
 #define PARK_MAX_IO 4		/* I/O registers it reads */
+#define PARK_MAX_READS 64	/* SRAM reads it makes (followed) */
 
 /* The board at an instruction boundary of the turn. */
 typedef struct park_point_t {
@@ -66,16 +67,24 @@ typedef struct park_t {
 	void *wd_param;
 	uint64_t wd_before;		/* its due cycle when the board was parked */
 	uint64_t wd_period;		/* a WDR at cycle c sets it due at c + this */
-	uint64_t first;			/* the first turn's start */
+	uint64_t first;			/* the watched turn's start, then where it was parked */
 	park_point_t pt[PARK_MAX_STEPS + 1];
 
-	uint64_t retry_at;		/* no new try before this cycle */
-	uint32_t backoff;		/* cycles to the next try after a failed one */
+	int watching;			/* a turn is being watched: pt[0..wn] so far */
+	int wn;
+	int dirty;			/* it changed an SRAM cell it had read */
+	uint16_t read[PARK_MAX_READS];	/* the SRAM cells it read */
+	int nread;
+	int warm;			/* the watch began again after such a turn */
+	uint64_t retry_at;		/* no new watch before this cycle */
+	uint32_t backoff;		/* cycles to the next watch after a failed one */
 } park_t;
 
-/* After a normal run: park AVR if it idles in a loop (and a try is due).
- * Returns 1 when parked (its cycle unchanged). */
-int park_try(park_t *p, avr_t *avr);
+/* Run a board that is not parked to END (as avr_step_until), watching a
+ * turn of the loop it is in when a watch is on, and parking it when the
+ * turn repeats; with ALLOW, a watch begins at the end when one is due.
+ * Returns the MCU's state. */
+int park_run(park_t *p, avr_t *avr, uint64_t end, int allow);
 
 /* A parked board's turn in the lock-step, to quantum END: 0 when it stays
  * parked (its cycle the first boundary at or past END), 1 when it left the

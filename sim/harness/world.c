@@ -3,7 +3,6 @@
  */
 #include <string.h>
 
-#include "harness/avr_step.h"
 #include "harness/world.h"
 
 void world_init(world_t *w)
@@ -54,14 +53,11 @@ static int world_run_one(world_t *w, uint64_t target)
 		if (w->no_park || end > target) {
 			end = target;
 		}
-		state = avr_step_until(avr, end);
+		state = park_run(park, avr, end, !w->no_park);
 		if (world_state_dead(state)) {
 			w->dead = 0;
 			w->dead_state = state;
 			return 1;
-		}
-		if (!w->no_park && avr->cycle >= park->retry_at) {
-			park_try(park, avr);
 		}
 	}
 	if (park->parked) {
@@ -145,16 +141,14 @@ int world_run(world_t *w, uint64_t target)
 				parked++;
 				continue;
 			}
-			state = avr_step_until(avr, end);
+			state = park_run(park, avr, end, !w->no_park);
 			if (world_state_dead(state)) {
 				w->dead = i;
 				w->dead_state = state;
 				world_unpark(w);
 				return 1;
 			}
-			if (!w->no_park && avr->cycle >= park->retry_at) {
-				parked += park_try(park, avr);
-			}
+			parked += park->parked;
 		}
 		w->now = end;
 	}
