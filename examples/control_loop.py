@@ -127,6 +127,9 @@ class ControlLoop:
         self.gateway = board.gateway
         self.motors = board.has("motor")
         self.free = free_servo_channels(board)
+        #: the newest inputs (run), and the last step submitted (submit)
+        self.latest = None
+        self.last = None
 
     def setup(self):
         """ADC channels on (AVCC, 10 bits), the IMU awake, the bus at 400 kHz."""
@@ -192,6 +195,7 @@ def run(loop, steps, pipelined=True, inputs_seen=None, ahead=AHEAD):
             latest = loop.step_one_at_a_time(*law(loop, k, latest))
             if inputs_seen:
                 inputs_seen(k, latest)
+        loop.latest = latest
         return latest
     under_way = deque()
     for k in range(steps):
@@ -204,7 +208,29 @@ def run(loop, steps, pipelined=True, inputs_seen=None, ahead=AHEAD):
         latest = under_way.popleft().wait()
         if inputs_seen:
             inputs_seen(steps - len(under_way) - 1, latest)
+    loop.latest = latest
     return latest
+
+
+def timed(loop, steps, pipelined=True, clock=time.monotonic, inputs_seen=None, warmup=0):
+    """run() timed from the inputs of step `warmup` - 1 (from the start if
+    0: the pipeline still empty) to the last step's: (the clock's ticks,
+    the Python process's CPU seconds) of the steps - warmup steps in
+    between. `clock` is wall time by default; a simulator's cycle counter
+    (SimControl.time) gives the board's own time."""
+    marks = []
+
+    def seen(k, inputs):
+        if inputs_seen:
+            inputs_seen(k, inputs)
+        if k == warmup - 1 or k == steps - 1:
+            marks.append((clock(), time.process_time()))
+
+    if not warmup:
+        marks.append((clock(), time.process_time()))
+    run(loop, steps, pipelined, seen)
+    (t0, cpu0), (t1, cpu1) = marks
+    return t1 - t0, cpu1 - cpu0
 
 
 #: What the simulated board of --sim senses: 1.0 .. 4.5 V on the ADC
@@ -280,10 +306,9 @@ def main(argv=None):
         with Gateway(sim.port if sim else args.port, baudrate=args.baud) as gw:
             loop = ControlLoop(Board(gw))
             loop.setup()
-            wall, cpu = time.monotonic(), time.process_time()
-            raw, imu = run(loop, args.steps, pipelined=not args.one_at_a_time,
-                           inputs_seen=check_sim_inputs if sim else None)
-            wall, cpu = time.monotonic() - wall, time.process_time() - cpu
+            wall, cpu = timed(loop, args.steps, not args.one_at_a_time,
+                              inputs_seen=check_sim_inputs if sim else None)
+            raw, imu = loop.latest
         accel, temp, gyro = decode_imu(imu)
         print("%d steps in %.3f s: %.1f steps/s, Python %.3f ms CPU per step"
               % (args.steps, wall, args.steps / wall, cpu * 1e3 / args.steps))

@@ -871,9 +871,7 @@ def bench_control_loop(board, rate, steps=LOOP_STEPS, steps_one=LOOP_STEPS_ONE):
             loop.setup()
             ctl.wait(F_CPU // 100)                     # the IMU samples at 1 kHz
             for name, n, pipelined in (("pipelined", steps, True), ("one", steps_one, False)):
-                t0, cpu = ctl.time(), time.process_time()
-                cl.run(loop, n, pipelined, inputs_seen=cl.check_sim_inputs)
-                rows[name] = (n, ctl.time() - t0, time.process_time() - cpu)
+                rows[name] = (n,) + cl.timed(loop, n, pipelined, ctl.time, cl.check_sim_inputs)
             rows["wire"] = loop.last.wire()
     except (OrfaError, ValueError) as e:
         return {"error": "%s at %d baud: %s (the serial line: %s)"
