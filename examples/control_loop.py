@@ -280,9 +280,25 @@ def firmware_at(board, baud):
     import subprocess
     root = Path(__file__).resolve().parents[1]
     out = Path("build") / "test-baud" / ("%s-%d" % (board, baud))
-    subprocess.run(["make", "-s", "--no-print-directory", "BOARD=" + board, "MODE=gate",
-                    "BAUD=%d" % baud, "BUILD=%s" % out], cwd=root, check=True)
+    made = subprocess.run(["make", "-s", "--no-print-directory", "BOARD=" + board, "MODE=gate",
+                           "BAUD=%d" % baud, "BUILD=%s" % out], cwd=root,
+                          capture_output=True, text=True)
+    if made.returncode:
+        raise ValueError("no %s gateway at %d baud: %s" % (
+            board, baud, (made.stderr.strip().splitlines() or ["make failed"])[-1]))
     return root / out / "orfa.elf"
+
+
+def report(loop, steps, pipelined, check):
+    """Run the loop `steps` steps and print its rate and its last inputs."""
+    loop.setup()
+    wall, cpu = timed(loop, steps, pipelined, inputs_seen=check)
+    accel, temp, gyro = decode_imu(loop.latest[1])
+    print("%d steps in %.3f s: %.1f steps/s, Python %.3f ms CPU per step"
+          % (steps, wall, steps / wall, cpu * 1e3 / steps))
+    print("last inputs: ADC %s; accel %s m/s^2, %.1f C, gyro %s deg/s"
+          % (loop.latest[0], " ".join("%.2f" % a for a in accel), temp,
+             " ".join("%.1f" % w for w in gyro)))
 
 
 def main(argv=None):
@@ -301,28 +317,17 @@ def main(argv=None):
         ap.error("--steps: 1 or more")
     sim = None
     try:
-        if args.sim:
-            sim = simulated_board(args.board, args.baud)
+        sim = simulated_board(args.board, args.baud) if args.sim else None
         with Gateway(sim.port if sim else args.port, baudrate=args.baud) as gw:
-            loop = ControlLoop(Board(gw))
-            loop.setup()
-            wall, cpu = timed(loop, args.steps, not args.one_at_a_time,
-                              inputs_seen=check_sim_inputs if sim else None)
-            raw, imu = loop.latest
-        accel, temp, gyro = decode_imu(imu)
-        print("%d steps in %.3f s: %.1f steps/s, Python %.3f ms CPU per step"
-              % (args.steps, wall, args.steps / wall, cpu * 1e3 / args.steps))
-        print("last inputs: ADC %s; accel %s m/s^2, %.1f C, gyro %s deg/s"
-              % (raw, " ".join("%.2f" % a for a in accel), temp,
-                 " ".join("%.1f" % w for w in gyro)))
+            report(ControlLoop(Board(gw)), args.steps, not args.one_at_a_time,
+                   check_sim_inputs if sim else None)
+        status = 0
     except (OrfaError, OSError, ValueError) as e:
         print("control_loop: %s" % e, file=sys.stderr)
-        return 1
-    finally:
-        if sim is not None:
-            sim.stop()
-    return 0
-
+        status = 1
+    if sim is not None:
+        sim.stop()
+    return status
 
 if __name__ == "__main__":
     sys.exit(main())

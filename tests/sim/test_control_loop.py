@@ -113,3 +113,26 @@ def test_the_pipelined_loop_keeps_the_wire_busy(loop_on, board, rate):
                                  ", ".join("%.1f %%" % t[0] for t in tries))
     # the PC is far from the limit: its CPU time a step is under the step's wire time
     assert cpu < max(sent, received) * 10 / rate
+
+
+@pytest.mark.parametrize("args", [["--board", "m128s"], ["--one-at-a-time"]])
+def test_the_example_as_a_program(args):
+    """`python3 examples/control_loop.py --sim ...` as a user runs it."""
+    import subprocess
+    require_builds(["m32d", "m128s"])
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "control_loop.py"), "--sim",
+                        "--steps", "10"] + args, capture_output=True, text=True, timeout=120)
+    assert (r.returncode, r.stderr) == (0, "")
+    first, last = r.stdout.splitlines()
+    assert first.startswith("10 steps in ") and " steps/s, Python " in first
+    assert last == ("last inputs: ADC [204, 306, 409, 511, 613, 716, 818, 920]; accel 1.00 "
+                    "-2.00 9.81 m/s^2, 25.0 C, gyro 10.0 -20.0 30.0 deg/s")
+
+
+def test_the_example_refuses_a_rate_without_a_build():
+    import subprocess
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "control_loop.py"), "--sim",
+                        "--baud", "12345"], capture_output=True, text=True, timeout=120)
+    assert (r.returncode, r.stdout) == (1, "")
+    assert r.stderr.startswith("control_loop: no m32d gateway at 12345 baud: ")
+    assert len(r.stderr.splitlines()) == 1
