@@ -2,6 +2,7 @@
 
 #include <avr/interrupt.h>
 #include <avr/wdt.h>
+#include <util/atomic.h>
 
 #include "firmware/mcu.h"
 
@@ -48,6 +49,13 @@ void uart_putc(uint8_t c)
 		wdt_reset();
 	}
 	uart.tx[head] = c;
-	uart.tx_head = next;
-	MCU_UCSRB |= _BV(UDRIE);
+	/* The byte joins the ring and UDRIE goes on in one piece: the M128-S's
+	 * UCSR1B is beyond sbi's reach, so |= is a load and a store, and a UDRE
+	 * interrupt between them that empties the ring and turns UDRIE off
+	 * would have it turned on again over an empty ring: stale bytes sent,
+	 * the tail run past the head (replies garbled at 460800). */
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		uart.tx_head = next;
+		MCU_UCSRB |= _BV(UDRIE);
+	}
 }
