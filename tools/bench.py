@@ -845,6 +845,8 @@ def print_sensor_reads(boards, width=38):
 sys.path.insert(0, str(ROOT / "examples"))
 LOOP_STEPS = 300
 LOOP_STEPS_ONE = 100
+#: Steps before the clock starts: the pipeline full (examples/control_loop.py timed)
+LOOP_WARMUP = 10
 
 
 def loop_rates():
@@ -871,7 +873,8 @@ def bench_control_loop(board, rate, steps=LOOP_STEPS, steps_one=LOOP_STEPS_ONE):
             loop.setup()
             ctl.wait(F_CPU // 100)                     # the IMU samples at 1 kHz
             for name, n, pipelined in (("pipelined", steps, True), ("one", steps_one, False)):
-                rows[name] = (n,) + cl.timed(loop, n, pipelined, ctl.time, cl.check_sim_inputs)
+                rows[name] = (n - LOOP_WARMUP,) + cl.timed(loop, n, pipelined, ctl.time,
+                                                           cl.check_sim_inputs, LOOP_WARMUP)
             rows["wire"] = loop.last.wire()
     except (OrfaError, ValueError) as e:
         return {"error": "%s at %d baud: %s (the serial line: %s)"
@@ -920,6 +923,7 @@ def print_control_loop(boards, width=38):
     print("(10 bits each) at the rate. Pipelined: the next %d steps submitted before a" % cl_ahead())
     print("step's replies are waited for (Board.submit, Gateway.submit_transactions, within")
     print("the flow rule); one at a time: the same requests, each after the last one's reply.")
+    print("Timed from step %d's inputs to the last step's." % (LOOP_WARMUP - 1))
     broken = [r["error"] for r in res.values() if "error" in r]
     for why in broken:
         print("broken: %s" % why)

@@ -33,6 +33,8 @@
 
 #define SIM_BATCH_CYCLES (SIM_FREQUENCY / 1000)	/* 1 ms simulated */
 #define SIM_IDLE_AFTER_S 0.5
+/* --real-time: further behind wall time than this, it starts again from now. */
+#define SIM_REAL_TIME_BEHIND_S 0.002
 #define SIM_BOOT_MAX_CYCLES (SIM_FREQUENCY / 10)	/* 100 ms simulated */
 #define SIM_UCSRB_RXEN 0x10
 
@@ -628,6 +630,13 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 	if (th->on) {
 		double ahead = (double)(world_cycle(&sim->world) - th->cycle0) / SIM_FREQUENCY -
 			       (now - th->wall0);
+		if (sim->real_time && ahead < -SIM_REAL_TIME_BEHIND_S) {
+			/* Fallen behind (the machine busy): go on at real time
+			 * from here rather than run free to catch up, which
+			 * would give the PC less than a real board's time. */
+			th->wall0 = now;
+			th->cycle0 = world_cycle(&sim->world);
+		}
 		if (ahead > 0.0005) {
 			/* Wait for wall time, or for the PC or a control
 			 * client to send. */

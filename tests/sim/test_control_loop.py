@@ -10,8 +10,7 @@ Where the target is missed the firmware is what limits (docs/python.md,
 "Pipelining across calls", has the figures): the M32-D's 16-triple servo
 write (about 27000 cycles) and every board's per-character and per-request
 cost above 115200; the M32-D loses received characters to its servo
-interrupt above 115200 (test_fast_rates.py); the M128-S at 460800 sends an
-occasional reply with a wrong character (found by this loop).
+interrupt above 115200 (test_fast_rates.py).
 """
 
 import sys
@@ -35,14 +34,11 @@ TARGET = 95.0
 
 M32D_DOR = pytest.mark.xfail(reason="issue 20: the M32-D's servo interrupt holds interrupts "
                              "off longer than two frames above 115200 (characters lost: DOR)")
-M128S_460800 = pytest.mark.xfail(reason="issue 20: the M128-S at 460800 now and then sends a "
-                                 "reply with one wrong character (a read's data)")
 FIRMWARE_TIME = pytest.mark.xfail(reason="issue 20: the firmware's time per step is longer "
                                   "than the step's wire time (its servo write, per character "
                                   "and per request costs)")
 
-CORRECT = {("m32d", 230400): M32D_DOR, ("m32d", 460800): M32D_DOR,
-           ("m128s", 460800): M128S_460800}
+CORRECT = {("m32d", 230400): M32D_DOR, ("m32d", 460800): M32D_DOR}
 AT_TARGET = {("m32d", 115200): FIRMWARE_TIME, ("m32d", 230400): M32D_DOR,
              ("m32d", 460800): M32D_DOR, ("m128s", 230400): FIRMWARE_TIME,
              ("m128s", 460800): FIRMWARE_TIME}
@@ -93,6 +89,14 @@ def test_the_loop_reads_and_writes_right(loop_on, board, rate):
         assert tuple(b.motor.duties()) == duties
     line = sim.control.line()
     assert line["dor"] == line["fe"] == 0
+
+
+def test_300_steps_at_460800_on_the_m128s(loop_on):
+    """Before firmware/uart.c turned UDRIE on atomically, the M128-S sent
+    stale bytes now and then at 460800 (a UDRE interrupt between the load
+    and the store of UCSR1B |= UDRIE): 300 steps always met one."""
+    _, loop = loop_on("m128s", 460800)
+    cl.run(loop, 300, True, cl.check_sim_inputs)
 
 
 @pytest.mark.parametrize("board, rate", cases(AT_TARGET))
