@@ -49,11 +49,12 @@ void uart_putc(uint8_t c)
 		wdt_reset();
 	}
 	uart.tx[head] = c;
-	/* The byte joins the ring and UDRIE goes on in one piece: the M128-S's
-	 * UCSR1B is beyond sbi's reach, so |= is a load and a store, and a UDRE
-	 * interrupt between them that empties the ring and turns UDRIE off
-	 * would have it turned on again over an empty ring: stale bytes sent,
-	 * the tail run past the head (replies garbled at 460800). */
+	/* The byte joins the ring and UDRIE goes on in one piece: a UDRE
+	 * interrupt in between could send the byte, find the ring empty and
+	 * turn UDRIE off, and then UDRIE went on over an empty ring: a stale
+	 * byte sent and the tail run past the head (replies garbled now and
+	 * then at 460800). The M128-S's UCSR1B is beyond sbi's reach, so its
+	 * |= (a load and a store) made that window three instructions wide. */
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 		uart.tx_head = next;
 		MCU_UCSRB |= _BV(UDRIE);

@@ -92,9 +92,10 @@ def test_the_loop_reads_and_writes_right(loop_on, board, rate):
 
 
 def test_300_steps_at_460800_on_the_m128s(loop_on):
-    """Before firmware/uart.c turned UDRIE on atomically, the M128-S sent
-    stale bytes now and then at 460800 (a UDRE interrupt between the load
-    and the store of UCSR1B |= UDRIE): 300 steps always met one."""
+    """Before firmware/uart.c put a byte in its ring and turned UDRIE on
+    atomically, the M128-S sent stale bytes now and then at 460800 (a UDRE
+    interrupt in between emptied the ring and turned UDRIE off): 300 steps
+    always met one."""
     _, loop = loop_on("m128s", 460800)
     cl.run(loop, 300, True, cl.check_sim_inputs)
 
