@@ -845,6 +845,10 @@ def print_sensor_reads(boards, width=38):
 sys.path.insert(0, str(ROOT / "examples"))
 LOOP_STEPS = 300
 LOOP_STEPS_ONE = 100
+#: Columns that break for a reason of their own, an xfail of the tests (the
+#: run's exit status does not count them)
+LOOP_KNOWN_BROKEN = {("m32d", r): "the servo interrupt loses received characters above"
+                     " 115200, tests/sim/test_fast_rates.py" for r in (230400, 460800)}
 #: Steps before the clock starts: the pipeline full (examples/control_loop.py timed)
 LOOP_WARMUP = 10
 
@@ -924,10 +928,11 @@ def print_control_loop(boards, width=38):
     print("step's replies are waited for (Board.submit, Gateway.submit_transactions, within")
     print("the flow rule); one at a time: the same requests, each after the last one's reply.")
     print("Timed from step %d's inputs to the last step's." % (LOOP_WARMUP - 1))
-    broken = [r["error"] for r in res.values() if "error" in r]
-    for why in broken:
-        print("broken: %s" % why)
-    return not broken
+    for col in cols:
+        if "error" in res[col]:
+            print("broken%s: %s" % (" (known: %s)" % LOOP_KNOWN_BROKEN[col]
+                                    if col in LOOP_KNOWN_BROKEN else "", res[col]["error"]))
+    return all("error" not in res[c] for c in cols if c not in LOOP_KNOWN_BROKEN)
 
 # --- end of the control loop --------------------------------------------------------
 
