@@ -182,6 +182,8 @@ class Gateway(Closing):
         self._synced = not sync
         #: times the line was brought back in step (noise, stale lines, timeouts)
         self.resyncs = 0
+        #: bytes read from the port beyond the last line taken (_read_until)
+        self._rx = bytearray()
         #: the stream of submitted requests (submit()): not yet sent, and
         #: sent with their replies still to come (their characters: in_flight)
         self._unsent: deque = deque()
@@ -224,16 +226,47 @@ class Gateway(Closing):
     def _read_until(self, left: float) -> bytes:
         """Bytes up to an LF, or what came within `left` seconds: the
         port's own timeout is shortened for this read when clearly less is
-        left (on a real port that reconfigures it: not for every line)."""
+        left (on a real port that reconfigures it: not for every line).
+        A pyserial port is read for all it holds at once (in_waiting), the bytes after the LF kept for the
+        next line: pyserial's read_until takes one byte a call, and a
+        USB-serial adapter hands over a millisecond's bytes at once (46 at
+        460800 baud)."""
         port = self.serial
-        short = port.timeout is None or left < port.timeout - _TIMEOUT_GRACE
+        if not isinstance(port, serial.SerialBase):        # a wrapper, a test's fake
+            return self._port_call(port.read_until, b"\n", left)
+        buf = self._rx
+        deadline = time.monotonic() + left
+        first = True
+        while b"\n" not in buf:
+            waiting = self._port_waiting()
+            if waiting:
+                buf += self._port_call(port.read, waiting, None)
+                continue
+            left = deadline - time.monotonic()
+            if left <= 0 and not first:
+                break
+            # one byte, waited for; then what came with it
+            got = self._port_call(port.read, 1, max(left, 0.0))
+            first = False
+            if not got:
+                break
+            buf += got
+        end = buf.find(b"\n") + 1 or len(buf)
+        line = bytes(buf[:end])
+        del buf[:end]
+        return line
+
+    def _port_call(self, read, arg, left: Optional[float]):
+        """read(arg) on the port, its timeout shortened to `left` when
+        clearly less is left (None: as it is); its errors as SerialError."""
+        port = self.serial
         try:
-            if not short:
-                return port.read_until(b"\n")
+            if left is None or not (port.timeout is None or left < port.timeout - _TIMEOUT_GRACE):
+                return read(arg)
             kept = port.timeout
             port.timeout = left
             try:
-                return port.read_until(b"\n")
+                return read(arg)
             finally:
                 port.timeout = kept
         except (serial.SerialException, OSError) as e:
@@ -489,6 +522,10 @@ class Gateway(Closing):
             return "<noise: %s>" % e
 
     def _waiting(self) -> int:
+        """Bytes received that no line has taken yet."""
+        return len(self._rx) + self._port_waiting()
+
+    def _port_waiting(self) -> int:
         try:
             return self.serial.in_waiting
         except (AttributeError, NotImplementedError, serial.SerialException, OSError):
