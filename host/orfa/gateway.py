@@ -227,10 +227,10 @@ class Gateway(Closing):
         """Bytes up to an LF, or what came within `left` seconds: the
         port's own timeout is shortened for this read when clearly less is
         left (on a real port that reconfigures it: not for every line).
-        A pyserial port is read for all it holds at once (in_waiting), the bytes after the LF kept for the
-        next line: pyserial's read_until takes one byte a call, and a
-        USB-serial adapter hands over a millisecond's bytes at once (46 at
-        460800 baud)."""
+        A pyserial port is read for all it holds at once (in_waiting), the
+        bytes after the LF kept for the next line: pyserial's read_until
+        takes one byte a call, and a USB-serial adapter hands over a
+        millisecond's bytes at once (46 at 460800 baud)."""
         port = self.serial
         if not isinstance(port, serial.SerialBase):        # a wrapper, a test's fake
             return self._port_call(port.read_until, b"\n", left)
