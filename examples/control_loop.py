@@ -17,11 +17,11 @@ IMU on its I2C bus at D0 (7-bit 0x68). Each step is four requests:
   SAA<RD>SAB10P            the 8 ADC results, 10 bits each
   SD03BSD10EP              the IMU's 14 bytes from ACCEL_XOUT_H
 
-Pipelined (the default), step k+1's requests are submitted before step k's
-replies are waited for (Board.submit, Gateway.submit_transactions: the
-library keeps the flow rule), so the line never waits for the PC between
-steps; the outputs are computed from the newest inputs in hand, one step
-older than a loop that waits. --one-at-a-time sends the same requests as
+Pipelined (the default), the next AHEAD (2) steps' requests are submitted
+before a step's replies are waited for (Board.submit,
+Gateway.submit_transactions: the library keeps the flow rule), so the line
+never waits for the PC between steps; the outputs are computed from the
+newest inputs in hand, AHEAD steps older than a loop that waits. --one-at-a-time sends the same requests as
 naive code does, each after the last one's reply.
 
 The law here is a demonstration: each servo follows an ADC input (0..5 V
