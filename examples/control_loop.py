@@ -21,8 +21,9 @@ Pipelined (the default), the next AHEAD (2) steps' requests are submitted
 before a step's replies are waited for (Board.submit,
 Gateway.submit_transactions: the library keeps the flow rule), so the line
 never waits for the PC between steps; the outputs are computed from the
-newest inputs in hand, AHEAD steps older than a loop that waits. --one-at-a-time sends the same requests as
-naive code does, each after the last one's reply.
+newest inputs in hand, AHEAD steps older than a loop that waits.
+--one-at-a-time sends the same requests as naive code does, each after the
+last one's reply.
 
 The law here is a demonstration: each servo follows an ADC input (0..5 V
 to 1000..2000 us) plus a slow sweep, the motors the IMU's tilt. Every reply
