@@ -96,7 +96,7 @@ static void run_i2c(sg_parser_t *p)
 	for (uint8_t i = 0; i < p->nbytes && err == SG_OK;) {
 		uint8_t addr = buf[i];
 		uint8_t n = buf[i + 1];
-		if ((addr & 0xFE) == gate.local) {
+		if ((uint8_t)(addr & 0xFE) == gate.local) {
 			err = run_local(addr, &buf[i + 2], n);
 		} else {
 			on_bus = true;
@@ -155,6 +155,11 @@ void sg_exec(sg_parser_t *p)
 		out_error(p->err);
 		return;
 	}
+	if (p->cmd == SG_CMD_I2C) {
+		/* first: the requests whose latency counts */
+		run_i2c(p);
+		return;
+	}
 	switch (p->cmd) {
 	case SG_CMD_VERSION:
 		sg_out('V');
@@ -184,9 +189,6 @@ void sg_exec(sg_parser_t *p)
 		out_hex((uint8_t)(gate.khz >> 8));
 		out_hex((uint8_t)gate.khz);
 		break;
-	case SG_CMD_I2C:
-		run_i2c(p);
-		return;
 	default:
 		out_error(SG_ERR_INTERNAL);
 		return;
