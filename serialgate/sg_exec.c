@@ -89,20 +89,22 @@ static uint8_t run_bus(uint8_t addr, uint8_t *data, uint8_t n)
 
 static void run_i2c(sg_parser_t *p)
 {
-	uint8_t *buf = p->buf;
+	uint8_t *const end = p->buf + p->nbytes;
 	uint8_t err = SG_OK;
 	bool on_bus = false;
 
-	for (uint8_t i = 0; i < p->nbytes && err == SG_OK;) {
-		uint8_t addr = buf[i];
-		uint8_t n = buf[i + 1];
+	/* frames as [addr][n][n bytes], walked with a pointer */
+	for (uint8_t *f = p->buf; f < end && err == SG_OK;) {
+		uint8_t addr = f[0];
+		uint8_t n = f[1];
+		uint8_t *data = f + 2;
+		f = data + n;
 		if ((uint8_t)(addr & 0xFE) == gate.local) {
-			err = run_local(addr, &buf[i + 2], n);
+			err = run_local(addr, data, n);
 		} else {
 			on_bus = true;
-			err = run_bus(addr, &buf[i + 2], n);
+			err = run_bus(addr, data, n);
 		}
-		i = (uint8_t)(i + 2 + n);
 	}
 	/* A STOP that cannot be made leaves the last frame unfinished: its
 	 * slave drops it (twi_quiet.h), so the request failed. */
@@ -113,10 +115,11 @@ static void run_i2c(sg_parser_t *p)
 		out_error(err);
 		return;
 	}
-	for (uint8_t i = 0; i < p->nbytes;) {
-		uint8_t addr = buf[i];
-		uint8_t n = buf[i + 1];
-		uint8_t *data = &buf[i + 2];
+	for (uint8_t *f = p->buf; f < end;) {
+		uint8_t addr = f[0];
+		uint8_t n = f[1];
+		uint8_t *data = f + 2;
+		f = data + n;
 		sg_out('S');
 		if (addr & 1) {
 			sg_out('R');
@@ -129,7 +132,6 @@ static void run_i2c(sg_parser_t *p)
 				sg_out('A');
 			}
 		}
-		i = (uint8_t)(i + 2 + n);
 	}
 	sg_out('P');
 	out_end();
