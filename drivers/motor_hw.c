@@ -23,10 +23,14 @@ void motor_hw_init(void)
 	motor_hw_apply(zero, zero, 0x03);
 }
 
-/* High for OCR+1 of 368 cycles: OCR = round(pwm * 368 / 255) - 1. */
+/* High for OCR+1 of 368 cycles: OCR = round(pwm * 368 / 255) - 1, with
+ * 368 = 255 + 113 taken apart so the division is 16-bit (no 32-bit
+ * division linked): pwm * 255 divides exactly. */
+_Static_assert(MOTOR_TOP + 1 >= 255 && 255u * (MOTOR_TOP + 1 - 255) + 127u <= 0xFFFFu,
+	       "pwm * (368 - 255) + 127 fits 16 bits");
 static uint16_t motor_ocr(uint8_t pwm)
 {
-	return (uint16_t)(((uint32_t)pwm * (MOTOR_TOP + 1) + 127) / 255 - 1);
+	return (uint16_t)(pwm + (uint16_t)(pwm * (uint16_t)(MOTOR_TOP + 1 - 255) + 127u) / 255u - 1);
 }
 
 void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
