@@ -87,7 +87,7 @@ DRIVERS ?= $(BOARD_DRIVERS)
 BUILD ?= build/$(BOARD)-$(MODE)
 # -fno-move-loop-invariants -mstrict-X: 130 bytes less on the M32-D gateway,
 # no slower where it counts (make bench).
-FW_OPT ?= -Os -fno-move-loop-invariants -mstrict-X
+FW_OPT ?= -Os -fno-move-loop-invariants -mstrict-X -mcall-prologues
 CC := avr-gcc
 OBJCOPY := avr-objcopy
 AVR_SIZE := avr-size

@@ -10,7 +10,6 @@
 
 #include "firmware/board_pins.h"
 #include "firmware/pins.h"
-#include "firmware/port_io.h"
 
 #define MOTOR_TOP 367  /* 368 timer cycles per PWM period */
 
@@ -63,16 +62,14 @@ void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
 	}
 	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
 		uint8_t d = board_pin(BF_MOTOR_DIR, m);
-		port_io_write(PIN_PORT(d), PIN_MASK(d), dir[m] ? PIN_MASK(d) : 0);
-		port_io_dir(PIN_PORT(d), PIN_MASK(d), PIN_MASK(d));
+		pins_drive(d, dir[m]);
 		if (lines & (1u << m)) {
 			/* 0 and 255 are steady levels from the port with the compare
 			 * output disconnected: at OCR 0 the output would still spike
 			 * once a period, and OCR = TOP relies on compare and overflow
 			 * meeting in the same cycle. */
 			uint8_t p = board_pin(BF_MOTOR_PWM, m);
-			port_io_write(PIN_PORT(p), PIN_MASK(p), pwm[m] == 255 ? PIN_MASK(p) : 0);
-			port_io_dir(PIN_PORT(p), PIN_MASK(p), PIN_MASK(p));
+			pins_drive(p, pwm[m] == 255);
 		}
 	}
 }
