@@ -72,19 +72,10 @@ static uint8_t run_bus(uint8_t addr, uint8_t *data, uint8_t n)
 		/* no ACK, or the bus could not be had (held, lost, timeout) */
 		return SG_ERR_ADDR_NACK;
 	}
-	for (uint8_t i = 0; i < n; i++) {
-		if (addr & 1) {
-			r = twi_read(&data[i], (uint8_t)(i + 1) < n);
-		} else {
-			r = twi_write(data[i]);
-		}
-		if (r != TWI_ACK) {
-			/* refused, or the bus was lost or stuck after the
-			 * address was acknowledged */
-			return SG_ERR_DATA_NACK;
-		}
-	}
-	return SG_OK;
+	r = (addr & 1) ? twi_read_bytes(data, n) : twi_write_bytes(data, n);
+	/* refused, or the bus was lost or stuck after the address was
+	 * acknowledged */
+	return r == TWI_ACK ? SG_OK : SG_ERR_DATA_NACK;
 }
 
 static void run_i2c(sg_parser_t *p)
