@@ -113,12 +113,13 @@ void front_poll(void)
 {
 	/* TWINT first and often: a bus event waits for nothing else (the
 	 * failsafe and the quiet check are looked at every few hundred
-	 * cycles, far more often than they need). */
+	 * cycles, far more often than they need, and after every event,
+	 * which the failsafe has to see at once: SYS_HEARD). */
 	uint8_t i = 0;
 	do {
 		if (TWCR & _BV(TWINT)) {
 			slave_event();
-			return;
+			break;
 		}
 	} while (--i);
 	/* A master gone in the middle of a frame must not leave this TWI

@@ -6,7 +6,8 @@
 
 typedef enum {
 	WORK_NONE = 0,
-	WORK_FRAME_END,   /* apply a write frame's data */
+	WORK_FRAME_END,   /* end the frame: a write frame's data applied */
+	WORK_WRITE_START, /* a write frame begins */
 	WORK_READ_START,  /* a read frame's first driver answer */
 	WORK_READ_MORE,   /* the driver's next answer */
 } slave_work_t;
@@ -67,13 +68,14 @@ static slave_action_t slave_end_write(void)
 	return SLAVE_ACK;
 }
 
-/* The read frame is over (or was never one): nothing to take ahead. */
+/* The read frame is over (or was never one): nothing to take ahead; the
+ * bus goes on before its end is booked. */
 static slave_action_t slave_end_read(void)
 {
 	slave.reading = 0;
 	slave.next_ok = 0;
-	xact_frame_end();
-	return SLAVE_ACK;
+	slave.work = WORK_FRAME_END;
+	return SLAVE_DEFER_ACK;
 }
 
 slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
@@ -90,11 +92,12 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 	switch (status) {
 	case TW_SR_SLA_ACK:
 	case TW_SR_ARB_LOST_SLA_ACK:
-		xact_write_requested(slave.buf, sizeof slave.buf);
+		/* acknowledged whatever comes: the frame is opened after */
 		slave.in_write = 1;
 		slave.reading = 0;
 		slave.next_ok = 0;
-		return SLAVE_ACK;
+		slave.work = WORK_WRITE_START;
+		return SLAVE_DEFER_ACK;
 	case TW_SR_DATA_ACK:
 		return xact_write_received(*byte) ? SLAVE_ACK : SLAVE_NACK;
 	case TW_ST_SLA_ACK:
@@ -142,6 +145,9 @@ slave_action_t slave_fsm_work(uint8_t *byte)
 	switch (work) {
 	case WORK_FRAME_END:
 		xact_frame_end();
+		return SLAVE_RESUME;
+	case WORK_WRITE_START:
+		xact_write_requested(slave.buf, sizeof slave.buf);
 		return SLAVE_RESUME;
 	case WORK_READ_START:
 		xact_read_requested(slave.buf, sizeof slave.buf);
