@@ -89,8 +89,8 @@ BUILD ?= build/$(BOARD)-$(MODE)
 # no slower where it counts (make bench). -mcall-prologues: register saves
 # through one shared routine, 250 bytes less; interrupt handlers keep their
 # own, and the local latency is the same over the phases of the clock tick.
-# -fno-tree-sink: 48 bytes less, the latency the same.
-FW_OPT ?= -Os -fno-move-loop-invariants -mstrict-X -mcall-prologues -fno-tree-sink
+# -fno-tree-sink -fno-tree-copyrename: 50 bytes less, the latency the same.
+FW_OPT ?= -Os -fno-move-loop-invariants -mstrict-X -mcall-prologues -fno-tree-sink -fno-tree-copyrename
 CC := avr-gcc
 OBJCOPY := avr-objcopy
 AVR_SIZE := avr-size

@@ -77,7 +77,8 @@ static twi_result_t twi_abandon(void)
 void twi_init(void)
 {
 	TWCR = _BV(TWEN);
-	twi_set_khz(100);
+	/* The rate is the front end's to set (sg_exec_init: the one
+	 * default, SG_KHZ_DEFAULT), before any transfer. */
 	/* This board may have reset in the middle of a frame. */
 	twi_fence_up();
 }

@@ -19,6 +19,7 @@ typedef enum {
 	TWI_FAIL,      /* bus error, arbitration lost or timeout: abandoned */
 } twi_result_t;
 
+/* The TWI on, the quiet fence up; twi_set_khz() then, before a transfer. */
 void twi_init(void);
 
 /* Sets the fastest SCL rate the TWI can make that is not above `khz` and
