@@ -51,23 +51,18 @@ static bool slave_quiet(void)
 /* The answer into TWDR/TWCR: TWINT written 1 lets the bus go on. */
 static void slave_apply(slave_action_t act, uint8_t byte)
 {
-	switch (act) {
-	case SLAVE_SEND:
+	/* the common answers tested first */
+	if (act == SLAVE_SEND) {
 		TWDR = byte;
 		TWCR = _BV(TWINT) | SLAVE_TWCR;
-		break;
-	case SLAVE_NACK:
-		TWCR = _BV(TWINT) | _BV(TWEN);
-		break;
-	case SLAVE_RECOVER:
-		TWCR = _BV(TWINT) | _BV(TWSTO) | SLAVE_TWCR;
-		break;
-	case SLAVE_RESUME:
-		break;  /* the event was answered before its work */
-	default:    /* SLAVE_ACK, SLAVE_DEFER_ACK */
+	} else if (act == SLAVE_ACK || act == SLAVE_DEFER_ACK) {
 		TWCR = _BV(TWINT) | SLAVE_TWCR;
-		break;
+	} else if (act == SLAVE_NACK) {
+		TWCR = _BV(TWINT) | _BV(TWEN);
+	} else if (act == SLAVE_RECOVER) {
+		TWCR = _BV(TWINT) | _BV(TWSTO) | SLAVE_TWCR;
 	}
+	/* SLAVE_RESUME: the event was answered before its work */
 }
 
 /* One TWI event (TWINT set), answered. */
@@ -95,9 +90,11 @@ static void slave_event(void)
 	}
 	slave_seen = clock_now8();
 	/* Its own address (SLA+W or SLA+R) keeps the link alive; frames for
-	 * other addresses never reach here. */
+	 * other addresses never reach here. Booked at once: the main loop
+	 * may go from event to event for a while. */
 	if (status == TW_SR_SLA_ACK || status == TW_ST_SLA_ACK) {
 		SYS_HEARD();
+		sys_poll();
 	}
 	slave_fsm_after();
 }
@@ -112,14 +109,14 @@ void front_init(void)
 void front_poll(void)
 {
 	/* TWINT first and often: a bus event waits for nothing else (the
-	 * failsafe and the quiet check are looked at every few hundred
-	 * cycles, far more often than they need, and after every event,
-	 * which the failsafe has to see at once: SYS_HEARD). */
+	 * failsafe and the quiet check are looked at when the bus has been
+	 * still for a thousand cycles or so, far more often than they need;
+	 * the keep-alive is booked by the event itself). */
 	uint8_t i = 0;
 	do {
 		if (TWCR & _BV(TWINT)) {
 			slave_event();
-			break;
+			return;
 		}
 	} while (--i);
 	/* A master gone in the middle of a frame must not leave this TWI

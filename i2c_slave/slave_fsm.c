@@ -89,6 +89,14 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 	/* addressed until a frame's end: STOP or repeated START, a refused
 	 * byte, the master's NACK or the last byte sent */
 	slave.in_frame = 1;
+	/* Then the two the master waits on longest, tested first. */
+	if (status == TW_ST_SLA_ACK || status == TW_ST_ARB_LOST_SLA_ACK) {
+		slave.next_ok = 0;
+		return slave_defer(WORK_READ_START);
+	}
+	if (status == TW_SR_DATA_ACK) {
+		return xact_write_received(*byte) ? SLAVE_ACK : SLAVE_NACK;
+	}
 	switch (status) {
 	case TW_SR_SLA_ACK:
 	case TW_SR_ARB_LOST_SLA_ACK:
@@ -98,12 +106,6 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 		slave.next_ok = 0;
 		slave.work = WORK_WRITE_START;
 		return SLAVE_DEFER_ACK;
-	case TW_SR_DATA_ACK:
-		return xact_write_received(*byte) ? SLAVE_ACK : SLAVE_NACK;
-	case TW_ST_SLA_ACK:
-	case TW_ST_ARB_LOST_SLA_ACK:
-		slave.next_ok = 0;
-		return slave_defer(WORK_READ_START);
 	case TW_ST_DATA_ACK:
 		/* nothing taken ahead: the driver's answer is used up */
 		if (!xact_read_buffered()) {
@@ -115,16 +117,15 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 		break;
 	}
 	slave.in_frame = 0;
+	if (status == TW_SR_STOP) {
+		/* the frame's end: the master waits to go on */
+		return slave.in_write ? slave_end_write() : slave_end_read();
+	}
 	switch (status) {
 	case TW_SR_DATA_NACK:
 		/* Refused byte: the TWI is no longer addressed, and no STOP
 		 * event will come for this frame. */
 		return slave_end_write();
-	case TW_SR_STOP:
-		if (slave.in_write) {
-			return slave_end_write();
-		}
-		return slave_end_read();
 	case TW_ST_DATA_NACK:
 	case TW_ST_LAST_DATA:
 		return slave_end_read();
@@ -142,6 +143,13 @@ slave_action_t slave_fsm_work(uint8_t *byte)
 	slave_work_t work = (slave_work_t)slave.work;
 
 	slave.work = WORK_NONE;
+	if (work == WORK_READ_START) {
+		/* first: the master waits for its byte, SCL held */
+		xact_read_requested(slave.buf, sizeof slave.buf);
+		slave.reading = 1;
+		xact_read_processed(byte);
+		return SLAVE_SEND;
+	}
 	switch (work) {
 	case WORK_FRAME_END:
 		xact_frame_end();
@@ -149,11 +157,6 @@ slave_action_t slave_fsm_work(uint8_t *byte)
 	case WORK_WRITE_START:
 		xact_write_requested(slave.buf, sizeof slave.buf);
 		return SLAVE_RESUME;
-	case WORK_READ_START:
-		xact_read_requested(slave.buf, sizeof slave.buf);
-		slave.reading = 1;
-		xact_read_processed(byte);
-		return SLAVE_SEND;
 	case WORK_READ_MORE:
 		xact_read_processed(byte);
 		return SLAVE_SEND;
