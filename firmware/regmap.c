@@ -20,35 +20,25 @@ enum {
 
 _Static_assert(REGMAP_END <= 0x100, "registers must fit in one byte");
 
-/* One table in flash per operation, function pointers read straight from
- * it (a pointer to a descriptor that itself lives in flash is the double
- * indirection avr-gcc 5.4 gets wrong at -O2): a driver's entry is two bytes
- * in, where rows of four pointers cost a shift loop on every call (on the
- * latency path of every local request). */
-#define X(name) drv_##name##_init,
-static void (*const ORFA_FLASH regmap_init_fns[])(void) = {
-	drv_intro_init, ORFA_DRIVER_LIST drv_sys_init
-};
-#undef X
-#define X(name) drv_##name##_write,
-static reg_status_t (*const ORFA_FLASH regmap_write_fns[])(uint8_t reg, const uint8_t *data,
-							       uint8_t len) = {
-	drv_intro_write, ORFA_DRIVER_LIST drv_sys_write
-};
-#undef X
-#define X(name) drv_##name##_read,
-static uint8_t (*const ORFA_FLASH regmap_read_fns[])(uint8_t reg, uint8_t *dst, uint8_t max) = {
-	drv_intro_read, ORFA_DRIVER_LIST drv_sys_read
-};
-#undef X
-#define X(name) drv_##name##_check,
-static reg_status_t (*const ORFA_FLASH regmap_check_fns[])(uint8_t reg, const uint8_t *data,
-							       uint8_t len) = {
-	drv_intro_check, ORFA_DRIVER_LIST drv_sys_check
-};
-#undef X
+/* One flat table in flash: function pointers read straight from it (a
+ * pointer to a descriptor that itself lives in flash is the double
+ * indirection avr-gcc 5.4 gets wrong at -O2). */
+typedef struct {
+	void (*init)(void);
+	reg_status_t (*write)(uint8_t reg, const uint8_t *data, uint8_t len);
+	uint8_t (*read)(uint8_t reg, uint8_t *dst, uint8_t max);
+	reg_status_t (*check)(uint8_t reg, const uint8_t *data, uint8_t len);
+} regmap_entry_t;
 
-#define REGMAP_NDRIVERS ((uint8_t)(sizeof regmap_init_fns / sizeof regmap_init_fns[0]))
+static const ORFA_FLASH regmap_entry_t regmap_table[] = {
+	{ drv_intro_init, drv_intro_write, drv_intro_read, drv_intro_check },
+#define X(name) { drv_##name##_init, drv_##name##_write, drv_##name##_read, drv_##name##_check },
+	ORFA_DRIVER_LIST
+#undef X
+	{ drv_sys_init, drv_sys_write, drv_sys_read, drv_sys_check },
+};
+
+#define REGMAP_NDRIVERS ((uint8_t)(sizeof regmap_table / sizeof regmap_table[0]))
 
 /* Start registers on their own: selecting walks bytes, not 7-byte rows. */
 static const ORFA_FLASH uint8_t regmap_starts[] = {
@@ -74,12 +64,11 @@ static const ORFA_FLASH uint8_t regmap_records[][REGMAP_RECORD_LEN] = {
 
 /* selected.entry when no register is selected (after an unmapped one). */
 #define REGMAP_NO_ENTRY 0xFF
-_Static_assert(REGMAP_NDRIVERS < REGMAP_NO_ENTRY, "a driver index is never 0xFF");
 
 /* The register that reads and writes go to, and how the last one ended. */
 static struct {
 	uint8_t reg;     /* selected register */
-	uint8_t entry;   /* its driver's index in the tables, or REGMAP_NO_ENTRY */
+	uint8_t entry;   /* its driver's row's offset in regmap_table, or REGMAP_NO_ENTRY */
 	uint8_t off;     /* the register's number within its driver */
 	uint8_t status;  /* result of the last write or read that reached a driver */
 } selected;
@@ -87,12 +76,23 @@ static struct {
 void regmap_init(void)
 {
 	for (uint8_t i = 0; i < REGMAP_NDRIVERS; i++) {
-		regmap_init_fns[i]();
+		regmap_table[i].init();
 	}
 	selected.reg = REGMAP_INTRO_REG;
 	selected.entry = 0;
 	selected.off = 0;
 	selected.status = REG_OK;
+}
+
+/* The selected driver's row: its offset in the table kept as a byte at
+ * selection (an index times 8 as a 16-bit product was a shift loop on
+ * every call, on the latency path of every local request). */
+_Static_assert((REGMAP_NDRIVERS - 1) * sizeof(regmap_entry_t) < REGMAP_NO_ENTRY,
+	       "a row's offset in the table fits a byte, never REGMAP_NO_ENTRY");
+static const ORFA_FLASH regmap_entry_t *regmap_row(void)
+{
+	return (const ORFA_FLASH regmap_entry_t *)((const ORFA_FLASH uint8_t *)regmap_table +
+						   selected.entry);
 }
 
 bool regmap_select(uint8_t reg)
@@ -109,7 +109,7 @@ bool regmap_select(uint8_t reg)
 		i++;
 	}
 	selected.reg = reg;
-	selected.entry = i;
+	selected.entry = (uint8_t)(i * sizeof(regmap_entry_t));
 	selected.off = (uint8_t)(reg - regmap_starts[i]);
 	return true;
 }
@@ -122,7 +122,7 @@ reg_status_t regmap_check(const uint8_t *data, uint8_t len)
 	if (selected.reg == REGMAP_STATUS_REG) {
 		return REG_NOT_WRITABLE;
 	}
-	return regmap_check_fns[selected.entry](selected.off, data, len);
+	return regmap_row()->check(selected.off, data, len);
 }
 
 reg_status_t regmap_write(const uint8_t *data, uint8_t len)
@@ -134,7 +134,7 @@ reg_status_t regmap_write(const uint8_t *data, uint8_t len)
 	} else if (selected.reg == REGMAP_STATUS_REG) {
 		st = REG_NOT_WRITABLE;
 	} else {
-		st = regmap_write_fns[selected.entry](selected.off, data, len);
+		st = regmap_row()->write(selected.off, data, len);
 	}
 	selected.status = st;
 	return st;
@@ -159,7 +159,7 @@ uint8_t regmap_read(uint8_t *dst, uint8_t max)
 		}
 		return max;
 	}
-	uint8_t got = regmap_read_fns[selected.entry](selected.off, dst, max);
+	uint8_t got = regmap_row()->read(selected.off, dst, max);
 	if (got == 0) {  /* (a driver gives at most max: tests/unit checks each) */
 		selected.status = REG_NOT_READABLE;
 		return 0;
