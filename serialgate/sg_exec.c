@@ -106,12 +106,15 @@ static void run_i2c(sg_parser_t *p)
 		out_error(err);
 		return;
 	}
-	for (uint8_t *f = p->buf; f < end;) {
+	/* A request has a frame at least (the parser's): the reply's first
+	 * byte leaves before anything else is looked at. */
+	uint8_t *f = p->buf;
+	do {
+		sg_out('S');
 		uint8_t addr = f[0];
 		uint8_t n = f[1];
 		uint8_t *data = f + 2;
 		f = data + n;
-		sg_out('S');
 		if (addr & 1) {
 			sg_out('R');
 			for (uint8_t k = 0; k < n; k++) {
@@ -123,7 +126,7 @@ static void run_i2c(sg_parser_t *p)
 				sg_out('A');
 			}
 		}
-	}
+	} while (f < end);
 	sg_out('P');
 	out_end();
 }
