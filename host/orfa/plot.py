@@ -2,7 +2,9 @@
 signal, the time axis counted from the window's start in a unit that suits
 its length (us, ms or s), each row annotated with what orfa.waves measures
 (every pulse's width when they fit, and a summary line: widths, and period
-and duty for a periodic line).
+and duty for a periodic line), and a serial line or SDA with what
+orfa.decode read on it (its bytes; START, address + R/W, data, ACK/NACK,
+STOP) written over each frame.
 
 matplotlib is the extra `orfa[plot]`; this module imports it only when it
 draws, and says which package is missing otherwise.
@@ -12,10 +14,11 @@ from __future__ import annotations
 
 from typing import List, NamedTuple, Optional, Sequence
 
-from . import waves
+from . import decode, waves
 from .errors import PlotUnavailable
 
 MAX_PULSE_LABELS = 8          # a row with more complete pulses gets only its summary
+MAX_MARK_LABELS = 150         # a row with more decoded frames in the window: none written
 ROW_HEIGHT_IN = 0.62
 WIDTH_IN = 12.0
 
@@ -24,6 +27,25 @@ class Row(NamedTuple):
     wave: waves.Wave
     label: str                # the y axis text: name and what the pin does
     periodic: bool = True     # False: a bus or a serial line (no period, no duty)
+    frames: Sequence[decode.Frame] = ()   # what orfa.decode read on the line
+
+
+def frames_in(row: Row) -> List[decode.Frame]:
+    """The row's decoded frames that lie whole inside its window."""
+    w = row.wave
+    return [f for f in row.frames if f.start >= w.start and f.end <= w.end]
+
+
+def mark_text(frame: decode.Frame) -> str:
+    """What a frame says on the picture: a serial byte as the character it
+    is in ORFA's text protocol (`S`, `0`, `CR`; `!` after it when its stop
+    bit read low), the I2C frames as ORFA's replies spell them (`S`, `Sr`,
+    `A0 W`, `41`, `A`, `N`, `P`)."""
+    if frame.kind == "byte":
+        return decode.char(frame.value)
+    if frame.kind == "framing error":
+        return decode.char(frame.value) + "!"
+    return frame.text
 
 
 class Axis(NamedTuple):
@@ -46,18 +68,24 @@ def time_axis(start: int, end: int, f_cpu: int) -> Axis:
 
 class Annotation(NamedTuple):
     signal: str
-    kind: str                 # "pulse" (one pulse's width) or "summary"
+    kind: str                 # "pulse" (one pulse's width), "decoded" (a frame) or "summary"
     text: str
-    cycles: Optional[int]     # the measured width (pulse) or None
+    cycles: Optional[int]     # the measured width (pulse), the frame's start, or None
 
 
 def annotations(rows: Sequence[Row], f_cpu: int) -> List[Annotation]:
-    """What the plot writes next to each row (also what the tests check)."""
+    """What the plot writes next to each row (also what the tests check):
+    a decoded line's frames (when at most MAX_MARK_LABELS), else each
+    pulse's width (when at most MAX_PULSE_LABELS); then the summary."""
     out = []
     for row in rows:
         name = row.wave.name
         ps = waves.pulses(row.wave)
-        if 0 < len(ps) <= MAX_PULSE_LABELS:
+        frames = frames_in(row)
+        if frames:
+            if len(frames) <= MAX_MARK_LABELS:
+                out += [Annotation(name, "decoded", mark_text(f), f.start) for f in frames]
+        elif 0 < len(ps) <= MAX_PULSE_LABELS:
             for rise, fall in ps:
                 out.append(Annotation(name, "pulse", waves.show_us(fall - rise, f_cpu),
                                       fall - rise))
@@ -100,6 +128,25 @@ def _steps(wave: waves.Wave, f_cpu: int, axis: Axis):
     return xs, ys
 
 
+#: The colour of a decoded frame's text by its kind (default: a byte's).
+_FRAME_COLOURS = {"start": "tab:green", "restart": "tab:green", "stop": "tab:green",
+                  "ack": "0.35", "nack": "tab:red", "partial": "tab:red",
+                  "framing error": "tab:red"}
+_POINT_KINDS = ("start", "restart", "stop", "ack", "nack")
+
+
+def _draw_frames(ax, frames: Sequence[decode.Frame], f_cpu: int, axis: Axis) -> None:
+    """Each frame's text over it; a byte's span lightly shaded."""
+    def x(cycle):
+        return waves.us(cycle - axis.origin, f_cpu) / axis.us_per_unit
+    for f in frames:
+        if f.kind not in _POINT_KINDS:
+            ax.axvspan(x(f.start), x(f.end), color="tab:purple", alpha=0.08, linewidth=0)
+        ax.text(x((f.start + f.end) / 2), 1.08, mark_text(f), ha="center", va="bottom",
+                fontsize=7 if f.kind not in _POINT_KINDS else 6.5,
+                color=_FRAME_COLOURS.get(f.kind, "tab:purple"))
+
+
 def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[Annotation]:
     """Draw rows into the PNG (or SVG/PDF by out's suffix) at out; returns
     the annotations written on it."""
@@ -127,6 +174,8 @@ def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[A
             middle = waves.us((rise + fall) / 2 - axis.origin, f_cpu) / axis.us_per_unit
             ax.annotate(_micro(note.text), xy=(middle, 1.05),
                         ha="center", va="bottom", fontsize=7.5, color="tab:red")
+        if any(a.kind == "decoded" for a in mine):
+            _draw_frames(ax, frames_in(row), f_cpu, axis)
         summary = [a.text for a in mine if a.kind == "summary"]
         ax.text(1.01, 0.35, _micro(summary[0]).replace(", ", "\n", 1) if summary else "",
                 transform=ax.transAxes, ha="left", va="center", fontsize=8, color="0.2")
