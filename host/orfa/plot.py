@@ -21,6 +21,8 @@ MAX_PULSE_LABELS = 8          # a row with more complete pulses gets only its su
 MAX_MARK_LABELS = 150         # a row with more decoded frames in the window: none written
 ROW_HEIGHT_IN = 0.62
 WIDTH_IN = 12.0
+ROWS_WIDTH_IN = 8.2           # about the width the rows get (right of the labels, left of the notes)
+LABEL_CHAR_IN = 0.06          # about a character's width at a pulse label's 7.5 pt
 
 
 class Row(NamedTuple):
@@ -133,6 +135,8 @@ _FRAME_COLOURS = {"start": "tab:green", "restart": "tab:green", "stop": "tab:gre
                   "ack": "0.35", "nack": "tab:red", "partial": "tab:red",
                   "framing error": "tab:red"}
 _POINT_KINDS = ("start", "restart", "stop", "ack", "nack")
+#: Drawn narrower than printed: a space of the serial line is one glyph.
+GLYPHS = {"SP": "\u2423"}
 
 
 def _draw_frames(ax, frames: Sequence[decode.Frame], f_cpu: int, axis: Axis) -> None:
@@ -142,8 +146,9 @@ def _draw_frames(ax, frames: Sequence[decode.Frame], f_cpu: int, axis: Axis) -> 
     for f in frames:
         if f.kind not in _POINT_KINDS:
             ax.axvspan(x(f.start), x(f.end), color="tab:purple", alpha=0.08, linewidth=0)
-        ax.text(x((f.start + f.end) / 2), 1.08, mark_text(f), ha="center", va="bottom",
-                fontsize=7 if f.kind not in _POINT_KINDS else 6.5,
+        text = mark_text(f)
+        ax.text(x((f.start + f.end) / 2), 1.08, GLYPHS.get(text, text), ha="center",
+                va="bottom", fontsize=7 if f.kind not in _POINT_KINDS else 6.5,
                 color=_FRAME_COLOURS.get(f.kind, "tab:purple"))
 
 
@@ -158,6 +163,7 @@ def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[A
     axes = [a[0] for a in axes]
     start, end = (rows[0].wave.start, rows[0].wave.end) if rows else (0, 1)
     axis = time_axis(start, end, f_cpu)
+    span = waves.us(end - start, f_cpu) / axis.us_per_unit
     for ax, row in zip(axes, rows):
         xs, ys = _steps(row.wave, f_cpu, axis)
         ax.plot(xs, ys, color="tab:blue", linewidth=1.0)
@@ -170,8 +176,13 @@ def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[A
         ax.grid(axis="x", color="0.85", linewidth=0.6)
         mine = [a for a in notes if a.signal == row.wave.name]
         pulses = waves.pulses(row.wave)
+        right = float("-inf")               # where the last width written ends
         for (rise, fall), note in zip(pulses, [a for a in mine if a.kind == "pulse"]):
             middle = waves.us((rise + fall) / 2 - axis.origin, f_cpu) / axis.us_per_unit
+            half = len(note.text) * LABEL_CHAR_IN * span / ROWS_WIDTH_IN / 2
+            if middle - half < right:
+                continue                     # it would be written over the one before
+            right = middle + half
             ax.annotate(_micro(note.text), xy=(middle, 1.05),
                         ha="center", va="bottom", fontsize=7.5, color="tab:red")
         if any(a.kind == "decoded" for a in mine):
@@ -179,7 +190,7 @@ def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[A
         summary = [a.text for a in mine if a.kind == "summary"]
         ax.text(1.01, 0.35, _micro(summary[0]).replace(", ", "\n", 1) if summary else "",
                 transform=ax.transAxes, ha="left", va="center", fontsize=8, color="0.2")
-    axes[-1].set_xlim(0, waves.us(end - start, f_cpu) / axis.us_per_unit)
+    axes[-1].set_xlim(0, span)
     axes[-1].ticklabel_format(axis="x", useOffset=False, style="plain")
     axes[-1].set_xlabel(axis.label)
     if title:
