@@ -1,7 +1,10 @@
 """orfa.decode on waveforms made here: a serial line's 8N1 frames at the
 board's rate, and an I2C bus bit by bit (START, address + R/W, data,
 ACK/NACK, repeated START, STOP, clock stretching, a START in the middle of
-a byte)."""
+a byte); and sigrok's own decoders read the same from them."""
+
+import shutil
+import subprocess
 
 import pytest
 
@@ -142,3 +145,66 @@ def test_i2c_reads_nothing_before_the_first_start():
     bus.byte(0x30, True)
     bus.stop()
     assert texts(bus.frames()) == "S 30 W A P"
+
+
+# --- the same waveforms through sigrok's own decoders --------------------------
+
+def sigrok(tmp_path, edges, names, decoder, annotations):
+    """sigrok-cli's plain output for EDGES written as the simulator's VCD
+    (every wire idle high from cycle 100, a last edge on `end` after them)."""
+    from test_waves import make_vcd
+    last = max(c for es in edges.values() for c, _ in es)
+    changes = {n: [(100, 1)] + edges.get(n, []) for n in names}
+    changes["end"] = [(last + 2000, 1)]
+    src = tmp_path / "syn.vcd"
+    src.write_text(make_vcd(changes, names=tuple(names) + ("end",)))
+    r = subprocess.run(["sigrok-cli", "-i", str(src), "-I", "vcd", "-P", decoder,
+                        "-A", annotations], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    return [line.split(": ", 1)[1] for line in r.stdout.splitlines()]
+
+
+needs_sigrok = pytest.mark.skipif(shutil.which("sigrok-cli") is None,
+                                  reason="needs sigrok-cli (tools/setup.sh installs it)")
+
+#: sigrok's i2c annotations as ORFA's letters (its "Write"/"Read" is the R/W bit)
+SIGROK_I2C = [("Start repeat", "Sr"), ("Start", "S"), ("Stop", "P"), ("NACK", "N"),
+              ("ACK", "A"), ("Address write: ", "{} W"), ("Address read: ", "{} R"),
+              ("Data write: ", "{}"), ("Data read: ", "{}")]
+
+
+def orfa_text(line):
+    for prefix, text in SIGROK_I2C:
+        if line.startswith(prefix):
+            return text.format(line[len(prefix):])
+    return None
+
+
+@needs_sigrok
+def test_i2c_reads_as_sigroks_i2c_decoder_does(tmp_path):
+    bus = Bus(t=5000)
+    bus.start()
+    bus.byte(0xA0, True)
+    bus.byte(0x10, True)
+    bus.restart()
+    bus.byte(0xA1, True)
+    bus.byte(0x41, True, stretch=300)
+    bus.byte(0x42, False)
+    bus.stop()
+    bus.t += 200
+    bus.start()
+    bus.byte(0xE0, False)
+    bus.stop()
+    got = sigrok(tmp_path, bus.edges, ("sda", "scl"),
+                 "i2c:scl=scl:sda=sda:address_format=unshifted", "i2c=addr-data")
+    theirs = [t for t in map(orfa_text, got) if t is not None]
+    assert theirs == [f.text for f in bus.frames()]
+    assert " ".join(theirs) == "S A0 W A 10 A Sr A1 R A 41 A 42 N P S E0 W N P"
+
+
+@needs_sigrok
+def test_uart_reads_as_sigroks_uart_decoder_does(tmp_path):
+    edges, _ = serial(b"S A0 10 S A1 02 P\r\x00\xff", F // 115200, t=1000, gap=100)
+    got = sigrok(tmp_path, {"D0": edges}, ("D0",), "uart:rx=D0:baudrate=115200", "uart=rx-data")
+    ours = decode.uart(waves.window("D0", 1, edges, 0, edges[-1][0] + 1000), F / 115200)
+    assert [int(t, 16) for t in got] == [f.value for f in ours]
