@@ -29,6 +29,15 @@ CS_PINS = {"m32d": ["C2", "C3", "D6"], "m128s": ["A0", "A1", "A2"]}
 CHANNELS = {0: ("", 0, False, 0), 1: (None, 0, False, 6), 2: (":mode=3:lsb", 3, True, 2)}
 
 
+def spi_pins(board):
+    """{"SCK": "B7", "MOSI": ..., "MISO": ..., "SS": ...}: the board's SPI pins."""
+    return {p.function[4:]: p.signal for p in boardmap.load(board).pins
+            if p.function.startswith("SPI_")}
+
+
+MISO = {board: spi_pins(board)["MISO"] for board in BOARDS}
+
+
 def parts(board):
     pins = CS_PINS[board]
     return ["eeprom25@%s%s" % (pins[0], CHANNELS[0][0]), "mcp3008@%s" % pins[1],
@@ -68,6 +77,8 @@ def run(board):
             spi = Board(gw).spi
             for ch, pin in enumerate(CS_PINS[board]):   # every chip select high first
                 spi.bind(ch, pin[0], int(pin[1]))
+            # nothing selected: MISO shows 1, what the master reads
+            assert sim.control.pin(MISO[board]) == (1, "in spi")
             done = exchanges(spi, sim.control)
         sim.control.wait(1000)
     except BaseException:
@@ -81,8 +92,7 @@ def sigrok_spi(path, board, cs, mode, lsb):
     """sigrok's spi decoder on the board's SPI pins with chip select CS:
     ([(mosi bytes, miso bytes)] per transfer, [(begin cycle, mosi, miso)]
     per byte)."""
-    pins = {p.function[4:]: p.signal for p in boardmap.load(board).pins
-            if p.function.startswith("SPI_")}
+    pins = spi_pins(board)
     dec = "spi:clk=%s:mosi=%s:miso=%s:cs=%s:cpol=%d:cpha=%d:bitorder=%s" % (
         pins["SCK"], pins["MOSI"], pins["MISO"], cs, mode >> 1, mode & 1,
         "lsb-first" if lsb else "msb-first")
