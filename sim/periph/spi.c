@@ -186,6 +186,18 @@ static void spi_edge_note(spi_t *s, uint64_t cycle, int pin, int level)
 	}
 }
 
+/* MISO as device D (NULL: none, the line reads 1) drives it at WHEN, noted
+ * among the byte's edges when it changes. */
+static void spi_miso_note(spi_t *s, const spi_dev_t *d, uint64_t when)
+{
+	int level = d ? d->out : 1;
+
+	if (level != s->miso_level) {
+		s->miso_level = level;
+		spi_edge_note(s, when, SPI_PIN_MISO, level);
+	}
+}
+
 /* Clock one byte through the selected devices, edge by edge. At each edge
  * everyone who samples sees the levels from before it; then the shifters
  * move. */
@@ -205,14 +217,7 @@ static uint8_t spi_clock_byte(spi_t *s, uint8_t tx, uint64_t t0, unsigned half)
 		}
 	}
 	s->nedges = 0;
-#define MISO_NOTE(when) do { \
-		int m_ = nsel ? sel[0]->out : 1; \
-		if (m_ != s->miso_level) { \
-			s->miso_level = m_; \
-			spi_edge_note(s, (when), SPI_PIN_MISO, m_); \
-		} \
-	} while (0)
-	MISO_NOTE(t0);
+	spi_miso_note(s, nsel ? sel[0] : NULL, t0);
 #define TXBIT(k) (lsb ? (tx >> (k)) & 1 : (tx >> (7 - (k))) & 1)
 	if (!cpha && s->mosi_level != TXBIT(0)) {
 		s->mosi_level = TXBIT(0);
@@ -259,9 +264,8 @@ static uint8_t spi_clock_byte(spi_t *s, uint8_t tx, uint64_t t0, unsigned half)
 				d->out = d->next_out(d);
 			}
 		}
-		MISO_NOTE(when);
+		spi_miso_note(s, nsel ? sel[0] : NULL, when);
 	}
-#undef MISO_NOTE
 #undef TXBIT
 	s->pending_cs = nsel ? sel[0]->cs->name : "-";
 	s->pending_txn = nsel ? sel[0]->txn : 0;
@@ -347,6 +351,7 @@ static void spi_pins(spi_t *s)
 static void spi_write_spdr(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *param)
 {
 	spi_t *s = param;
+
 	(void)addr;
 	spi_clear_on_access(s);
 	if (!spi_master_on(s)) {
