@@ -3,13 +3,17 @@ board's rate, and an I2C bus bit by bit (START, address + R/W, data,
 ACK/NACK, repeated START, STOP, clock stretching, a START in the middle of
 a byte); and sigrok's own decoders read the same from them."""
 
-import shutil
 import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
 from orfa import boardmap, decode, waves
 from wavegen import Bus, serial
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sim"))
+from sigrok import i2c_texts, needs_sigrok  # noqa: E402  (tests/sim's sigrok-cli helpers)
 
 F = boardmap.F_CPU
 
@@ -161,23 +165,7 @@ def sigrok(tmp_path, edges, names, decoder, annotations):
     r = subprocess.run(["sigrok-cli", "-i", str(src), "-I", "vcd", "-P", decoder,
                         "-A", annotations], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
-    return [line.split(": ", 1)[1] for line in r.stdout.splitlines()]
-
-
-needs_sigrok = pytest.mark.skipif(shutil.which("sigrok-cli") is None,
-                                  reason="needs sigrok-cli (tools/setup.sh installs it)")
-
-#: sigrok's i2c annotations as ORFA's letters (its "Write"/"Read" is the R/W bit)
-SIGROK_I2C = [("Start repeat", "Sr"), ("Start", "S"), ("Stop", "P"), ("NACK", "N"),
-              ("ACK", "A"), ("Address write: ", "{} W"), ("Address read: ", "{} R"),
-              ("Data write: ", "{}"), ("Data read: ", "{}")]
-
-
-def orfa_text(line):
-    for prefix, text in SIGROK_I2C:
-        if line.startswith(prefix):
-            return text.format(line[len(prefix):])
-    return None
+    return r.stdout.splitlines()
 
 
 @needs_sigrok
@@ -197,7 +185,7 @@ def test_i2c_reads_as_sigroks_i2c_decoder_does(tmp_path):
     bus.stop()
     got = sigrok(tmp_path, bus.edges, ("sda", "scl"),
                  "i2c:scl=scl:sda=sda:address_format=unshifted", "i2c=addr-data")
-    theirs = [t for t in map(orfa_text, got) if t is not None]
+    theirs = i2c_texts(got)
     assert theirs == [f.text for f in bus.frames()]
     assert " ".join(theirs) == "S A0 W A 10 A Sr A1 R A 41 A 42 N P S E0 W N P"
 
@@ -207,4 +195,4 @@ def test_uart_reads_as_sigroks_uart_decoder_does(tmp_path):
     edges, _ = serial(b"S A0 10 S A1 02 P\r\x00\xff", F // 115200, t=1000, gap=100)
     got = sigrok(tmp_path, {"D0": edges}, ("D0",), "uart:rx=D0:baudrate=115200", "uart=rx-data")
     ours = decode.uart(waves.window("D0", 1, edges, 0, edges[-1][0] + 1000), F / 115200)
-    assert [int(t, 16) for t in got] == [f.value for f in ours]
+    assert [int(line.split(": ")[1], 16) for line in got] == [f.value for f in ours]

@@ -45,3 +45,23 @@ def decode(path, decoder, annotations):
         elif ev["ph"] == "E":
             out.setdefault(ev["tid"], []).append((begun.pop(ev["tid"]), cycle, ev["name"]))
     return out, took
+
+
+#: sigrok's i2c annotations (its addr-data row) as orfa.decode's texts,
+#: ORFA's letters; its "Write"/"Read" (the R/W bit alone) has none.
+_I2C_TEXTS = [("Start repeat", "Sr"), ("Start", "S"), ("Stop", "P"), ("NACK", "N"),
+              ("ACK", "A"), ("Address write: ", "{} W"), ("Address read: ", "{} R"),
+              ("Data write: ", "{}"), ("Data read: ", "{}")]
+
+
+def i2c_texts(lines):
+    """sigrok-cli's plain i2c output (`i2c-1: Address write: A0`, with
+    address_format=unshifted) as orfa.decode writes it (`A0 W`)."""
+    out = []
+    for line in lines:
+        text = line.split(": ", 1)[1] if ": " in line else ""
+        for prefix, form in _I2C_TEXTS:
+            if text.startswith(prefix):
+                out.append(form.format(text[len(prefix):]))
+                break
+    return out

@@ -18,8 +18,9 @@ import serial
 
 from conftest import REPLY_TIMEOUT, require_builds
 from orfa import vcd
+from orfa.protocol import F_CPU
 from orfa.sim import SimBoard
-from sigrok import decode, needs_sigrok
+from sigrok import i2c_texts, needs_sigrok
 
 pytestmark = needs_sigrok
 pytest.importorskip("matplotlib")
@@ -70,6 +71,31 @@ def capture():
     return sim, sent, got, first
 
 
+@pytest.fixture(scope="module")
+def captured():
+    sim, sent, got, first = capture()
+    yield sim, sent, got, first
+    shutil.rmtree(sim.dir, ignore_errors=True)
+
+
+def plot(path, start, end, signals, out):
+    """`orfa plot -v` of the capture between cycles START and END: its
+    lines {row: [texts]}."""
+    trace_us = 1e6 / F_CPU
+    r = subprocess.run(
+        [sys.executable, "-m", "orfa", "plot", str(path), "--signals"] + signals
+        + ["--from", "%.1f" % (start * trace_us), "--to", "%.1f" % (end * trace_us),
+           "-v", "-o", str(out)],
+        env=dict(os.environ, PYTHONPATH=str(ROOT / "host")), capture_output=True,
+        text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    rows = {}
+    for line in r.stdout.splitlines():
+        rows.setdefault(line[:10].strip(), []).append(line[11:])
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    return rows
+
+
 def sigrok_lines(path, dec, ann):
     """sigrok-cli's plain output, as a shell prints it (trailing blanks off)."""
     r = subprocess.run(["sigrok-cli", "-i", str(path), "-I", "vcd", "-P", dec, "-A", ann],
@@ -92,44 +118,50 @@ def as_text(lines):
     return bytes(int(line.split()[1], 16) for line in lines).decode().splitlines()
 
 
-def test_the_docs_capture_decodes_as_quoted_and_is_drawn():
-    sim, sent, got, first = capture()
-    try:
-        path = sim.vcd_path
-        assert got.decode().split("\r\n")[:-1] == REPLIES
-        rx = sigrok_lines(path, UART, "uart=rx-data")
-        tx = sigrok_lines(path, UART, "uart=tx-data")
-        assert as_text(rx) == sent.decode().splitlines()
-        assert as_text(tx) == got.decode().splitlines()
-        spi = sigrok_lines(path, SPI, "spi=mosi-transfer:miso-transfer")
-        for cmd, out in (
-                ("-P %s -A uart=rx-data | cut -d' ' -f2 | xxd -r -p" % UART, as_text(rx)),
-                ("-P %s -A uart=tx-data | cut -d' ' -f2 | xxd -r -p" % UART, as_text(tx)),
-                ("-P %s -A spi=mosi-transfer:miso-transfer" % SPI, spi)):
-            block = ["$ sigrok-cli -i capture.vcd -I vcd " + cmd] + out
-            assert quoted(block), "docs/simulator.md should quote:\n" + "\n".join(block)
-        # the bytes of the SPI exchanges, as the host asked for them
-        assert spi[-2:] == ["spi-1: FF FF A5 3C", "spi-1: 03 10 00 00"]
+def test_the_docs_capture_decodes_as_quoted_and_is_drawn(captured):
+    sim, sent, got, first = captured
+    path = sim.vcd_path
+    assert got.decode().split("\r\n")[:-1] == REPLIES
+    rx = sigrok_lines(path, UART, "uart=rx-data")
+    tx = sigrok_lines(path, UART, "uart=tx-data")
+    assert as_text(rx) == sent.decode().splitlines()
+    assert as_text(tx) == got.decode().splitlines()
+    spi = sigrok_lines(path, SPI, "spi=mosi-transfer:miso-transfer")
+    for cmd, out in (
+            ("-P %s -A uart=rx-data | cut -d' ' -f2 | xxd -r -p" % UART, as_text(rx)),
+            ("-P %s -A uart=tx-data | cut -d' ' -f2 | xxd -r -p" % UART, as_text(tx)),
+            ("-P %s -A spi=mosi-transfer:miso-transfer" % SPI, spi)):
+        block = ["$ sigrok-cli -i capture.vcd -I vcd " + cmd] + out
+        assert quoted(block), "docs/simulator.md should quote:\n" + "\n".join(block)
+    # the bytes of the SPI exchanges, as the host asked for them
+    assert spi[-2:] == ["spi-1: FF FF A5 3C", "spi-1: 03 10 00 00"]
 
-        # the picture: the three pictured requests, their replies and the
-        # SPI exchange and the bus between them
-        trace = vcd.load(str(path))
-        last = max(c for c, _ in trace.edges("D1"))
-        bus = [n for n in ("sda", "scl") if n in trace.names()]
-        SHOTS.mkdir(parents=True, exist_ok=True)
-        out = SHOTS / "plot-capture.png"
-        us = 1e6 / trace.f_cpu
-        r = subprocess.run(
-            [sys.executable, "-m", "orfa", "plot", str(path), "--signals", "D0", "D1", "C2",
-             "B7", "B5", "B6", "i2c"] + bus
-            + ["--from", "%.1f" % ((first - 2000) * us), "--to", "%.1f" % ((last + 2000) * us),
-               "-v", "-o", str(out)],
-            env=dict(os.environ, PYTHONPATH=str(ROOT / "host")), capture_output=True,
-            text=True, timeout=120)
-        assert r.returncode == 0, r.stderr
-        drawn = [line[11:] for line in r.stdout.splitlines() if line.startswith("D0 ")][:-1]
-        want = [c if c != " " else "SP" for c in "\n".join(PICTURED)]
-        assert drawn == ["LF" if c == "\n" else c for c in want] + ["LF"]
-        assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    finally:
-        shutil.rmtree(sim.dir, ignore_errors=True)
+    # the picture: the three pictured requests, their replies and the
+    # SPI exchange and the bus between them
+    trace = vcd.load(str(path))
+    last = max(c for c, _ in trace.edges("D1"))
+    bus = [n for n in ("sda", "scl") if n in trace.names()]
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    rows = plot(path, first - 2000, last + 2000,
+                ["D0", "D1", "C2", "B7", "B5", "B6", "i2c"] + bus, SHOTS / "plot-capture.png")
+    want = [c if c != " " else "SP" for c in "\n".join(PICTURED)]
+    assert rows["D0"][:-1] == ["LF" if c == "\n" else c for c in want] + ["LF"]
+
+
+def test_the_bus_in_the_capture_is_decoded_as_sigrok_does(captured):
+    """With the bit-level bus's wires `sda` and `scl` in the capture (issue
+    19), `orfa plot` writes on SDA what sigrok's i2c decoder reads (the
+    EEPROM read: S A0 W A 00 A Sr A1 R A FF A FF N P), and draws the
+    transaction alone (plot-capture-i2c.png)."""
+    sim, _, _, _ = captured
+    trace = vcd.load(str(sim.vcd_path))
+    if "sda" not in trace.names() or "scl" not in trace.names():
+        pytest.skip("this simulator's VCD has no bus wires sda and scl")
+    theirs = i2c_texts(sigrok_lines(sim.vcd_path, "i2c:scl=scl:sda=sda:address_format=unshifted",
+                                    "i2c=addr-data"))
+    assert " ".join(theirs) == "S A0 W A 00 A Sr A1 R A FF A FF N P"
+    busy = trace.edges("i2c")[-2:]
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    rows = plot(sim.vcd_path, busy[0][0] - 500, busy[1][0] + 500, ["sda", "scl", "i2c"],
+                SHOTS / "plot-capture-i2c.png")
+    assert rows["sda"][:-1] == theirs
