@@ -441,6 +441,18 @@ def test_sda_row_carries_the_decoded_i2c(tmp_path, capsys):
     assert in_order(I2C_TEXTS, texts)
 
 
+def test_with_the_bus_wires_the_twi_pins_are_no_default_rows():
+    """The TWI pins (C0/C1 on the M32-D, a slave's 10/D0) carry the bus's
+    lines: with the wires sda and scl in the capture, those are the rows."""
+    names = list(M32D_PINS) + ["i2c", "sda", "scl", "10/C0"]
+    namer = cli_plot.Namer(names, {"": "m32d", "10": "m32d"})
+    assert [namer.rank(n) for n in ("sda", "scl", "C0", "C1", "10/C0", "i2c")] == \
+        [3, 3, None, None, None, 3]
+    assert namer.label("sda") == "sda\nI2C bus" and namer.periodic("scl") is False
+    without = cli_plot.Namer(list(M32D_PINS), {"": "m32d"})
+    assert without.rank("C0") == 3
+
+
 def test_without_scl_sda_is_not_decoded(tmp_path, capsys):
     pytest.importorskip("matplotlib")
     bus = wavegen.Bus(t=5000)

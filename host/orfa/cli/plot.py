@@ -59,6 +59,8 @@ class Namer:
         boards = boards or {}
         self.maps = {prefix: boardmap.load(boards[prefix]) if prefix in boards else _guess(group)
                      for prefix, group in groups.items()}
+        #: the capture has the bus's own wires: the TWI pins carry the same lines
+        self.bus_wires = all(wire in names for wire in BUS_WIRES)
 
     def _split(self, name: str) -> Tuple[str, str]:
         prefix, _, local = name.rpartition("/")
@@ -122,6 +124,9 @@ class Namer:
             return None if local.startswith("cnt") else 5
         if all(f in _HIDDEN for f, _ in uses):
             return None
+        if self.bus_wires and local not in BUS_WIRES and \
+                all(f in BUS_WIRES.values() for f, _ in uses):
+            return None                      # a TWI pin: the rows sda and scl show its line
         return min(_RANK.get(f, 5) for f, _ in uses)
 
 
