@@ -135,21 +135,48 @@ _FRAME_COLOURS = {"start": "tab:green", "restart": "tab:green", "stop": "tab:gre
                   "ack": "0.35", "nack": "tab:red", "partial": "tab:red",
                   "framing error": "tab:red"}
 _POINT_KINDS = ("start", "restart", "stop", "ack", "nack")
+#: Written under the line (the rest over it): so a START right after an ACK
+#: does not cover it.
+_UNDER_KINDS = ("start", "restart", "stop")
 #: Drawn narrower than printed: a space of the serial line is one glyph.
 GLYPHS = {"SP": "\u2423"}
 
 
-def _draw_frames(ax, frames: Sequence[decode.Frame], f_cpu: int, axis: Axis) -> None:
-    """Each frame's text over it; a byte's span lightly shaded."""
+#: A row whose texts would cover each other for more than this share of its
+#: frames gets none (only the shading): a few words of a sentence mislead.
+MAX_COVERED = 0.25
+
+
+def _draw_frames(ax, frames: Sequence[decode.Frame], f_cpu: int, axis: Axis,
+                 span: float) -> None:
+    """Each frame's text over it (a START or STOP under it); a byte's span
+    lightly shaded. A text that would cover the one before it on its level
+    is left out (the printed annotations have them all); when that is more
+    than MAX_COVERED of them, all are."""
     def x(cycle):
         return waves.us(cycle - axis.origin, f_cpu) / axis.us_per_unit
+    right = {True: float("-inf"), False: float("-inf")}   # under: where the last text ends
+    texts = []
     for f in frames:
-        if f.kind not in _POINT_KINDS:
+        point = f.kind in _POINT_KINDS
+        if not point:
             ax.axvspan(x(f.start), x(f.end), color="tab:purple", alpha=0.08, linewidth=0)
         text = mark_text(f)
-        ax.text(x((f.start + f.end) / 2), 1.08, GLYPHS.get(text, text), ha="center",
-                va="bottom", fontsize=7 if f.kind not in _POINT_KINDS else 6.5,
-                color=_FRAME_COLOURS.get(f.kind, "tab:purple"))
+        text = GLYPHS.get(text, text)
+        # a name or hex of a serial byte (CR, 0D) is smaller than a character
+        size = 6.5 if point else 6 if f.kind == "byte" and len(text) > 1 else 7
+        middle = x((f.start + f.end) / 2)
+        half = len(text) * LABEL_CHAR_IN * size / 7.5 * span / ROWS_WIDTH_IN / 2
+        under = f.kind in _UNDER_KINDS
+        if middle - half < right[under]:
+            continue
+        right[under] = middle + half
+        texts.append((middle, under, text, size, _FRAME_COLOURS.get(f.kind, "tab:purple")))
+    if len(texts) < (1 - MAX_COVERED) * len(frames):
+        return
+    for middle, under, text, size, colour in texts:
+        ax.text(middle, -0.08 if under else 1.08, text, ha="center",
+                va="top" if under else "bottom", fontsize=size, color=colour)
 
 
 def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[Annotation]:
@@ -168,7 +195,7 @@ def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[A
         xs, ys = _steps(row.wave, f_cpu, axis)
         ax.plot(xs, ys, color="tab:blue", linewidth=1.0)
         ax.fill_between(xs, 0, ys, color="tab:blue", alpha=0.15, linewidth=0)
-        ax.set_ylim(-0.25, 1.75)
+        ax.set_ylim(-0.6 if row.frames else -0.25, 1.75)
         ax.set_yticks([])
         ax.set_ylabel(row.label, rotation=0, ha="right", va="center", fontsize=9)
         for side in ("top", "right", "left"):
@@ -186,7 +213,7 @@ def render(rows: Sequence[Row], f_cpu: int, out: str, title: str = "") -> List[A
             ax.annotate(_micro(note.text), xy=(middle, 1.05),
                         ha="center", va="bottom", fontsize=7.5, color="tab:red")
         if any(a.kind == "decoded" for a in mine):
-            _draw_frames(ax, frames_in(row), f_cpu, axis)
+            _draw_frames(ax, frames_in(row), f_cpu, axis, span)
         summary = [a.text for a in mine if a.kind == "summary"]
         ax.text(1.01, 0.35, _micro(summary[0]).replace(", ", "\n", 1) if summary else "",
                 transform=ax.transAxes, ha="left", va="center", fontsize=8, color="0.2")
