@@ -463,3 +463,19 @@ def test_without_scl_sda_is_not_decoded(tmp_path, capsys):
     src.write_text(make_vcd({"sda": [(100, 1)] + bus.edges["sda"]}, names=M32D_PINS + ("sda",)))
     assert main(["plot", str(src), "-o", str(tmp_path / "sda.png"), "-v"]) == 0
     assert "A0 W" not in capsys.readouterr().out
+
+
+def test_decoded_texts_that_would_cover_each_other_are_not_drawn(tmp_path, capsys):
+    """Forty bytes in a window of 200 ms: each byte's frame is far narrower
+    than its text, so none is written (a few would read as a wrong word);
+    -v still prints every one."""
+    pytest.importorskip("matplotlib")
+    rx, _ = wavegen.serial(b"QZ" * 20, BIT, t=10000)
+    src = tmp_path / "dense.vcd"
+    src.write_text(make_vcd({"D0": [(500, 1)] + rx, "B0": [(F // 5, 1)]}))
+    out = tmp_path / "dense.svg"
+    assert main(["plot", str(src), "--signals", "D0", "--from", "0", "--to", "200ms", "-v",
+                 "-o", str(out)]) == 0
+    assert capsys.readouterr().out.splitlines()[:40] == ["D0         Q", "D0         Z"] * 20
+    texts = svg_texts(out)
+    assert "Q" not in texts and "Z" not in texts
