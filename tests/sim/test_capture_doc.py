@@ -41,6 +41,7 @@ REPLIES = ["SWAAAAP", "SWAAAAP", "SWAAAP", "SWAAAAAAP",
            "SWAAAAAAP", "SWASRFFFFA53CP", "SWASRFFFFP"]
 UART = "uart:rx=D0:tx=D1:baudrate=115200"
 SPI = "spi:clk=B7:mosi=B5:miso=B6:cs=C2"
+I2C = "i2c:scl=scl:sda=sda:address_format=unshifted"
 
 
 def capture():
@@ -157,8 +158,10 @@ def test_the_bus_in_the_capture_is_decoded_as_sigrok_does(captured):
     trace = vcd.load(str(sim.vcd_path))
     if "sda" not in trace.names() or "scl" not in trace.names():
         pytest.skip("this simulator's VCD has no bus wires sda and scl")
-    theirs = i2c_texts(sigrok_lines(sim.vcd_path, "i2c:scl=scl:sda=sda:address_format=unshifted",
-                                    "i2c=addr-data"))
+    lines = sigrok_lines(sim.vcd_path, I2C, "i2c=addr-data")
+    block = ["$ sigrok-cli -i capture.vcd -I vcd -P %s -A i2c=addr-data" % I2C] + lines
+    assert quoted(block), "docs/simulator.md should quote:\n" + "\n".join(block)
+    theirs = i2c_texts(lines)
     assert " ".join(theirs) == "S A0 W A 00 A Sr A1 R A FF A FF N P"
     busy = trace.edges("i2c")[-2:]
     SHOTS.mkdir(parents=True, exist_ok=True)
