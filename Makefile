@@ -260,7 +260,7 @@ test: setup
 
 # The pictures in docs/img/: each test file here saves its images in
 # $ORFA_SHOTS (default build/shots/); add a file to draw one more.
-DOC_IMAGE_TESTS := tests/sim/test_dash.py tests/sim/test_plot.py
+DOC_IMAGE_TESTS := tests/sim/test_dash.py tests/sim/test_plot.py tests/sim/test_capture_doc.py
 doc-images:
 	@$(MAKE) --no-print-directory all-boards robot sim
 	ORFA_SHOTS=docs/img python3 -m pytest -q $(DOC_IMAGE_TESTS)
