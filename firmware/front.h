@@ -8,4 +8,19 @@ void front_init(void);
  * (the link-loss failsafe): the busy path pays nothing for it. */
 void front_poll(void);
 
+/*
+ * For an interrupt that keeps interrupts off longer than the serial line's
+ * receiver holds characters (two in UDR: 320 cycles at 460800 baud) and
+ * cannot let the receive interrupt run at every point (drivers/servo_pins.c
+ * between its wake-up and an edge). Both are empty in the I2C slave.
+ *
+ * front_rx_hold(): takes a waiting character from UDR into a small hold
+ * (a dozen cycles), from which the receive interrupt hands it on first.
+ * front_rx_poll(): lets the receive interrupt run now, if anything is held
+ * or waits in UDR (or a pending one of higher priority: the caller allows
+ * for the longest); called with interrupts off, returns with them off.
+ */
+void front_rx_hold(void);
+void front_rx_poll(void);
+
 #endif

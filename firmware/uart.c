@@ -3,6 +3,7 @@
 #include <avr/interrupt.h>
 #include <avr/wdt.h>
 
+#include "firmware/front.h"
 #include "firmware/mcu.h"
 
 _Static_assert((UART_TX_SIZE & (UART_TX_SIZE - 1)) == 0, "tx size is a power of two");
@@ -13,10 +14,54 @@ static struct {
 	volatile uint8_t tx_tail;
 } uart;
 
+/* Characters front_rx_hold() took from UDR while the receive interrupt
+ * could not run, oldest first: the interrupt hands them on before UDR. */
+static struct {
+	uint8_t c[UART_HOLD];
+	uint8_t n;
+} held;
+
 ISR(MCU_UART_RX_vect)
 {
-	uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
-	uart_received(MCU_UDR);
+	uint8_t i = 0;
+
+	for (;;) {
+		uint8_t c;
+
+		if (i != held.n) {
+			/* Newer characters join the hold before UDR fills. */
+			front_rx_hold();
+			c = held.c[i++];
+		} else if (MCU_UCSRA & _BV(RXC)) {
+			uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
+			c = MCU_UDR;
+		} else {
+			break;
+		}
+		uart_received(c);
+	}
+	held.n = 0;
+}
+
+void front_rx_hold(void)
+{
+	uint8_t n = held.n;
+
+	if ((MCU_UCSRA & _BV(RXC)) && n < UART_HOLD) {
+		uart_line_rx();
+		held.c[n] = MCU_UDR;
+		held.n = (uint8_t)(n + 1);
+	}
+}
+
+void front_rx_poll(void)
+{
+	if (held.n || (MCU_UCSRA & _BV(RXC))) {
+		/* The receive interrupt called as a function: it keeps every
+		 * register it uses; its RETI sets I, and the one instruction
+		 * that runs before an interrupt can be taken clears it. */
+		__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (MCU_UART_RX_vect) : "memory");
+	}
 }
 
 ISR(MCU_UART_UDRE_vect)

@@ -16,6 +16,12 @@
  * of two. */
 #define UART_TX_SIZE 64
 
+/* Characters the receiver's hold (front_rx_hold(), firmware/front.h) keeps:
+ * more than reach UDR while the M32-D's servo interrupt runs at 460800
+ * baud (about 650 cycles for an edge, 400 more for each close one), and
+ * while the receive interrupt then hands them on. */
+#define UART_HOLD 16
+
 /* uart_init() (set the rate, enable the USART) is the line's: see
  * firmware/uart_line.h. */
 #include "firmware/uart_line.h"

@@ -129,3 +129,12 @@ void front_poll(void)
 	slave_seen = clock_now8();
 	slave_apply(act, byte);
 }
+
+/* No serial line: the TWI holds SCL while its interrupt waits. */
+void front_rx_hold(void)
+{
+}
+
+void front_rx_poll(void)
+{
+}
