@@ -98,7 +98,7 @@ static struct {
  * every width is the hardware's, and the next rise is programmed already. */
 static inline __attribute__((always_inline)) void rx_poll_after_rise(void)
 {
-	front_rx_poll();
+	front_rx_poll(FRONT_HOLD_ALL);
 }
 
 /*

@@ -27,19 +27,32 @@
 #include "firmware/front.h"
 #include "firmware/pins.h"
 #include "firmware/port_io.h"
+#include "firmware/uart.h"
 
-#define SERVO_LEAD   480       /* wake-up before an edge, cycles */
+#define SERVO_LEAD   640       /* wake-up before an edge, cycles */
 #define SERVO_NEAR   (SERVO_LEAD + 80)  /* closer than this: wait in place */
 #define SERVO_FINE   96        /* last stretch, waited on Timer0 */
+/* The receive interrupt's longest run (BOARD_RX_BURST characters, ~70
+ * cycles each, and its entry), and the interrupt's own from the wake-up to
+ * the last stretch, cycles: the lead allows for both. */
+#define SERVO_RX_CHAR 72
+#define SERVO_RX_ISR  (BOARD_RX_BURST * SERVO_RX_CHAR + 80)
+#define SERVO_ENTRY   300
+_Static_assert(SERVO_LEAD >= SERVO_RX_ISR + SERVO_ENTRY, "the lead allows a receive interrupt");
+/* An edge this far away leaves time to hand on the whole hold. */
+#define SERVO_FAR (SERVO_LEAD + SERVO_RX_CHAR * (UART_HOLD + 2))
 /*
  * Interrupts are off from the wake-up to the edge, longer than the USART
  * holds received characters above 115200 baud (two: 320 cycles at 460800
  * baud). So the interrupt takes them into the receiver's hold
- * (front_rx_hold(), a dozen cycles) as it starts, every turn of its wait,
- * right after each edge and before it plans the next, and lets the receive
- * interrupt hand them on (front_rx_poll()) before it returns, when the next
- * edge is SERVO_NEAR away: the wake-up's lead absorbs that.
+ * (front_rx_hold(), ~30 cycles with the call) as it starts, every turn of
+ * its wait until SERVO_HOLD_TICKS Timer2 ticks before the last stretch (a
+ * turn that holds one must end inside that stretch) and right after each
+ * edge, and lets the receive interrupt hand them on (front_rx_poll()) as it
+ * returns, within the next wake-up's lead. Every Timer2 wrap wakes it while
+ * servos run (0.28 ms), so nothing stays held longer than that.
  */
+#define SERVO_HOLD_TICKS 3
 
 static struct {
 	servo_sched_t sched[2];
@@ -123,13 +136,21 @@ static bool servo_arm(void)
 	return true;
 }
 
+/* Lets the receive interrupt hand on what the hold keeps: all of it when
+ * the next edge is SERVO_FAR away, else what the next wake-up's lead
+ * allows for. */
+static void servo_rx_release(void)
+{
+	front_rx_poll(servo_ticks_left() > SERVO_FAR / 8 ? FRONT_HOLD_ALL : BOARD_RX_BURST);
+}
+
 ISR(TIMER2_COMP_vect)
 {
-	if (!pulses.running || servo_ticks_left() > SERVO_NEAR / 8) {
-		front_rx_poll();  /* what waited while this one started */
-		return;           /* an earlier wrap, or a stale flag */
-	}
 	front_rx_hold();
+	if (!pulses.running || servo_ticks_left() > SERVO_NEAR / 8) {
+		servo_rx_release();
+		return;  /* an earlier wrap, or a stale flag */
+	}
 	for (;;) {
 		const servo_edge_t *edge = pulses.edge;
 		uint8_t e = edge->code;
@@ -147,7 +168,9 @@ ISR(TIMER2_COMP_vect)
 		 * again. */
 		if (left > -(SERVO_FINE / 8)) {
 			while (left > 0) {
-				front_rx_hold();
+				if (left > SERVO_HOLD_TICKS) {
+					front_rx_hold();
+				}
 				left = (int16_t)(servo_ticks_left() - SERVO_FINE / 8);
 			}
 			/* In assembly for 4 cycles a turn, so the write comes within
@@ -174,17 +197,17 @@ ISR(TIMER2_COMP_vect)
 				if (s->n == 0) {
 					pulses.running = 0;
 					TIMSK &= (uint8_t)~_BV(OCIE2);
-					front_rx_poll();
+					front_rx_poll(FRONT_HOLD_ALL);  /* no more edges */
 					return;
 				}
 				pulses.end = &s->edge[s->n];
 			}
 			edge = pulses.sched[pulses.active].edge;
 		}
-		front_rx_hold();
 		servo_aim(edge);
 		if (servo_arm()) {
-			front_rx_poll();
+			front_rx_hold();
+			servo_rx_release();
 			return;
 		}
 	}

@@ -3,6 +3,8 @@
 #ifndef ORFA_FRONT_H
 #define ORFA_FRONT_H
 
+#include <stdint.h>
+
 void front_init(void);
 /* One step of the front end's work; when it has none, it calls sys_poll()
  * (the link-loss failsafe): the busy path pays nothing for it. */
@@ -16,11 +18,15 @@ void front_poll(void);
  *
  * front_rx_hold(): takes a waiting character from UDR into a small hold
  * (a dozen cycles), from which the receive interrupt hands it on first.
- * front_rx_poll(): lets the receive interrupt run now, if anything is held
- * or waits in UDR (or a pending one of higher priority: the caller allows
- * for the longest); called with interrupts off, returns with them off.
+ * front_rx_poll(most): lets the receive interrupt run now, if anything is
+ * held or waits in UDR, to hand on `most` characters at most (about 70
+ * cycles each; FRONT_HOLD_ALL: everything); a pending interrupt of higher
+ * priority may run instead: the caller allows for the longest. Called with
+ * interrupts off, returns with them off.
  */
+#define FRONT_HOLD_ALL 0xFF
+
 void front_rx_hold(void);
-void front_rx_poll(void);
+void front_rx_poll(uint8_t most);
 
 #endif

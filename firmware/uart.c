@@ -14,55 +14,106 @@ static struct {
 	volatile uint8_t tx_tail;
 } uart;
 
+#ifdef BOARD_RX_BURST
+/* A board whose interrupts hold received characters (uart.h). */
+_Static_assert((UART_HOLD & (UART_HOLD - 1)) == 0, "hold size is a power of two");
+
 /* Characters front_rx_hold() took from UDR while the receive interrupt
- * could not run, oldest first: the interrupt hands them on before UDR. */
+ * could not run, oldest at tail: the interrupt hands them on before UDR. */
 static struct {
 	uint8_t c[UART_HOLD];
-	uint8_t n;
+	uint8_t head;
+	uint8_t tail;
+	uint8_t budget;  /* for a call from front_rx_poll(); 0: BOARD_RX_BURST */
 } held;
 
+/* UDR's character, if one waits, into the hold, if it has room. */
+static inline __attribute__((always_inline)) void uart_hold(void)
+{
+	uint8_t head = held.head;
+
+	if ((MCU_UCSRA & _BV(RXC)) && (uint8_t)(head - held.tail) < UART_HOLD) {
+		uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
+		held.c[head & (UART_HOLD - 1)] = MCU_UDR;
+		held.head = (uint8_t)(head + 1);
+	}
+}
+
+/* Hands on the held characters, oldest first, and UDR's, BOARD_RX_BURST at
+ * most, taking what arrives meanwhile into the hold: UDR is empty as it
+ * ends. What stays in the hold waits for the next receive interrupt, the
+ * servo interrupt's next release or the main loop (uart_rx_flush()). */
 ISR(MCU_UART_RX_vect)
 {
-	uint8_t i = 0;
+	uint8_t budget = held.budget ? held.budget : BOARD_RX_BURST;
 
-	for (;;) {
-		uint8_t c;
-
-		if (i != held.n) {
-			/* Newer characters join the hold before UDR fills. */
-			front_rx_hold();
-			c = held.c[i++];
-		} else if (MCU_UCSRA & _BV(RXC)) {
-			uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
-			c = MCU_UDR;
-		} else {
+	held.budget = 0;
+	do {
+		uart_hold();
+		uint8_t tail = held.tail;
+		if (tail == held.head) {
 			break;
 		}
-		uart_received(c);
+		held.tail = (uint8_t)(tail + 1);
+		uart_received(held.c[tail & (UART_HOLD - 1)]);
+	} while (--budget);
+	uart_hold();
+}
+
+void uart_rx_flush(void)
+{
+	if (held.head != held.tail) {
+		cli();
+		front_rx_poll(FRONT_HOLD_ALL);
+		sei();
 	}
-	held.n = 0;
 }
 
 void front_rx_hold(void)
 {
-	uint8_t n = held.n;
-
-	if ((MCU_UCSRA & _BV(RXC)) && n < UART_HOLD) {
-		uart_line_rx();
-		held.c[n] = MCU_UDR;
-		held.n = (uint8_t)(n + 1);
-	}
+	uart_hold();
 }
 
-void front_rx_poll(void)
+void front_rx_poll(uint8_t most)
 {
-	if (held.n || (MCU_UCSRA & _BV(RXC))) {
+	if (held.head != held.tail || (MCU_UCSRA & _BV(RXC))) {
+		held.budget = most;
 		/* The receive interrupt called as a function: it keeps every
 		 * register it uses; its RETI sets I, and the one instruction
 		 * that runs before an interrupt can be taken clears it. */
 		__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (MCU_UART_RX_vect) : "memory");
 	}
 }
+
+#else
+/* Takes what UDR holds: a second character waits there when an interrupt
+ * of higher priority ran long (the M128-S's servo compare interrupts can
+ * come back to back). */
+ISR(MCU_UART_RX_vect)
+{
+	do {
+		uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
+		uart_received(MCU_UDR);
+	} while (MCU_UCSRA & _BV(RXC));
+}
+
+void uart_rx_flush(void)
+{
+}
+
+void front_rx_hold(void)
+{
+}
+
+void front_rx_poll(uint8_t most)
+{
+	(void)most;
+	if (MCU_UCSRA & _BV(RXC)) {
+		/* As above: the receive interrupt called as a function. */
+		__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (MCU_UART_RX_vect) : "memory");
+	}
+}
+#endif
 
 ISR(MCU_UART_UDRE_vect)
 {

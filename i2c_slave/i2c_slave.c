@@ -135,6 +135,7 @@ void front_rx_hold(void)
 {
 }
 
-void front_rx_poll(void)
+void front_rx_poll(uint8_t most)
 {
+	(void)most;
 }

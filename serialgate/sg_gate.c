@@ -38,6 +38,7 @@ void front_poll(void)
 {
 	int16_t c = sg_rx_get();
 	if (c < 0) {
+		uart_rx_flush();
 		if (!sg_rx_losing()) {
 			if (uart_line_poll()) {
 				/* The line's rate changed (autobaud): what the ring
