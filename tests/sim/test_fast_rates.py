@@ -169,3 +169,62 @@ def test_servo_widths_with_the_line_busy(board, rate):
         print("\n%s at %d: worst width error %.1f cycles over %d frames"
               % (board, rate, worst, (t1 - t0) // SERVO_FRAME))
         assert bad == [], "; ".join(bad[:10])
+
+
+def test_flow_rule_holds_the_host_back_at_460800():
+    """SPEC section 2, flow above 115200: a 16-triple servo write on the
+    M32-D takes longer to run than its characters take to arrive at 460800.
+    The host library pipelines such writes (Gateway.pipeline) with fewer than
+    FLOW_WINDOW characters unanswered, so it holds the next ones back (two
+    fit the window); the firmware's receive ring never overflows, and every
+    write is answered and applied. The slowness and the characters the
+    board held unanswered are taken from the trace (simulated time)."""
+    rate, count = 460800, 40
+    reg = boardmap.load("m32d").reg("servo", "SP")
+    lines = ["S AA %02X %s P" % (reg, " ".join("%02X%04X" % (ch, 1000 + 10 * i + ch)
+                                               for ch in range(16)))
+             for i in range(count)]
+    per = len(lines[0]) + 1                     # characters with the terminator
+    with sim_for("m32d", rate) as sim, \
+            Gateway(sim.port, baudrate=rate, timeout=REPLY_TIMEOUT) as gw:
+        batches = []
+        send = gw.send
+        gw.send = lambda data: (batches.append(len(data)), send(data))[1]
+        start = sim.control.time()
+        replies = gw.pipeline(lines)
+        assert replies == ["SW" + "A" * 49 + "P"] * count
+        assert gw.request("S AA %02X 0F S AB 02 P" % reg) == \
+            "SWAASR%04XP" % (1000 + 10 * (count - 1) + 15)
+        assert sim.control.line()["dor"] == 0
+        events = [e for e in sim.trace_events(kinds=["uart rx", "uart tx"]) if e.cycle >= start]
+    # the library: never a window's worth in flight; after the first two
+    # writes, one at a time, each after a reply
+    assert max(batches) < FLOW_WINDOW and batches[0] == 2 * per, batches[:4]
+    assert all(b <= per for b in batches[1:count - 1]), batches
+    # the board: each write ran longer than its characters take to arrive
+    # (from its line end, or the reply before, to its reply's last byte,
+    # less the reply's wire time); writes and replies found in the trace
+    byte = 10 * F_CPU // rate
+    write_ends, reply_ends = [], []
+    for kind, out, want in (("uart rx", write_ends, lines[0][:10].encode()),
+                            ("uart tx", reply_ends, replies[0].encode())):
+        text = b""
+        for e in events:
+            if e.kind == kind:
+                text += bytes([int(e.fields[0], 16)])
+                if text.endswith(b"\n"):
+                    if text.startswith(want):
+                        out.append(e.cycle + (byte if kind == "uart tx" else 0))
+                    text = b""
+    assert len(write_ends) == len(reply_ends) == count
+    run = [d - max(r, prev) - len(replies[0] + "\r\n") * byte
+           for r, d, prev in zip(write_ends, reply_ends, [0] + reply_ends)]
+    assert min(run) > per * byte, (min(run), per * byte)
+    # and the writes' characters the board had received but not answered
+    # (at each write's line end) stayed below the window: two at most
+    worst = max(per * sum(1 for w, r in zip(write_ends, reply_ends) if w <= t < r)
+                for t in write_ends)
+    assert 2 * per <= worst < FLOW_WINDOW, worst
+    print("\nm32d at %d: a 16-triple write runs %d..%d cycles, its %d characters take %d "
+          "on the wire; at most %d characters unanswered" % (
+              rate, min(run), max(run), per, per * byte, worst))
