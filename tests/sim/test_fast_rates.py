@@ -172,7 +172,7 @@ def test_servo_widths_with_the_line_busy(board, rate):
 
 
 def test_flow_rule_holds_the_host_back_at_460800():
-    """SPEC section 2, flow above 115200: a 16-triple servo write on the
+    """docs/protocol.md, "The line": above 115200 a 16-triple servo write on the
     M32-D takes longer to run than its characters take to arrive at 460800.
     The host library pipelines such writes (Gateway.pipeline) with fewer than
     FLOW_WINDOW characters unanswered, so it holds the next ones back (two
