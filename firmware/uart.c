@@ -39,9 +39,10 @@ static inline __attribute__((always_inline)) void uart_hold(void)
 	}
 }
 
-/* Hands on the held characters, oldest first, and UDR's, BOARD_RX_BURST at
- * most, taking what arrives meanwhile into the hold: UDR is empty as it
- * ends. What stays in the hold waits for the next receive interrupt, the
+/* Hands on the held characters, oldest first, then UDR's, BOARD_RX_BURST
+ * at most; while it drains the hold, what arrives goes into the hold too,
+ * so UDR never fills behind it. A character left in UDR brings the
+ * interrupt back; one left in the hold waits for the next interrupt, the
  * servo interrupt's next release or the main loop (uart_rx_flush()). */
 ISR(MCU_UART_RX_vect)
 {
@@ -49,15 +50,21 @@ ISR(MCU_UART_RX_vect)
 
 	held.budget = 0;
 	do {
-		uart_hold();
+		uint8_t c;
 		uint8_t tail = held.tail;
-		if (tail == held.head) {
+
+		if (tail != held.head) {
+			uart_hold();
+			held.tail = (uint8_t)(tail + 1);
+			c = held.c[tail & (UART_HOLD - 1)];
+		} else if (MCU_UCSRA & _BV(RXC)) {
+			uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
+			c = MCU_UDR;
+		} else {
 			break;
 		}
-		held.tail = (uint8_t)(tail + 1);
-		uart_received(held.c[tail & (UART_HOLD - 1)]);
+		uart_received(c);
 	} while (--budget);
-	uart_hold();
 }
 
 void uart_rx_flush(void)
