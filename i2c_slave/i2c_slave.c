@@ -139,3 +139,13 @@ void front_poll(void)
 	}
 	sys_poll();  /* idle: the failsafe's turn */
 }
+
+/* No serial line: the TWI holds SCL while its interrupt waits. */
+void front_rx_hold(void)
+{
+}
+
+void front_rx_poll(uint8_t most)
+{
+	(void)most;
+}
