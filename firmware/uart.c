@@ -6,6 +6,7 @@
 
 #include "firmware/front.h"
 #include "firmware/mcu.h"
+#include "serialgate/sg_rx.h"
 
 _Static_assert((UART_TX_SIZE & (UART_TX_SIZE - 1)) == 0, "tx size is a power of two");
 
@@ -14,6 +15,14 @@ static struct {
 	volatile uint8_t tx_head;
 	volatile uint8_t tx_tail;
 } uart;
+
+/* The receive interrupt's whole work, an interrupt handler of its own
+ * (it keeps every register it uses, ends in RETI): the vector's fast path
+ * (below) jumps to it for anything but a plain character, and
+ * front_rx_poll() calls it. Its name begins with __vector, as the
+ * compiler wants of a handler. */
+void uart_rx_all(void) __asm__("__vector_uart_rx_all") __attribute__((signal, used, externally_visible));
+#define RX_ALL_HANDLER void uart_rx_all(void)
 
 #ifdef BOARD_RX_BURST
 /* A board whose interrupts hold received characters (uart.h). */
@@ -45,7 +54,7 @@ static inline __attribute__((always_inline)) void uart_hold(void)
  * so UDR never fills behind it. A character left in UDR brings the
  * interrupt back; one left in the hold waits for the next interrupt, the
  * servo interrupt's next release or the main loop (uart_rx_flush()). */
-ISR(MCU_UART_RX_vect)
+RX_ALL_HANDLER
 {
 	uint8_t budget = held.budget ? held.budget : BOARD_RX_BURST;
 
@@ -89,7 +98,7 @@ void front_rx_poll(uint8_t most)
 		/* The receive interrupt called as a function: it keeps every
 		 * register it uses; its RETI sets I, and the one instruction
 		 * that runs before an interrupt can be taken clears it. */
-		__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (MCU_UART_RX_vect) : "memory");
+		__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (uart_rx_all) : "memory");
 	}
 }
 
@@ -97,7 +106,7 @@ void front_rx_poll(uint8_t most)
 /* Takes what UDR holds: a second character waits there when an interrupt
  * of higher priority ran long (the M128-S's servo compare interrupts can
  * come back to back). */
-ISR(MCU_UART_RX_vect)
+RX_ALL_HANDLER
 {
 	do {
 		uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
@@ -118,10 +127,131 @@ void front_rx_poll(uint8_t most)
 	(void)most;
 	if (MCU_UCSRA & _BV(RXC)) {
 		/* As above: the receive interrupt called as a function. */
-		__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (MCU_UART_RX_vect) : "memory");
+		__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (uart_rx_all) : "memory");
 	}
 }
 #endif
+
+/* The receive interrupt at 460800 has 160 cycles a character, the
+ * parser's share and the reply's included; the whole handler's register
+ * saves alone cost ~60. Its fast path takes the common character with
+ * four registers (the vector runs only while UDR holds a character: no
+ * other code calls it): one inside a line (sg_rx.h's rule), the ring not losing
+ * and with room, the M32-D's hold empty. Anything else goes to
+ * uart_rx_all(), which on the M32-D finds a character already read from
+ * UDR in the hold, first in line; on the M128-S such a character goes to
+ * uart_received() with the call-clobbered registers saved. A rate found
+ * by autobaud needs uart_line_rx() on every character: uart_rx_all(). */
+ISR(MCU_UART_RX_vect, ISR_NAKED)
+{
+#ifdef ORFA_BAUD
+	__asm__ __volatile__(
+		"push r24\n\t"
+		"in r24, __SREG__\n\t"
+		"push r24\n\t"
+		"push r25\n\t"
+		"push r30\n\t"
+		"push r31\n\t"
+#ifdef BOARD_RX_BURST
+		"lds r24, %[hhead]\n\t"
+		"lds r25, %[htail]\n\t"
+		"cp r24, r25\n\t"
+		"brne 2f\n\t"
+#endif
+		"lds r24, %[losing]\n\t"
+		"tst r24\n\t"
+		"brne 2f\n\t"
+		"lds r24, %[line]\n\t"
+		"cpi r24, %[plain]\n\t"
+		"brne 2f\n\t"
+		"lds r24, %[head]\n\t"
+		"lds r25, %[tail]\n\t"
+		"sub r25, r24\n\t"
+		"subi r25, 1\n\t"
+		"cpi r25, %[record] + 1\n\t"
+		"brlo 2f\n\t"
+		"lds r25, %[udr]\n\t"
+		"cpi r25, 0x20\n\t"
+		"brlo 3f\n\t"
+		"tst r25\n\t"
+		"brmi 3f\n\t"
+		"mov r30, r24\n\t"
+		"ldi r31, 0\n\t"
+		"subi r30, lo8(-(%[buf]))\n\t"
+		"sbci r31, hi8(-(%[buf]))\n\t"
+		"st Z, r25\n\t"
+		"subi r24, 0xFF\n\t"
+		"sts %[head], r24\n"
+		"1:\n\t"
+		"pop r31\n\t"
+		"pop r30\n\t"
+		"pop r25\n\t"
+		"pop r24\n\t"
+		"out __SREG__, r24\n\t"
+		"pop r24\n\t"
+		"reti\n"
+#ifdef BOARD_RX_BURST
+		"3:\n\t"
+		/* into the empty hold: uart_rx_all() takes it first */
+		"lds r24, %[hhead]\n\t"
+		"mov r30, r24\n\t"
+		"andi r30, %[hmask]\n\t"
+		"ldi r31, 0\n\t"
+		"subi r30, lo8(-(%[hbuf]))\n\t"
+		"sbci r31, hi8(-(%[hbuf]))\n\t"
+		"st Z, r25\n\t"
+		"subi r24, 0xFF\n\t"
+		"sts %[hhead], r24\n"
+#endif
+		"2:\n\t"
+		"pop r31\n\t"
+		"pop r30\n\t"
+		"pop r25\n\t"
+		"pop r24\n\t"
+		"out __SREG__, r24\n\t"
+		"pop r24\n\t"
+		"%~jmp %x[all]\n"
+#ifndef BOARD_RX_BURST
+		"3:\n\t"
+		"push r0\n\t"
+		"push r1\n\t"
+		"clr r1\n\t"
+		"push r18\n\t"
+		"push r19\n\t"
+		"push r20\n\t"
+		"push r21\n\t"
+		"push r22\n\t"
+		"push r23\n\t"
+		"push r26\n\t"
+		"push r27\n\t"
+		"mov r24, r25\n\t"
+		"%~call %x[recv]\n\t"
+		"pop r27\n\t"
+		"pop r26\n\t"
+		"pop r23\n\t"
+		"pop r22\n\t"
+		"pop r21\n\t"
+		"pop r20\n\t"
+		"pop r19\n\t"
+		"pop r18\n\t"
+		"pop r1\n\t"
+		"pop r0\n\t"
+		"rjmp 1b\n"
+#endif
+		: : [udr] "n" (_SFR_MEM_ADDR(MCU_UDR)), [losing] "i" (&sg_rx.losing), [line] "i" (&sg_rx.line),
+		[plain] "n" (SG_RX_LINE_PLAIN), [head] "i" (&sg_rx.head), [tail] "i" (&sg_rx.tail),
+		[record] "n" (SG_RX_RECORD), [buf] "i" (sg_rx.buf), [all] "i" (uart_rx_all),
+#ifdef BOARD_RX_BURST
+		[hhead] "i" (&held.head), [htail] "i" (&held.tail), [hbuf] "i" (held.c),
+		[hmask] "n" (UART_HOLD - 1)
+#else
+		[recv] "i" (uart_received)
+#endif
+	);
+#else
+	__asm__ __volatile__("%~jmp %x0" : : "i" (uart_rx_all));
+#endif
+}
 
 ISR(MCU_UART_UDRE_vect)
 {

@@ -35,6 +35,25 @@
 #define SG_RX_MARK_END_LOST  0x81
 #define SG_RX_MARK_END_EMPTY 0x82
 
+struct sg_rx {
+	uint8_t buf[SG_RX_SIZE];
+	volatile uint8_t head;     /* written by the interrupt */
+	volatile uint8_t tail;     /* written by the main loop */
+	volatile uint8_t losing;   /* characters are being lost */
+	uint8_t ends_lost;         /* a line end was lost in this run */
+	uint16_t requests_lost;    /* requests whose end was lost in this run */
+	uint8_t line;              /* what is known of the line coming in */
+};
+
+/* The ring's state, open for one reader: the receive interrupt's fast path
+ * (firmware/uart.c), which stores a character as sg_rx_put() would with a
+ * few registers. Its rule: while !losing, line == SG_RX_LINE_PLAIN (a line
+ * started, something but spaces in it, not a comment, nothing lost) and
+ * (uint8_t)(tail - head - 1) > SG_RX_RECORD, a character from ' ' to 0x7F
+ * is stored as is: buf[head] = c, head + 1. Anything else: sg_rx_put(). */
+extern struct sg_rx sg_rx;
+#define SG_RX_LINE_PLAIN 0x03
+
 void sg_rx_init(void);
 
 /* One received character (interrupt). */
