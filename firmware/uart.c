@@ -136,7 +136,7 @@ void front_rx_poll(uint8_t most)
  * parser's share and the reply's included; the whole handler's register
  * saves alone cost ~60. Its fast path takes the common character with
  * four registers (the vector runs only while UDR holds a character: no
- * other code calls it): one inside a line (sg_rx.h's rule), the ring not losing
+ * other code calls it): one inside a line, or its CR or LF (sg_rx.h's rule), the ring not losing
  * and with room, the M32-D's hold empty. Anything else goes to
  * uart_rx_all(), which on the M32-D finds a character already read from
  * UDR in the hold, first in line; on the M128-S such a character goes to
@@ -158,9 +158,6 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"cp r24, r25\n\t"
 		"brne 2f\n\t"
 #endif
-		"lds r24, %[losing]\n\t"
-		"tst r24\n\t"
-		"brne 2f\n\t"
 		"lds r24, %[line]\n\t"
 		"cpi r24, %[plain]\n\t"
 		"brne 2f\n\t"
@@ -171,12 +168,19 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"cpi r25, %[record] + 1\n\t"
 		"brlo 2f\n\t"
 		"lds r25, %[udr]\n\t"
-		"cpi r25, 0x20\n\t"
-		"brlo 3f\n\t"
+		"ldi r31, 0\n\t"
 		"tst r25\n\t"
 		"brmi 3f\n\t"
+		"cpi r25, 0x20\n\t"
+		"brsh 6f\n\t"
+		"cpi r25, '\\n'\n\t"
+		"breq 5f\n\t"
+		"cpi r25, '\\r'\n\t"
+		"brne 3f\n"
+		"5:\n\t"
+		"sts %[line], r31\n"	/* the line's end: a new line next */
+		"6:\n\t"
 		"mov r30, r24\n\t"
-		"ldi r31, 0\n\t"
 		"subi r30, lo8(-(%[buf]))\n\t"
 		"sbci r31, hi8(-(%[buf]))\n\t"
 		"st Z, r25\n\t"
@@ -195,8 +199,7 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		/* into the empty hold: uart_rx_all() takes it first */
 		"lds r24, %[hhead]\n\t"
 		"mov r30, r24\n\t"
-		"andi r30, %[hmask]\n\t"
-		"ldi r31, 0\n\t"
+		"andi r30, %[hmask]\n\t"	/* r31 is 0 */
 		"subi r30, lo8(-(%[hbuf]))\n\t"
 		"sbci r31, hi8(-(%[hbuf]))\n\t"
 		"st Z, r25\n\t"
@@ -238,7 +241,7 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"pop r0\n\t"
 		"rjmp 1b\n"
 #endif
-		: : [udr] "n" (_SFR_MEM_ADDR(MCU_UDR)), [losing] "i" (&sg_rx.losing), [line] "i" (&sg_rx.line),
+		: : [udr] "n" (_SFR_MEM_ADDR(MCU_UDR)), [line] "i" (&sg_rx.line),
 		[plain] "n" (SG_RX_LINE_PLAIN), [head] "i" (&sg_rx.head), [tail] "i" (&sg_rx.tail),
 		[record] "n" (SG_RX_RECORD), [buf] "i" (sg_rx.buf), [all] "i" (uart_rx_all),
 #ifdef BOARD_RX_BURST

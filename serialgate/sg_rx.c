@@ -45,7 +45,7 @@ static inline __attribute__((always_inline)) void put_slow(uint8_t c, uint8_t he
 			head = end_run(head);  /* room for the record and this byte */
 		}
 	} else if (room <= SG_RX_RECORD) {
-		sg_rx.losing = 1;
+		sg_rx.losing = 1;  /* the line below gets LINE_LOST or ends: never plain (sg_rx.h) */
 		sg_rx.ends_lost = 0;
 		sg_rx.requests_lost = 0;
 	}

@@ -47,10 +47,12 @@ struct sg_rx {
 
 /* The ring's state, open for one reader: the receive interrupt's fast path
  * (firmware/uart.c), which stores a character as sg_rx_put() would with a
- * few registers. Its rule: while !losing, line == SG_RX_LINE_PLAIN (a line
- * started, something but spaces in it, not a comment, nothing lost) and
+ * few registers. Its rule: while line == SG_RX_LINE_PLAIN (a line started,
+ * something but spaces in it, not a comment, nothing lost; never so while
+ * characters are being lost: sg_rx.c keeps that) and
  * (uint8_t)(tail - head - 1) > SG_RX_RECORD, a character from ' ' to 0x7F
- * is stored as is: buf[head] = c, head + 1. Anything else: sg_rx_put(). */
+ * is stored as is: buf[head] = c, head + 1, and so is a CR or LF, line
+ * then 0. Anything else: sg_rx_put(). */
 extern struct sg_rx sg_rx;
 #define SG_RX_LINE_PLAIN 0x03
 
