@@ -927,6 +927,38 @@ def bench_control_loop(board, rate, steps=LOOP_STEPS, steps_one=LOOP_STEPS_ONE):
     return rows
 
 
+#: The pipelined burst of the per-rate rows: introspection counts put on the
+#: line back to back, as many as the flow rule lets a host have unanswered.
+BURST_REQUEST = b"S AA 00 00 S AB 01 P\n"
+BURST_COUNT = 11
+
+
+def bench_burst(board, rate):
+    """BURST_COUNT introspection counts on the line back to back at `rate`
+    (the gateway build for it; simulated time, deterministic): (the cycles
+    from the first request's start bit to the last reply's stop bit, the
+    wire's time for the requests' characters and the last reply's), or
+    {"error": why} if the replies are not all right."""
+    import control_loop as cl
+    from orfa.sim import SimBoard
+    byte = 10 * F_CPU // rate
+    with SimBoard(board, control=True, trace=True, firmware=cl.firmware_at(board, rate)) as sim, \
+            serial.Serial(sim.port, rate, timeout=10):  # the PC's end open: the line is up
+        ctl = sim.control
+        start = ctl.time() + F_CPU // 2
+        ctl.rx(start, BURST_REQUEST * BURST_COUNT)
+        ctl.wait(start - ctl.time() + 4 * BURST_COUNT * len(BURST_REQUEST) * byte)
+        tx = [e for e in sim.trace_events(kinds=["uart tx"]) if e.cycle >= start]
+        sent = bytes(int(e.fields[0], 16) for e in tx)
+        lines = sent.split(b"\r\n")
+        if len(lines) != BURST_COUNT + 1 or lines[-1] or len(set(lines[:-1])) != 1 \
+                or not lines[0].startswith(b"SWAASR"):
+            return {"error": "%s at %d: the burst's replies %r" % (board, rate, sent[:80])}
+        reply = len(lines[0]) + 2
+    return (tx[-1].cycle + byte - start,
+            (BURST_COUNT * len(BURST_REQUEST) + reply) * byte)
+
+
 def cl_ahead():
     import control_loop
     return control_loop.AHEAD
@@ -935,6 +967,7 @@ def cl_ahead():
 def print_control_loop(boards, width=38):
     rates = loop_rates()
     res = {(b, r): bench_control_loop(b, r) for b in boards for r in rates}
+    burst = {(b, r): bench_burst(b, r) for b in boards for r in rates}
     cols = [(b, r) for b in boards for r in rates]
     print()
     print("A robot control loop (issue 20, examples/control_loop.py): per step 16 servo")
@@ -961,6 +994,11 @@ def print_control_loop(boards, width=38):
             100.0 * r[key][0] * F_CPU / r[key][1] / wire_steps(r, rate)),
             ">= 95" if key == "pipelined" else "")
         row("%s: Python CPU ms a step" % label, lambda r, _: "%.2f" % (1e3 * r[key][2] / r[key][0]))
+    print("%-*s" % (width, "%d counts back to back: cycles" % BURST_COUNT) + "".join(
+        "%14s" % ("broken" if "error" in burst[c] else burst[c][0]) for c in cols))
+    print("%-*s" % (width, "%d counts back to back: %% of wire" % BURST_COUNT) + "".join(
+        "%14s" % ("broken" if "error" in burst[c] else "%.1f" % (100.0 * burst[c][1] / burst[c][0]))
+        for c in cols) + "%10s" % ">= 99")
     print()
     print("Columns are board@rate. The wire limit: the longer way's characters of one step")
     print("(10 bits each) at the rate. Pipelined: the next %d steps submitted before a" % cl_ahead())
@@ -971,7 +1009,15 @@ def print_control_loop(boards, width=38):
         if "error" in res[col]:
             print("broken%s: %s" % (" (known: %s)" % LOOP_KNOWN_BROKEN[col]
                                     if col in LOOP_KNOWN_BROKEN else "", res[col]["error"]))
-    return all("error" not in res[c] for c in cols if c not in LOOP_KNOWN_BROKEN)
+    print("Counts back to back: %d introspection counts (%s, %d characters: within"
+          % (BURST_COUNT, BURST_REQUEST.decode().strip(), BURST_COUNT * len(BURST_REQUEST)))
+    print("the flow rule) on the line at once; the wire's time for their characters and the")
+    print("last reply's against the board's, first start bit to the last reply's stop bit.")
+    for col in cols:
+        if "error" in burst[col]:
+            print("broken: %s" % burst[col]["error"])
+    return all("error" not in res[c] for c in cols if c not in LOOP_KNOWN_BROKEN) and \
+        all("error" not in burst[c] for c in cols)
 
 # --- end of the control loop --------------------------------------------------------
 
