@@ -142,6 +142,10 @@ void front_rx_poll(uint8_t most)
  * UDR in the hold, first in line; on the M128-S such a character goes to
  * uart_received() with the call-clobbered registers saved. A rate found
  * by autobaud needs uart_line_rx() on every character: uart_rx_all(). */
+/* The fast path's registers back, SREG last, as they were. */
+#define RX_FAST_RESTORE \
+	"pop r31\n\tpop r30\n\tpop r25\n\tpop r24\n\tout __SREG__, r24\n\tpop r24\n\t"
+
 ISR(MCU_UART_RX_vect, ISR_NAKED)
 {
 #ifdef ORFA_BAUD
@@ -187,12 +191,7 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"subi r24, 0xFF\n\t"
 		"sts %[head], r24\n"
 		"1:\n\t"
-		"pop r31\n\t"
-		"pop r30\n\t"
-		"pop r25\n\t"
-		"pop r24\n\t"
-		"out __SREG__, r24\n\t"
-		"pop r24\n\t"
+		RX_FAST_RESTORE
 		"reti\n"
 #ifdef BOARD_RX_BURST
 		"3:\n\t"
@@ -207,12 +206,7 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"sts %[hhead], r24\n"
 #endif
 		"2:\n\t"
-		"pop r31\n\t"
-		"pop r30\n\t"
-		"pop r25\n\t"
-		"pop r24\n\t"
-		"out __SREG__, r24\n\t"
-		"pop r24\n\t"
+		RX_FAST_RESTORE
 		"%~jmp %x[all]\n"
 #ifndef BOARD_RX_BURST
 		"3:\n\t"
