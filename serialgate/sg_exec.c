@@ -12,11 +12,15 @@ static struct {
 	uint16_t khz;   /* bus clock actually set */
 } gate;
 
+static void out_digit(uint8_t d)
+{
+	sg_out((uint8_t)(d < 10 ? '0' + d : 'A' - 10 + d));
+}
+
 static void out_hex(uint8_t b)
 {
-	static const ORFA_FLASH char digits[16] = "0123456789ABCDEF";
-	sg_out((uint8_t)digits[b >> 4]);
-	sg_out((uint8_t)digits[b & 0x0F]);
+	out_digit(b >> 4);
+	out_digit(b & 0x0F);
 }
 
 static void out_end(void)
@@ -85,7 +89,7 @@ static uint8_t run_bus(uint8_t addr, uint8_t *data, uint8_t n)
  * the frames run (issue 20: the latency of driver info). */
 __attribute__((noinline)) static bool intro_read(const uint8_t *b, uint8_t nbytes)
 {
-	return b[0] == gate.local && b[1] == 2 && b[2] == REGMAP_INTRO_REG &&
+	return b[0] == gate.local && (b[1] | b[2] << 8) == (2 | REGMAP_INTRO_REG << 8) &&
 	       b[3] <= regmap_driver_count() && b[4] == (uint8_t)(gate.local | 1) &&
 	       nbytes == (uint8_t)(6 + b[5]);
 }
