@@ -8,7 +8,10 @@ static RAM and measured peak stack (the simulator paints SRAM; the firmware
 is first put through every driver's requests), the cost of servo writes
 (request end to reply start, and a stream of them against the wire), and
 servo pulse accuracy: width error against the commanded width and its
-spread (jitter) while requests stream over the UART back to back. Everything is counted in
+spread (jitter) while requests stream over the UART back to back, and a
+ping-pong host (introspection count and driver info): each request sent at
+the exact cycle the previous reply's last stop bit ends, 20 round trips, as
+% over the wire time of the requests' and replies' characters. Everything is counted in
 simulated CPU cycles; wall time enters only the simulator-speed line.
 
 Every request reaches the board at a fixed cycle after power-up: each board
