@@ -29,15 +29,24 @@
 #include "firmware/port_io.h"
 #include "firmware/uart.h"
 
-#define SERVO_LEAD   640       /* wake-up before an edge, cycles */
-#define SERVO_NEAR   (SERVO_LEAD + 80)  /* closer than this: wait in place */
 #define SERVO_FINE   96        /* last stretch, waited on Timer0 */
 /* The receive interrupt's longest run (BOARD_RX_BURST characters, ~70
  * cycles each, and its entry), and the interrupt's own from the wake-up to
  * the last stretch, cycles: the lead allows for both. */
 #define SERVO_RX_CHAR 72
-#define SERVO_RX_ISR  (BOARD_RX_BURST * SERVO_RX_CHAR + 80)
 #define SERVO_ENTRY   300
+#ifdef ORFA_MODE_slave
+/* The I2C slave has no serial receiver: the lead allows for the clock's
+ * tick (480, as before the fast rates); a longer one would take its cycles
+ * from the slave's longest write (docs/protocol.md, the SPI exchange the
+ * gateway waits out). */
+#define SERVO_RX_ISR  0
+#define SERVO_LEAD    480       /* wake-up before an edge, cycles */
+#else
+#define SERVO_RX_ISR  (BOARD_RX_BURST * SERVO_RX_CHAR + 80)
+#define SERVO_LEAD    640
+#endif
+#define SERVO_NEAR   (SERVO_LEAD + 80)  /* closer than this: wait in place */
 _Static_assert(SERVO_LEAD >= SERVO_RX_ISR + SERVO_ENTRY, "the lead allows a receive interrupt");
 /* An edge this far away leaves time to hand on the whole hold. */
 #define SERVO_FAR (SERVO_LEAD + SERVO_RX_CHAR * (UART_HOLD + 2))

@@ -36,17 +36,19 @@ reg_status_t drv_intro_check(uint8_t reg, const uint8_t *data, uint8_t len)
 
 uint8_t drv_intro_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
+	uint8_t cursor = intro_cursor;
+
 	(void)reg;
-	if (intro_cursor == 0) {
+	if (cursor == 0) {
 		dst[0] = regmap_driver_count();
 		return 1;
 	}
-	if (intro_cursor > regmap_driver_count()) {
-		intro_cursor = 1;
+	if (cursor > regmap_driver_count()) {
+		cursor = 1;
 		regmap_set_status(REG_READ_WRAPPED);
 	}
 	uint8_t n = max < REGMAP_RECORD_LEN ? max : REGMAP_RECORD_LEN;
-	regmap_driver_record(intro_cursor, dst, n);
-	intro_cursor++;
+	regmap_driver_record(cursor, dst, n);
+	intro_cursor = (uint8_t)(cursor + 1);
 	return n;
 }

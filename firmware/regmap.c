@@ -62,6 +62,8 @@ static const ORFA_FLASH uint8_t regmap_records[][REGMAP_RECORD_LEN] = {
 	REGMAP_RECORD(DRV_sys_UID, DRV_sys_MAJOR, DRV_sys_MINOR, REGMAP_START_sys, DRV_sys_NREGS),
 };
 
+_Static_assert(sizeof regmap_records <= 0x100, "a record's offset fits a byte");
+
 /* selected.entry when no register is selected (after an unmapped one). */
 #define REGMAP_NO_ENTRY 0xFF
 
@@ -192,7 +194,9 @@ uint8_t regmap_driver_count(void)
 
 void regmap_driver_record(uint8_t n, uint8_t *dst, uint8_t len)
 {
-	const ORFA_FLASH uint8_t *r = regmap_records[n - 1];
+	/* the record's offset as a byte: an 8-bit product, not a 16-bit one */
+	const ORFA_FLASH uint8_t *r = &regmap_records[0][0] +
+				      (uint8_t)((uint8_t)(n - 1) * REGMAP_RECORD_LEN);
 	/* counted down, pointers walking: the tightest loop avr-gcc makes here
 	 * (on the latency path of every introspection read) */
 	while (len--) {

@@ -12,11 +12,15 @@ static struct {
 	uint16_t khz;   /* bus clock actually set */
 } gate;
 
+static void out_digit(uint8_t d)
+{
+	sg_out((uint8_t)(d < 10 ? '0' + d : 'A' - 10 + d));
+}
+
 static void out_hex(uint8_t b)
 {
-	static const ORFA_FLASH char digits[16] = "0123456789ABCDEF";
-	sg_out((uint8_t)digits[b >> 4]);
-	sg_out((uint8_t)digits[b & 0x0F]);
+	out_digit(b >> 4);
+	out_digit(b & 0x0F);
 }
 
 static void out_end(void)
@@ -78,11 +82,28 @@ static uint8_t run_bus(uint8_t addr, uint8_t *data, uint8_t n)
 	return r == TWI_ACK ? SG_OK : SG_ERR_DATA_NACK;
 }
 
+/* The gateway's own introspection read, `S AA 00 0N S AB 0M P` with N
+ * within the count (the parser takes no read of 0 bytes): once the line is checked it cannot
+ * fail (the write only moves the cursor, a read of the introspection
+ * register always gives bytes), so its reply's first byte may leave before
+ * the frames run (issue 20: the latency of driver info). */
+__attribute__((noinline)) static bool intro_read(const uint8_t *b, uint8_t nbytes)
+{
+	return b[0] == gate.local && (b[1] | b[2] << 8) == (2 | REGMAP_INTRO_REG << 8) &&
+	       b[3] <= regmap_driver_count() && b[4] == (uint8_t)(gate.local | 1) &&
+	       nbytes == (uint8_t)(6 + b[5]);
+}
+
 static void run_i2c(sg_parser_t *p)
 {
 	uint8_t *const end = p->buf + p->nbytes;
 	uint8_t err = SG_OK;
 	bool on_bus = false;
+	bool early = intro_read(p->buf, p->nbytes);
+
+	if (early) {
+		sg_out('S');
+	}
 
 	/* frames as [addr][n][n bytes], walked with a pointer */
 	for (uint8_t *f = p->buf; f < end && err == SG_OK;) {
@@ -107,10 +128,13 @@ static void run_i2c(sg_parser_t *p)
 		return;
 	}
 	/* A request has a frame at least (the parser's): the reply's first
-	 * byte leaves before anything else is looked at. */
+	 * byte leaves before anything else is looked at (or has left). */
 	uint8_t *f = p->buf;
 	do {
-		sg_out('S');
+		if (!early) {
+			sg_out('S');
+		}
+		early = false;
 		uint8_t addr = f[0];
 		uint8_t n = f[1];
 		uint8_t *data = f + 2;

@@ -8,7 +8,10 @@ static RAM and measured peak stack (the simulator paints SRAM; the firmware
 is first put through every driver's requests), the cost of servo writes
 (request end to reply start, and a stream of them against the wire), and
 servo pulse accuracy: width error against the commanded width and its
-spread (jitter) while requests stream over the UART back to back. Everything is counted in
+spread (jitter) while requests stream over the UART back to back, and a
+ping-pong host (introspection count and driver info): each request sent at
+the exact cycle the previous reply's last stop bit ends, 20 round trips, as
+% over the wire time of the requests' and replies' characters. Everything is counted in
 simulated CPU cycles; wall time enters only the simulator-speed line.
 
 Every request reaches the board at a fixed cycle after power-up: each board
@@ -339,6 +342,88 @@ def bench_board(board, count):
     rows["speed"] = cycles_total / wall / 1e6
     rows["footprint"] = footprint(board)
     return rows
+
+
+# --- Ping-pong: one request at a time, the next at the reply's last stop bit ---
+
+#: (label, request): the host sends it, waits for the whole reply and sends
+#: it again at once, PING_PONG_ROUNDS times.
+PING_PONG = [("introspection count", "S AA 00 00 S AB 01 P\r"),
+             ("driver info", "S AA 00 01 S AB 06 P\r")]
+PING_PONG_ROUNDS = 20
+
+
+def ping_pong_run(board, request, starts):
+    """One fresh simulator with `request` scheduled at each of `starts`;
+    returns (the cycle each request's last stop bit ends, the cycle each
+    reply's last stop bit ends, the replies)."""
+    with SimBoard(board, control=True) as sim:
+        ctl = sim.control
+        if ctl.time() >= starts[0]:
+            raise SystemExit("bench: the %s simulator passed cycle %d before the ping-pong "
+                             "schedule; is the machine very busy?" % (board, starts[0]))
+        ends = [ctl.rx(at, request) for at in starts]
+        with serial.Serial(sim.port, 115200, timeout=30) as port:
+            replies = read_replies(port, len(starts))
+        tx = [e.cycle for e in parse_trace(sim.trace_text()) if e.kind == "uart tx"]
+    done, i = [], 0
+    for reply in replies:
+        i += len(reply)
+        done.append(tx[i - 1] + CYCLES_PER_BYTE)
+    return ends, done, replies
+
+
+def bench_ping_pong(board, request, rounds=PING_PONG_ROUNDS):
+    """A host that sends `request`, waits for the whole reply and sends the
+    next at once, `rounds` times: each request's first start bit exactly at
+    the cycle the last reply's last stop bit ends. A reply's end is known
+    only once the board has sent it, and the simulator runs ahead of the
+    host, so the schedule is found by replay: every run is a fresh simulator
+    (the same cycles every time), each round starts where the last run saw
+    the round before end, until they agree. Returns (% over the wire time
+    of the requests and replies, mean latency in cycles)."""
+    data = request.encode()
+    # first each round alone (GAP apart), to see how long one takes
+    starts = [START + k * GAP for k in range(rounds)]
+    prev = None
+    for _ in range(rounds + 1):
+        ends, done, replies = ping_pong_run(board, data, starts)
+        if len(set(replies)) != 1 or not replies[0].startswith(b"S"):
+            raise SystemExit("bench: ping-pong %r on the %s: bad replies %r"
+                             % (request, board, sorted(set(replies))))
+        if all(starts[k + 1] == done[k] for k in range(rounds - 1)):
+            break
+        # each round as long as this run took it, from where the last ended
+        took = [(d - s) for s, d in zip(starts, done)]
+        starts = [START]
+        for t in took[:-1]:
+            starts.append(starts[-1] + t)
+        if starts == prev:
+            raise SystemExit("bench: the ping-pong schedule does not settle")
+        prev = starts
+    else:
+        raise SystemExit("bench: the ping-pong schedule did not settle in %d runs" % (rounds + 1))
+    wire = rounds * (len(data) + len(replies[0])) * CYCLES_PER_BYTE
+    lat = [first - end for end, first in
+           zip(ends, (d - len(replies[0]) * CYCLES_PER_BYTE for d in done))]
+    return 100.0 * (done[-1] - starts[0] - wire) / wire, sum(lat) / len(lat)
+
+
+def print_ping_pong(boards, width=38):
+    rows = {b: [bench_ping_pong(b, request) for _, request in PING_PONG] for b in boards}
+    print()
+    print("Ping-pong: %d round trips, each request sent at the previous reply's last stop bit"
+          % PING_PONG_ROUNDS)
+    print()
+    print("%-*s" % (width, "figure") + "".join("%14s" % b for b in boards) + "%10s" % "target")
+    for i, (name, _) in enumerate(PING_PONG):
+        print("%-*s" % (width, "ping-pong %s: %% over wire" % name) + "".join(
+            "%14.2f" % rows[b][i][0] for b in boards) + "%10s" % "<= 2")
+        print("%-*s" % (width, "  mean latency (cycles)") + "".join(
+            "%14.1f" % rows[b][i][1] for b in boards))
+    print()
+    print("The wire time is the request's and the reply's characters at 640 cycles each;")
+    print("what is over it is the board's latency and any gap inside its reply.")
 
 
 # --- RoboBus: slave boards behind an M32-D gateway ------------------------------
@@ -1094,6 +1179,8 @@ def main():
     print()
     print("Targets are the M32-D's (issue 2); flash/RAM budget = ORFA 0.7.5's own M32-D figures.")
     ok = all(results[b]["pipeline"][0] == n for b in args.boards)
+
+    print_ping_pong(args.boards, width)
 
     # --- RoboBus ------------------------------------------------------------------
     slaves = {b: bench_slave(b, SLAVE_PIPELINE) for b in args.boards}

@@ -81,6 +81,36 @@ def test_driver_above_count_status(board):
     assert board.status() == OK
 
 
+def first_byte_after(board, request):
+    """The reply to `request` and the cycles from its terminator reaching the
+    board to the reply's first byte."""
+    mark = board.mark()
+    reply = board.ask(request)
+    ev = board.events(mark, ["uart"])
+    first = next(i for i, e in enumerate(ev) if e.kind == "uart tx")
+    assert ev[first - 1].kind == "uart rx" and ev[first - 1].fields == ("0A",), ev[:first + 1]
+    return reply, ev[first].cycle - ev[first - 1].cycle
+
+
+def test_introspection_reply_starts_within_a_byte(board):
+    """issue 20: the gateway's own introspection read cannot fail once the
+    line is checked, so its reply starts before the frames run: within 640
+    cycles (a byte at 115200), the reply the same as ever."""
+    n = board.driver_count()
+    reply, cycles = first_byte_after(board, "S AA 00 00 S AB 01 P")
+    assert reply == b"SWAASR%02XP\r\n" % n and cycles <= 640
+    reply, cycles = first_byte_after(board, "S AA 00 01 S AB 06 P")
+    assert reply == b"SWAASR000001000002P\r\n" and cycles <= 640
+    assert board.status() == OK
+
+
+def test_driver_above_count_is_refused_whole(board):
+    """The fast reply never starts for a request that fails: ERROR only."""
+    n = board.driver_count()
+    reply, _ = first_byte_after(board, "S AA 00 %02X S AB 06 P" % (n + 1))
+    assert reply == b"ERROR 07\r\n"
+
+
 def test_driver_ff_is_refused(board):
     assert board.ask("S AA 00 FF P") == b"ERROR 07\r\n"
     assert board.status() == BAD_VALUE
