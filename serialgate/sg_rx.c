@@ -90,6 +90,11 @@ static inline __attribute__((always_inline)) void put_slow(uint8_t c, uint8_t he
 void sg_rx_put(uint8_t c)
 {
 	uint8_t head = sg_rx.head;
+
+#ifndef ORFA_BAUD
+	/* A fixed rate's receive interrupt stores these itself (its fast path,
+	 * firmware/uart.c, sg_rx.h's rule) and brings put_slow() the rest;
+	 * autobaud's brings every character here. */
 	uint8_t line = sg_rx.line;
 
 	/* The common cases first, room to spare: a character inside a line,
@@ -115,6 +120,7 @@ void sg_rx_put(uint8_t c)
 			return;
 		}
 	}
+#endif
 	put_slow(c, head);
 }
 
