@@ -155,9 +155,18 @@ ISR(TIMER1_COMPC_vect) { servo_rise(3, &OCR1C, &TCNT1, &TCCR1A, COM1C0, &TCCR1C,
 #define COM1C_ALL (_BV(COM1C1) | _BV(COM1C0))
 
 /* Frame start (Timer1 compare A): reset the counters, start the active
- * ones. Everything it writes was worked out by servo_hw_apply(). */
+ * ones. Everything it writes was worked out by servo_hw_apply().
+ *
+ * It lets a waiting character's interrupt in first, too: its work (about
+ * 230 cycles to the poll at its end) is more than the USART's room left
+ * when it starts after a character has waited a while already (a UDRE
+ * interrupt ran, the outranked receive interrupt waits: 54 + 230 + the
+ * poll > 320 cycles at 460800, a character lost while a reply goes out).
+ * Nothing here is due before counter 0's first rise, SERVO_LEAD ticks
+ * after OCR1A's match, on which the plan's times are based. */
 ISR(TIMER1_COMPA_vect)
 {
+	rx_poll_after_rise();
 	uint16_t f = OCR1A;
 	if (pulses.pending) {
 		pulses.cur ^= 1;
