@@ -4,6 +4,9 @@
 #include <avr/io.h>
 #include <util/atomic.h>
 
+#include "board.h"
+#include "firmware/front.h"
+
 /* F_CPU / 64 = 115.2 kHz ADC clock (datasheet: 50-200 kHz for 10 bits):
  * 13 ADC clocks = 832 CPU cycles a conversion, all 8 channels in < 1 ms. */
 #define ADC_PRESCALE (_BV(ADPS2) | _BV(ADPS1))
@@ -33,7 +36,8 @@ static void adc_start(uint8_t ch)
 	ADCSRA = _BV(ADEN) | _BV(ADSC) | _BV(ADIE) | ADC_PRESCALE;
 }
 
-ISR(ADC_vect)
+/* Its next conversion starts at its end: it cannot come again before then. */
+ISR(ADC_vect, FRONT_ISR_LETS_RX)
 {
 	uint8_t lo = ADCL;
 	uint8_t hi = ADCH;

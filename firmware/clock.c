@@ -2,6 +2,8 @@
 
 #include <avr/interrupt.h>
 
+#include "board.h"
+#include "firmware/front.h"
 #include "firmware/mcu.h"
 
 _Static_assert(F_CPU % CLOCK_TICK_CYCLES == 0, "a whole number of ticks per second");
@@ -14,7 +16,8 @@ void clock_init(void)
 	TIMSK |= MCU_CLOCK_TOIE;
 }
 
-ISR(MCU_CLOCK_OVF_vect)
+/* The next overflow is 2048 cycles away: it cannot come again before its end. */
+ISR(MCU_CLOCK_OVF_vect, FRONT_ISR_LETS_RX)
 {
 	clock_wraps++;
 }

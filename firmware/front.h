@@ -26,6 +26,18 @@ void front_poll(void);
  */
 #define FRONT_HOLD_ALL 0xFF
 
+/* The ISR() attribute of an interrupt with no deadline of its own (the
+ * ADC's, the clock tick's) that cannot come again before it ends: on a
+ * board whose receive interrupt they outrank (BOARD_RX_OUTRANKED) it runs
+ * with interrupts on (ISR_NOBLOCK), so the receive interrupt waits for
+ * none of it. Elsewhere it blocks: the M32-D's servo interrupt has a
+ * budget for the others that run before it. */
+#ifdef BOARD_RX_OUTRANKED
+#define FRONT_ISR_LETS_RX ISR_NOBLOCK
+#else
+#define FRONT_ISR_LETS_RX ISR_BLOCK
+#endif
+
 void front_rx_hold(void);
 void front_rx_poll(uint8_t most);
 

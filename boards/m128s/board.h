@@ -29,6 +29,12 @@
 /* The PC's serial port: USART1, as ORFA 0.7.5 (PE0/PE1 of USART0 are the
  * ISP programming pins), and the TWI pins. */
 #define BOARD_UART      1
+/* USART1's receive interrupt (vector 30) is outranked by the clock's, the
+ * ADC's and the servo counters' interrupts, and back to back those keep it
+ * waiting longer than the USART holds characters at 460800 (320 cycles):
+ * the ones with no deadline of their own let it in (FRONT_ISR_LETS_RX,
+ * firmware/front.h). */
+#define BOARD_RX_OUTRANKED 1
 #define BOARD_TWI_PORT  'D'
 #define BOARD_TWI_SCL   0
 #define BOARD_TWI_SDA   1
