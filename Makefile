@@ -103,6 +103,7 @@ AVR_SIZE := avr-size
 
 FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) \
 	$(if $(filter auto,$(BAUD)),'-DORFA_BAUD_RATES(X)=$(foreach r,$(AUTOBAUD_RATES),X($(r)))',-DORFA_BAUD=$(BAUD)) \
+	-DORFA_BAUD_TOP=$(if $(filter auto,$(BAUD)),$(lastword $(AUTOBAUD_RATES)),$(BAUD)) \
 	-DORFA_ADDR=$(ADDR) -DORFA_MODE_$(MODE) \
 	-std=gnu99 $(FW_OPT) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
 	-fshort-enums -I. -Iboards/$(BOARD) \

@@ -30,22 +30,27 @@
 #include "firmware/uart.h"
 
 #define SERVO_FINE   96        /* last stretch, waited on Timer0 */
-/* The receive interrupt's longest run (BOARD_RX_BURST characters, ~70
+/* The receive interrupt's longest run (BOARD_RX_BURST characters, ~85
  * cycles each, and its entry), and the interrupt's own from the wake-up to
  * the last stretch, cycles: the lead allows for both. */
-#define SERVO_RX_CHAR 72
+#define SERVO_RX_CHAR 85
 #define SERVO_ENTRY   300
+/* The lead: the receive interrupt's run and the wake-up's own, a whole
+ * number of Timer2 ticks, and never less than the clock's tick needs (480,
+ * as before the fast rates; BOARD_SERVO_LEAD_MIN): 480 at 115200, 552 at
+ * 230400, 640 at 460800 (600 left an edge 20 cycles late now and then in
+ * tests/sim/test_fast_rates.py). Every cycle of it is the main loop's,
+ * twice a channel a frame (at 640 servo streaming at 115200 fell to 97 %
+ * of the wire). The I2C slave has no serial receiver: 480 (a longer
+ * lead would take its cycles from the slave's longest write,
+ * docs/protocol.md, the SPI exchange the gateway waits out). */
 #ifdef ORFA_MODE_slave
-/* The I2C slave has no serial receiver: the lead allows for the clock's
- * tick (480, as before the fast rates); a longer one would take its cycles
- * from the slave's longest write (docs/protocol.md, the SPI exchange the
- * gateway waits out). */
 #define SERVO_RX_ISR  0
-#define SERVO_LEAD    480       /* wake-up before an edge, cycles */
 #else
 #define SERVO_RX_ISR  (BOARD_RX_BURST * SERVO_RX_CHAR + 80)
-#define SERVO_LEAD    640
 #endif
+#define SERVO_LEAD_NEED ((SERVO_RX_ISR + SERVO_ENTRY + 7) / 8 * 8)
+#define SERVO_LEAD (SERVO_LEAD_NEED > BOARD_SERVO_LEAD_MIN ? SERVO_LEAD_NEED : BOARD_SERVO_LEAD_MIN)
 #define SERVO_NEAR   (SERVO_LEAD + 80)  /* closer than this: wait in place */
 _Static_assert(SERVO_LEAD >= SERVO_RX_ISR + SERVO_ENTRY, "the lead allows a receive interrupt");
 /* An edge this far away leaves time to hand on the whole hold. */

@@ -30,6 +30,11 @@
  */
 #define UART_HOLD 16
 
+/* CPU cycles a character lasts on the line at the fastest rate the build
+ * may run (ORFA_BAUD_TOP: BAUD, or autobaud's fastest): 640 at 115200,
+ * 160 at 460800. */
+#define UART_CHAR_CYCLES ((int16_t)(F_CPU * 10 / ORFA_BAUD_TOP))
+
 /* uart_init() (set the rate, enable the USART) is the line's: see
  * firmware/uart_line.h. */
 #include "firmware/uart_line.h"

@@ -48,8 +48,12 @@
 #define BOARD_SERVO_CHANNELS 16
 /* Received characters one receive interrupt hands on at most: its servo
  * interrupt waits for cycle-exact edges, and its wake-up's lead allows for
- * a receive interrupt of about this many (drivers/servo_pins.c). */
-#define BOARD_RX_BURST 3
+ * a receive interrupt of this many (drivers/servo_pins.c): as many as
+ * reach the line in the 480 cycles the lead needs without one (the clock's
+ * tick), at least one: 3 at 460800 baud, 2 at 230400, 1 at 115200 and
+ * below, where the lead stays 480 (UART_CHAR_CYCLES, firmware/uart.h). */
+#define BOARD_SERVO_LEAD_MIN 480
+#define BOARD_RX_BURST ((BOARD_SERVO_LEAD_MIN + UART_CHAR_CYCLES - 1) / UART_CHAR_CYCLES)
 
 /*
  * Fixed wiring: X(port, bit, function, index).
