@@ -37,15 +37,18 @@ static struct {
 	uint8_t budget;  /* for a call from front_rx_poll(); 0: BOARD_RX_BURST */
 } held;
 
-/* UDR's character, if one waits, into the hold, if it has room. */
+/* UDR's characters, both if two wait, into the hold, as it has room. One
+ * a call left the second in UDR: after a release that ran out of its
+ * budget the USART stayed two behind, and the servo interrupt's last
+ * stretch (~260 cycles without a call) then lost the third at 460800. */
 static inline __attribute__((always_inline)) void uart_hold(void)
 {
 	uint8_t head = held.head;
 
-	if ((MCU_UCSRA & _BV(RXC)) && (uint8_t)(head - held.tail) < UART_HOLD) {
+	while ((MCU_UCSRA & _BV(RXC)) && (uint8_t)(head - held.tail) < UART_HOLD) {
 		uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
 		held.c[head & (UART_HOLD - 1)] = MCU_UDR;
-		held.head = (uint8_t)(head + 1);
+		held.head = ++head;
 	}
 }
 
