@@ -58,17 +58,51 @@ static void twi_done(sim_twi_t *t, uint8_t status)
 	twi_sync(t);
 }
 
+/* The master lost arbitration in the byte that ended at WHEN (twi_fault.h):
+ * it let SDA go from the lost bit on and clocked the byte to its end; it is
+ * not the master any more. (Addressed by the winner, silicon would give
+ * 0x68/0xB0: the rival does not address anybody, and the bus has no second
+ * master that could.) */
+static void twi_arb_lost(sim_twi_t *t, avr_cycle_count_t when)
+{
+	trace_event(t->bus->trace, when, "twi arb-lost");
+	t->owner = 0;
+	twi_done(t, TW_MT_ARB_LOST);
+}
+
+/* A START or STOP in the middle of the byte under way, at t->glitch_at:
+ * a bus error. The TWI stops and lets the lines go, TWINT rises with 0x00;
+ * the firmware recovers with TWSTO (or TWEN off). */
+static void twi_glitch(sim_twi_t *t)
+{
+	int start = t->op_fault == TWI_FAULT_START;
+	avr_cycle_count_t at = t->glitch_at;
+
+	t->op_fault = TWI_FAULT_NONE;
+	twi_bus_glitch(t->bus, at, start);
+	trace_event(t->bus->trace, at, "twi bus-error");
+	t->owner = 0;
+	twi_done(t, TW_BUS_ERROR);
+}
+
 static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *param)
 {
 	sim_twi_t *t = param;
 	uint8_t *twcr = twi_reg(t, t->regs->twcr);
 	uint8_t *twdr = twi_reg(t, t->regs->twdr);
-	int ack;
+	int ack, lost = 0;
+	unsigned bit = 0;
+	twi_fault_kind_t fault;
+	uint8_t sent;
 
 	(void)avr;
 	/* The bus events carry the exact completion cycle, not the cycle
 	 * simavr got round to calling us (1-4 later). */
 	when = t->op_end;
+	if (t->op_fault != TWI_FAULT_NONE) {
+		twi_glitch(t);
+		return 0;
+	}
 	if (t->op != TWI_OP_NONE && !t->bus->scl_ext) {
 		/* SCL held low under the operation: its clock stops; it ends
 		 * one period after the release (the bit position is not kept). */
@@ -99,20 +133,41 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 		twi_sync(t);	/* no TWINT after a STOP */
 		break;
 	case TWI_OP_SLA:
-		ack = twi_bus_address(t->bus, when, *twdr);
-		if (*twdr & 1) {
+		fault = twi_fault_here(&t->bus->fault, &bit);
+		sent = fault == TWI_FAULT_ARB ? twi_fault_arb_sent(*twdr, bit, &lost) : *twdr;
+		ack = twi_bus_address(t->bus, when, sent) || (fault == TWI_FAULT_ARB && bit == 8);
+		if (lost) {
+			twi_arb_lost(t, when);
+		} else if (*twdr & 1) {
 			twi_done(t, ack ? TW_MR_SLA_ACK : TW_MR_SLA_NACK);
 		} else {
 			twi_done(t, ack ? TW_MT_SLA_ACK : TW_MT_SLA_NACK);
 		}
 		break;
 	case TWI_OP_TX:
-		ack = twi_bus_write(t->bus, when, *twdr);
-		twi_done(t, ack ? TW_MT_DATA_ACK : TW_MT_DATA_NACK);
+		fault = twi_fault_here(&t->bus->fault, &bit);
+		sent = fault == TWI_FAULT_ARB ? twi_fault_arb_sent(*twdr, bit, &lost) : *twdr;
+		ack = twi_bus_write(t->bus, when, sent) || (fault == TWI_FAULT_ARB && bit == 8);
+		if (lost) {
+			twi_arb_lost(t, when);
+		} else {
+			twi_done(t, ack ? TW_MT_DATA_ACK : TW_MT_DATA_NACK);
+		}
 		break;
 	case TWI_OP_RX:
-		*twdr = twi_bus_read(t->bus, when, t->op_ack);
-		twi_done(t, t->op_ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK);
+		/* the rival's low bit: a 0 read, or an ACK where the master
+		 * sends its NACK (it loses arbitration there) */
+		fault = twi_fault_here(&t->bus->fault, &bit);
+		lost = fault == TWI_FAULT_ARB && bit == 8 && !t->op_ack;
+		*twdr = twi_bus_read(t->bus, when, t->op_ack || lost);
+		if (fault == TWI_FAULT_ARB && bit < 8) {
+			*twdr = twi_fault_arb_read(*twdr, bit);
+		}
+		if (lost) {
+			twi_arb_lost(t, when);
+		} else {
+			twi_done(t, t->op_ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK);
+		}
 		break;
 	case TWI_OP_NONE:
 		break;
@@ -123,10 +178,22 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 /* The operation in progress begins on the bus at cycle START. */
 static void twi_schedule(sim_twi_t *t, avr_cycle_count_t start)
 {
-	avr_cycle_count_t now = t->avr->cycle;
+	avr_cycle_count_t now = t->avr->cycle, p = sim_twi_scl_period(t), at;
+	unsigned bit;
 
-	t->op_end = start + t->op_periods * sim_twi_scl_period(t);
-	avr_cycle_timer_register(t->avr, t->op_end > now ? t->op_end - now : 1, twi_timer, t);
+	t->op_end = start + t->op_periods * p;
+	at = t->op_end;
+	/* a glitch armed for this byte: in SCL's high half of its bit */
+	t->op_fault = TWI_FAULT_NONE;
+	if (t->op_periods == 9) {
+		twi_fault_kind_t f = twi_fault_here(&t->bus->fault, &bit);
+
+		if (f == TWI_FAULT_START || f == TWI_FAULT_STOP) {
+			t->op_fault = f;
+			t->glitch_at = at = start + bit * p + 3 * p / 4;
+		}
+	}
+	avr_cycle_timer_register(t->avr, at > now ? at - now : 1, twi_timer, t);
 }
 
 static void twi_master_resume(twi_bus_master_t *m, uint64_t cycle)
@@ -313,12 +380,25 @@ static void twi_dev_end(twi_dev_t *dev)
 	}
 }
 
+/* A START or STOP in the middle of a byte of this slave's transfer: TWINT
+ * with 0x00, the lines let go, not addressed; the firmware recovers with
+ * TWSTO (twi_action). */
+static void twi_dev_bus_error(twi_dev_t *dev)
+{
+	sim_twi_t *t = twi_of_dev(dev);
+
+	trace_event(t->bus->trace, t->bus->cycle, "twi bus-error %02X", t->sl_addr);
+	t->addressed = 0;
+	twi_slave_deliver(t, TW_BUS_ERROR, 0, 0, TWI_HOLD_NONE);
+}
+
 static const twi_dev_ops_t twi_dev_ops = {
 	.start = twi_dev_start,
 	.write = twi_dev_write,
 	.read = twi_dev_read,
 	.stop = twi_dev_end,
 	.bus_start = twi_dev_end,
+	.bus_error = twi_dev_bus_error,
 };
 
 /* --- the pins ------------------------------------------------------------- */

@@ -60,6 +60,8 @@ typedef struct sim_twi_t {
 	int op_ack;			/* RX: TWEA when the byte started */
 	avr_cycle_count_t op_periods;	/* its length in SCL periods */
 	avr_cycle_count_t op_end;	/* the cycle it completes (0: waits for SCL) */
+	twi_fault_kind_t op_fault;	/* a glitch in its byte (twi_fault.h) ... */
+	avr_cycle_count_t glitch_at;	/* ... at this cycle */
 	twi_bus_master_t master;	/* the bus resumes a waiting operation here */
 
 	/* slave mode */

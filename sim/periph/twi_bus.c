@@ -24,6 +24,7 @@ void twi_bus_init(twi_bus_t *bus, trace_t *trace)
 	bus->pins = NULL;
 	bus->nlisteners = 0;
 	bus->busy_signal = NULL;
+	twi_fault_arm(&bus->fault, TWI_FAULT_NONE, 0, 0);
 }
 
 void twi_bus_attach(twi_bus_t *bus, twi_dev_t *dev)
@@ -45,6 +46,7 @@ void twi_bus_start(twi_bus_t *bus, uint64_t cycle)
 	bus->selected = NULL;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi start");
+	twi_fault_on_start(&bus->fault);
 	if (bus->busy_signal) {
 		signal_set(bus->busy_signal, cycle, 1);
 	}
@@ -67,6 +69,7 @@ int twi_bus_address(twi_bus_t *bus, uint64_t cycle, uint8_t addr8)
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi addr %02X %s", addr8,
 		    bus->selected ? "ack" : "nack");
+	twi_fault_byte_done(&bus->fault);
 	return bus->selected != NULL;
 }
 
@@ -78,6 +81,7 @@ int twi_bus_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte)
 	ack = bus->selected ? bus->selected->ops->write(bus->selected, byte) : 0;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi write %02X %s", byte, ack ? "ack" : "nack");
+	twi_fault_byte_done(&bus->fault);
 	return ack;
 }
 
@@ -92,6 +96,7 @@ uint8_t twi_bus_read(twi_bus_t *bus, uint64_t cycle, int master_acks)
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi read %02X %s", byte,
 		    master_acks ? "ack" : "nack");
+	twi_fault_byte_done(&bus->fault);
 	return byte;
 }
 
@@ -107,6 +112,30 @@ void twi_bus_stop(twi_bus_t *bus, uint64_t cycle)
 	trace_event(bus->trace, cycle, "twi stop");
 	if (bus->busy_signal) {
 		signal_set(bus->busy_signal, cycle, 0);
+	}
+}
+
+void twi_bus_glitch(twi_bus_t *bus, uint64_t cycle, int start)
+{
+	twi_dev_t *sel = bus->selected;
+
+	bus->cycle = cycle;
+	bus->selected = NULL;
+	bus->activity++;
+	trace_event(bus->trace, cycle, "twi glitch %s", start ? "start" : "stop");
+	twi_fault_byte_done(&bus->fault);
+	for (twi_dev_t *d = bus->devs; d; d = d->next) {
+		if (d == sel && d->ops->bus_error) {
+			d->ops->bus_error(d);
+		} else if (!start) {
+			d->ops->stop(d);
+		} else if (d->ops->bus_start) {
+			d->ops->bus_start(d);
+		}
+	}
+	bus->busy = start;
+	if (bus->busy_signal) {
+		signal_set(bus->busy_signal, cycle, start);
 	}
 }
 

@@ -19,6 +19,7 @@
 
 #include "harness/signals.h"
 #include "harness/trace.h"
+#include "periph/twi_fault.h"
 
 typedef struct twi_dev_t twi_dev_t;
 
@@ -35,6 +36,10 @@ typedef struct twi_dev_ops_t {
 	/* Optional (NULL: not told): a START condition completed (all
 	 * devices), before any address; a repeated START ends a transfer. */
 	void (*bus_start)(twi_dev_t *dev);
+	/* Optional (NULL: told the plain START or STOP): a START or STOP in
+	 * the middle of a byte of the transfer this device was selected for
+	 * (twi_bus_glitch): a TWI's bus error. */
+	void (*bus_error)(twi_dev_t *dev);
 } twi_dev_ops_t;
 
 /* How a device holds SCL low. */
@@ -108,6 +113,8 @@ typedef struct twi_bus_t {
 	/* the signal "i2c": 1 from the end of a START to the end of its STOP,
 	 * the bus's activity in the VCD and to `edges` (NULL: none) */
 	signal_t *busy_signal;
+	/* a fault armed for the middle of a byte (`i2c arb`, `i2c glitch`) */
+	twi_fault_t fault;
 } twi_bus_t;
 
 void twi_bus_init(twi_bus_t *bus, trace_t *trace);
@@ -119,6 +126,10 @@ int twi_bus_address(twi_bus_t *bus, uint64_t cycle, uint8_t addr8);
 int twi_bus_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte);
 uint8_t twi_bus_read(twi_bus_t *bus, uint64_t cycle, int master_acks);
 void twi_bus_stop(twi_bus_t *bus, uint64_t cycle);
+/* A START (START 1) or STOP condition at CYCLE in the middle of a byte
+ * (twi_fault.h): the selected device gets its bus error, every other one
+ * the plain condition; nobody is selected after it. */
+void twi_bus_glitch(twi_bus_t *bus, uint64_t cycle, int start);
 
 /* Master M wants to begin OP at cycle NOW. Returns the cycle it begins at
  * (NOW, or later when a device released SCL after NOW), or 0 when a device

@@ -1,0 +1,216 @@
+"""Bus faults in the middle of a byte (issue 19; docs/protocol.md, the
+bus-fault table; docs/simulator.md, "Faults in the middle of a byte").
+
+A robot of one gateway (each board in turn) and two slave boards (an M128-S
+at 0x10, an M32-D at 0x12), as in test_abandoned.py. A write or a read to
+one slave meets a fault at a chosen byte and bit of its transaction:
+
+* `i2c arb BYTE BIT`: a device pulls SDA low for that bit; where the
+  gateway sends a 1 it loses arbitration (TWSR 0x38);
+* `i2c glitch start|stop BYTE BIT`: a START or STOP condition in that bit,
+  a bus error (0x00) for the gateway's TWI and the addressed slave's.
+
+The gateway answers `ERROR 06` before the address was acknowledged and
+`ERROR 07` after, soon after the fault (no bus timeout is waited for);
+nothing of a cut write is applied and the slave's status says DROPPED
+where data had arrived; the gateway sends no STOP; the lines are high and
+the next request is served, to the same slave or the other."""
+
+import pytest
+
+from conftest import F_CPU
+from test_abandoned import (DROPPED, M128S, M32D, OK, SLAVES, applied_nothing, clear, mode,
+                            robot, sp, status)  # noqa: F401 (robot: the fixture)
+
+MS = F_CPU // 1000
+LEAD = 2000          # cycles from the batch to the request's first bit
+
+
+@pytest.fixture
+def rb(robot):  # noqa: F811
+    assert robot.sim.running, robot.sim.stderr
+    robot.gw.serial.reset_input_buffer()
+    robot.sim.control.i2c_disarm()
+    for addr in SLAVES:
+        clear(robot, addr)
+    yield robot
+    robot.sim.control.i2c_disarm()
+    robot.restore()
+
+
+def servo_write(addr):
+    """Channels 0 and 1 to 1500 us: bytes on the bus 0 address, 1 register,
+    2..4 `00 05 DC`, 5..7 `01 05 DC`."""
+    return "S%02X%02X0005DC0105DCP" % (addr, sp(addr))
+
+
+def first_one(byte):
+    """The first bit (MSB first) that is 1 in `byte`."""
+    return next(k for k in range(8) if byte & (0x80 >> k))
+
+
+def faulted(b, fault, req):
+    """`fault` armed, then `req` (text, without its end) from the serial
+    line: the reply, the cycles from the request's end to the reply's first
+    byte, the trace mark before it and the cycle the request began."""
+    ctl = b.sim.control
+    data = (req + "\n").encode()
+    mark = b.mark()
+    out = ctl.requests([fault, "rx +%d %s" % (LEAD, data.hex().upper())])
+    end = int(out[1])
+    reply = b.read_lines(1)
+    tx = [e.cycle for e in b.events(mark, ["uart tx"]) if e.cycle > end]
+    return reply, tx[0] - end, mark, end - 10 * ctl.line()["bit"] * len(data)
+
+
+def after_fault(b, mark, victim):
+    """The gateway never sent a STOP after the fault; the lines are high
+    (once the quiet time is over: a slave that was sending lets SDA go when
+    it drops the frame); every fault fired."""
+    kinds = [e.kind for e in b.events(mark, ["twi"])]
+    fault = next(i for i, k in enumerate(kinds) if k in ("twi arb-lost", "twi glitch"))
+    rest = kinds[fault:] + ["twi start"]
+    assert "twi stop" not in rest[:rest.index("twi start")], kinds
+    b.sim.control.wait(40 * MS)
+    assert b.sim.control.i2c()["sda"] == 1 and b.sim.control.i2c()["scl"] == 1
+    assert b.sim.control.i2c_armed() == "none"
+
+
+#: (fault, byte, bit or None: the first 1 of that byte) on servo_write:
+#: the reply, whether data had arrived at the slave (the register byte
+#: does not count)
+WRITE_CUTS = [
+    ("arb", 0, None, b"ERROR 06", False),          # the address
+    ("arb", 1, None, b"ERROR 07", False),          # the register byte
+    ("arb", 3, 5, b"ERROR 07", True),              # 05: its first 1
+    ("arb", 7, 0, b"ERROR 07", True),              # DC, the last byte
+    ("glitch start", 0, 4, b"ERROR 06", False),
+    ("glitch stop", 0, 8, b"ERROR 06", False),     # the address's acknowledge
+    ("glitch start", 2, 8, b"ERROR 07", False),    # the first data byte not in yet
+    ("glitch stop", 3, 8, b"ERROR 07", True),
+    ("glitch start", 4, 1, b"ERROR 07", True),
+    ("glitch stop", 7, 7, b"ERROR 07", True),
+]
+WRITE_IDS = ["%s-%d-%s" % (c[0].replace(" ", "-"), c[1], c[2]) for c in WRITE_CUTS]
+
+
+@pytest.mark.parametrize("victim", [M128S, M32D], ids=["m128s@10", "m32d@12"])
+@pytest.mark.parametrize("fault,byte,bit,want,data_in", WRITE_CUTS, ids=WRITE_IDS)
+def test_write_cut_mid_byte_applies_nothing(rb, victim, fault, byte, bit, want, data_in):
+    b = rb
+    req = servo_write(victim)
+    if bit is None:
+        bit = first_one(int(req[1 + 2 * byte:3 + 2 * byte], 16))
+    reply, lat, mark, began = faulted(b, "i2c %s %d %d" % (fault, byte, bit), req)
+    assert reply == want + b"\r\n", reply
+    print("%s %d %d: %s after %d cycles (%.2f ms)" % (fault, byte, bit, want.decode(), lat,
+                                                     lat / MS))
+    assert lat < 2 * MS, lat
+    ev = [(e.kind,) + e.fields for e in b.events(mark, ["twi"])]
+    if fault == "arb":
+        assert ("twi arb-lost",) in ev, ev
+    else:
+        assert ("twi glitch", fault.split()[1]) in ev and ("twi bus-error",) in ev, ev
+        # the slave's TWI took part from its address's acknowledge on
+        slave_error = ("twi bus-error", "%02X" % victim) in ev
+        assert slave_error == (byte >= 1), ev
+    after_fault(b, mark, victim)
+    # the next request to the same slave, its status first of all
+    assert status(b, victim) == (DROPPED if data_in else OK)
+    applied_nothing(b, victim, began)
+    # and the write itself, whole this time
+    assert b.ask(servo_write(victim)) == b"SWAAAAAAAP\r\n"
+    assert status(b, victim) == OK
+    assert b.ask("S %02X %02X 01 S %02X 02 P" % (victim, sp(victim), victim | 1)) \
+        == b"SWAASR05DCP\r\n"
+
+
+@pytest.mark.parametrize("fault", ["arb 3 4", "glitch stop 3 3"])
+def test_next_request_to_the_other_slave(rb, fault):
+    """A GPIO mode write to the M32-D (bytes 0 address, 1 register, 2 and 3
+    `0F`: the first 1 of 0F is bit 4) cut in its last byte; the next
+    request, a write to the M128-S, is applied; the cut one is not."""
+    b = rb
+    req = "S%02X%02X0F0FP" % (M32D, mode(M32D))       # lines 0-3 outputs
+    reply, _, mark, _ = faulted(b, "i2c " + fault, req)
+    assert reply == b"ERROR 07\r\n"
+    assert b.ask("S %02X %02X 01 05 DC P" % (M128S, sp(M128S))) == b"SWAAAAP\r\n"
+    after_fault(b, mark, M32D)
+    assert status(b, M32D) == DROPPED
+    assert b.ask("S %02X %02X S %02X 01 P" % (M32D, mode(M32D), M32D | 1)) == b"SWASR00P\r\n"
+    assert status(b, M128S) == OK
+    assert b.ask("S %02X %02X 01 S %02X 02 P" % (M128S, sp(M128S), M128S | 1)) \
+        == b"SWAASR05DCP\r\n"
+
+
+def read_req(addr):
+    """Channel 0's width: bytes 0 address, 1 register, 2 `00`, 3 the read
+    address (repeated START), 4 and 5 the two bytes read (ACK, NACK)."""
+    return "S%02X%02X00S%02X02P" % (addr, sp(addr), addr | 1)
+
+
+@pytest.mark.parametrize("victim", [M128S, M32D], ids=["m128s@10", "m32d@12"])
+def test_read_faults(rb, victim):
+    """In a read: the device's low bit in a byte the slave sends is read as
+    0 (no fault: the master does not send there); on the master's ACK it
+    changes nothing; on its NACK after the last byte the master loses
+    arbitration (ERROR 07) and the slave, which saw an ACK, goes on until it
+    drops the frame; a glitch in a byte the slave sends is a bus error for
+    both. After each the next request is served."""
+    b = rb
+    a = victim
+    assert b.ask("S %02X %02X 00 05 DC P" % (a, sp(a))) == b"SWAAAAP\r\n"
+    reply, _, _, _ = faulted(b, "i2c arb 4 5", read_req(a))
+    assert reply == b"SWAASR01DCP\r\n"                 # 05 read as 01
+    reply, _, _, _ = faulted(b, "i2c arb 4 8", read_req(a))
+    assert reply == b"SWAASR05DCP\r\n"
+    for fault in ("arb 5 8", "glitch stop 4 2", "glitch start 5 8"):
+        reply, lat, mark, _ = faulted(b, "i2c " + fault, read_req(a))
+        assert reply == b"ERROR 07\r\n", (fault, reply)
+        print("read, %s: ERROR 07 after %d cycles (%.2f ms)" % (fault, lat, lat / MS))
+        if fault.startswith("glitch"):
+            assert ("twi bus-error", "%02X" % a) in [(e.kind,) + e.fields
+                                                     for e in b.events(mark, ["twi"])]
+        after_fault(b, mark, a)
+        assert status(b, a) == OK
+        assert b.ask(read_req(a).replace("S", "S ")) == b"SWAASR05DCP\r\n"
+
+
+def test_x_after_a_fault(rb):
+    """`X` right after a fault frees nothing that is held, answers X, and
+    the bus serves the next request."""
+    b = rb
+    reply, _, mark, _ = faulted(b, "i2c glitch start 3 4", servo_write(M128S))
+    assert reply == b"ERROR 07\r\n"
+    assert b.ask("X") == b"X\r\n"
+    after_fault(b, mark, M128S)
+    assert status(b, M128S) == DROPPED
+    assert b.ask(servo_write(M128S)) == b"SWAAAAAAAP\r\n"
+    assert status(b, M128S) == OK
+
+
+def test_a_bit_the_master_sends_low_changes_nothing(rb):
+    """The device's low bit where the gateway sends a 0 is no fault: the
+    write goes through whole."""
+    b = rb
+    reply, _, _, _ = faulted(b, "i2c arb 0 0", servo_write(M32D))   # 12: its MSB is 0
+    assert reply == b"SWAAAAAAAP\r\n"
+    assert b.sim.control.i2c_armed() == "none"
+    assert b.ask("S %02X %02X 01 S %02X 02 P" % (M32D, sp(M32D), M32D | 1)) \
+        == b"SWAASR05DCP\r\n"
+
+
+def test_control_requests_refuse_bad_arguments(rb):
+    from orfa.simctl import SimControlError
+    ctl = rb.sim.control
+    for bad in ("i2c arb 0 9", "i2c arb 256 0", "i2c glitch start 0 0", "i2c glitch up 1 1",
+                "i2c glitch stop 1", "i2c arb x 1"):
+        with pytest.raises(SimControlError):
+            ctl.request(bad)
+    assert ctl.i2c_armed() == "none"
+    ctl.i2c_arb(2, 3)
+    assert ctl.i2c_armed() == "arb 2 3"
+    ctl.i2c_glitch("stop", 1, 8)
+    assert ctl.i2c_armed() == "glitch stop 1 8"
+    ctl.i2c_disarm()
+    assert ctl.i2c_armed() == "none"
