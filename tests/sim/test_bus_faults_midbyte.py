@@ -33,6 +33,9 @@ def rb(robot):  # noqa: F811
     robot.sim.control.i2c_disarm()
     for addr in SLAVES:
         clear(robot, addr)
+    # a servo pulse a test before left running ends within a 20 ms frame
+    # or two: none is seen as a write applied
+    robot.sim.control.wait(45 * MS)
     yield robot
     robot.sim.control.i2c_disarm()
     robot.restore()
@@ -115,6 +118,11 @@ def test_write_cut_mid_byte_applies_nothing(rb, victim, fault, byte, bit, want, 
         slave_error = ("twi bus-error", "%02X" % victim) in ev
         assert slave_error == (byte >= 1), ev
     after_fault(b, mark, victim)
+    # a bus error: the slave recovered with TWSTO at once; a frame the
+    # gateway left (arbitration lost) the slave dropped after 30 ms of
+    # quiet, resetting its TWI
+    off = [e.cycle for e in b.events(mark, ["twi off"]) if e.fields == ("%02X" % victim,)]
+    assert len(off) == (1 if fault == "arb" and byte >= 1 else 0), off
     # the next request to the same slave, its status first of all
     assert status(b, victim) == (DROPPED if data_in else OK)
     applied_nothing(b, victim, began)
@@ -179,6 +187,24 @@ def test_read_faults(rb, victim):
         after_fault(b, mark, a)
         assert status(b, a) == OK
         assert b.ask(read_req(a).replace("S", "S ")) == b"SWAASR05DCP\r\n"
+
+
+def test_a_lost_bit_addresses_the_other_slave(rb):
+    """12 with its bit 6 pulled low reads 11: the M128-S at 10 is addressed
+    for a read and starts sending to a master that went away (ERROR 06). It
+    drops that frame after 30 ms; the gateway's next START comes after it,
+    and both slaves serve as before."""
+    b = rb
+    reply, _, mark, began = faulted(b, "i2c arb 0 6", servo_write(M32D))
+    assert reply == b"ERROR 06\r\n"
+    ev = [(e.kind,) + e.fields for e in b.events(mark, ["twi"])]
+    assert ("twi addr", "11", "ack") in ev, ev
+    after_fault(b, mark, M32D)
+    # (the gateway's TWI was no longer the master when it reset it)
+    assert [e.fields for e in b.events(mark, ["twi off"])] == [("10",)]
+    assert status(b, M128S) == OK and status(b, M32D) == OK
+    applied_nothing(b, M32D, began)
+    assert b.ask(servo_write(M32D)) == b"SWAAAAAAAP\r\n"
 
 
 def test_x_after_a_fault(rb):
