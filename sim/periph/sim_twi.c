@@ -60,14 +60,32 @@ static void twi_done(sim_twi_t *t, uint8_t status)
 
 /* The master lost arbitration in the byte that ended at WHEN (twi_fault.h):
  * it let SDA go from the lost bit on and clocked the byte to its end; it is
- * not the master any more. (Addressed by the winner, silicon would give
- * 0x68/0xB0: the rival does not address anybody, and the bus has no second
- * master that could.) */
+ * not the master any more: 0x38. */
 static void twi_arb_lost(sim_twi_t *t, avr_cycle_count_t when)
 {
 	trace_event(t->bus->trace, when, "twi arb-lost");
 	t->owner = 0;
 	twi_done(t, TW_MT_ARB_LOST);
+}
+
+/* The master lost arbitration in its address byte: the address the devices
+ * read (SEEN) goes to them all, this TWI among them now that it is no
+ * longer the master; addressed (its TWAR, TWEA set) it is a slave from
+ * here, 0x68 (written to) or 0xB0 (read from), else 0x38. (No general
+ * call: 0x78 is not modelled.) */
+static void twi_arb_lost_addr(sim_twi_t *t, avr_cycle_count_t when, uint8_t seen)
+{
+	t->owner = 0;
+	t->op = TWI_OP_NONE;
+	twi_bus_address(t->bus, when, seen);
+	if (!t->addressed) {
+		twi_arb_lost(t, when);
+		return;
+	}
+	trace_event(t->bus->trace, when, "twi arb-lost %02X", t->sl_addr);
+	t->status = t->sl_status = t->addressed == TWI_SLAVE_TX ? TW_ST_ARB_LOST_SLA_ACK
+							       : TW_SR_ARB_LOST_SLA_ACK;
+	twi_sync(t);
 }
 
 /* A START or STOP in the middle of the byte under way, at t->glitch_at:
@@ -135,10 +153,12 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 	case TWI_OP_SLA:
 		fault = twi_fault_here(&t->bus->fault, &bit);
 		sent = fault == TWI_FAULT_ARB ? twi_fault_arb_sent(*twdr, bit, &lost) : *twdr;
-		ack = twi_bus_address(t->bus, when, sent) || (fault == TWI_FAULT_ARB && bit == 8);
 		if (lost) {
-			twi_arb_lost(t, when);
-		} else if (*twdr & 1) {
+			twi_arb_lost_addr(t, when, sent);
+			break;
+		}
+		ack = twi_bus_address(t->bus, when, sent) || (fault == TWI_FAULT_ARB && bit == 8);
+		if (*twdr & 1) {
 			twi_done(t, ack ? TW_MR_SLA_ACK : TW_MR_SLA_NACK);
 		} else {
 			twi_done(t, ack ? TW_MT_SLA_ACK : TW_MT_SLA_NACK);

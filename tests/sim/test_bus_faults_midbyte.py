@@ -18,7 +18,8 @@ the next request is served, to the same slave or the other."""
 
 import pytest
 
-from conftest import F_CPU
+from conftest import F_CPU, require_builds, require_slave, running
+from orfa.sim import REPO_ROOT, SimBoard
 from test_abandoned import (DROPPED, M128S, M32D, OK, SLAVES, applied_nothing, clear, mode,
                             robot, sp, status)  # noqa: F401 (robot: the fixture)
 
@@ -245,3 +246,55 @@ def test_control_requests_refuse_bad_arguments(rb):
     assert ctl.i2c_armed() == "glitch stop 1 8"
     ctl.i2c_disarm()
     assert ctl.i2c_armed() == "none"
+
+
+# --- a master that is addressed while it loses (0x68, 0xB0) -------------------
+
+ARB_ELF = REPO_ROOT / "build" / "sim-fw" / "twi_arb_master.elf"
+ARB = 0x1E          # its TWAR
+PORTA = 0x3B        # data addresses on the ATmega32
+PORTC = 0x35
+
+
+@pytest.fixture(scope="module")
+def arb_robot():
+    """An M32-D gateway, the M128-S slave at 0x10 and, as a second master,
+    tests/sim/fw/twi_arb_master.c (an ATmega32 whose TWI answers at 1E)."""
+    require_builds(["m32d"])
+    if not ARB_ELF.is_file():
+        pytest.fail("missing %s: run `make sim`" % ARB_ELF, pytrace=False)
+    slaves = [("m128s", M128S, require_slave("m128s", M128S)), ("m32d", ARB, ARB_ELF)]
+    sim = SimBoard("m32d", trace=True, control=True, slaves=slaves)
+    with running(sim) as b:
+        yield b
+
+
+def test_a_master_addressed_while_it_loses(arb_robot):
+    """The second master's TWI (TWEA set, TWAR 1E) loses arbitration in its
+    address byte: where the address the devices read is its own it is
+    addressed by it, 0xB0 (a read) or 0x68 (a write), else 0x38; with no
+    fault it is 0x20 (nobody at 20). The gateway's bus works after each."""
+    b = arb_robot
+    ctl = b.sim.control
+    arb = ctl.slave(ARB)
+    for n, (fault, want, seen) in enumerate([("arb 0 2", 0xB0, "1F ack"),
+                                              ("arb 0 7", 0x68, "1E ack"),
+                                              (None, 0x20, "20 nack"),
+                                              ("arb 0 3", 0x38, "0F nack")], 1):
+        mark = b.mark()
+        if fault:
+            ctl.request("i2c " + fault)
+        arb.drive("B0", 0)
+        ctl.wait(2 * MS)
+        arb.drive("B0", None)
+        assert arb.peek(PORTC)[0] == n
+        assert arb.peek(PORTA)[0] == want, (fault, hex(arb.peek(PORTA)[0]))
+        ev = [(e.kind,) + e.fields for e in b.events(mark, ["twi"])]
+        assert ("twi addr",) + tuple(seen.split()) in ev, ev
+        if want in (0x68, 0xB0):
+            assert ("twi arb-lost", "1E") in ev, ev
+        elif want == 0x38:
+            assert ("twi arb-lost",) in ev, ev
+        ctl.wait(40 * MS)
+        assert ctl.i2c()["sda"] == 1 and ctl.i2c()["scl"] == 1
+        assert status(b, M128S) == OK
