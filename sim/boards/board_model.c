@@ -64,13 +64,19 @@ static int bm_pin_level(const bm_port_t *p, int bit)
 	return !!(p->port & m);
 }
 
-void board_model_port_update(bm_port_t *p, uint64_t cycle)
+/* The pins of MASK. */
+static void bm_port_update_pins(bm_port_t *p, uint8_t mask, uint64_t cycle)
 {
 	avr_t *avr = p->bm->avr;
 
 	for (int b = 0; b < 8; b++) {
-		int level = bm_pin_level(p, b);
+		int level;
 		uint8_t m = (uint8_t)(1u << b);
+
+		if (!(mask & m)) {
+			continue;
+		}
+		level = bm_pin_level(p, b);
 
 		if (!(p->ddr & m) && !(p->ext_mask & m) &&
 		    !!(avr->data[p->io->r_pin] & m) != level) {
@@ -78,6 +84,11 @@ void board_model_port_update(bm_port_t *p, uint64_t cycle)
 		}
 		signal_set(&p->pin[b], cycle, level);
 	}
+}
+
+void board_model_port_update(bm_port_t *p, uint64_t cycle)
+{
+	bm_port_update_pins(p, 0xff, cycle);
 }
 
 /* PINx of an output reads the pin's real level: simavr returns PORTx,
@@ -501,7 +512,8 @@ static void bm_twi_lines(void *param, uint64_t cycle)
 {
 	board_model_t *bm = param;
 
-	board_model_port_update(bm->twi_port, cycle);
+	/* only the TWI's two pins: this runs on every edge of the bus */
+	bm_port_update_pins(bm->twi_port, bm->twi_port->wired, cycle);
 }
 
 int board_model_wire_twi(board_model_t *bm, twi_bus_t *bus)

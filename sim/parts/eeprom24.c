@@ -37,12 +37,11 @@ static int eeprom24_write(twi_dev_t *dev, uint8_t byte)
 	return 1;
 }
 
-static uint8_t eeprom24_read(twi_dev_t *dev, int master_acks)
+static uint8_t eeprom24_read(twi_dev_t *dev)
 {
 	eeprom24_t *e = (eeprom24_t *)dev;
 	uint8_t v = e->mem[e->ptr];
 
-	(void)master_acks;
 	e->ptr++;		/* uint8_t: wraps at 256 */
 	return v;
 }

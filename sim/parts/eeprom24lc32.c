@@ -80,12 +80,11 @@ static int ee24lc32_write(twi_dev_t *dev, uint8_t byte)
 	return 1;
 }
 
-static uint8_t ee24lc32_read(twi_dev_t *dev, int master_acks)
+static uint8_t ee24lc32_read(twi_dev_t *dev)
 {
 	ee24lc32_t *e = (ee24lc32_t *)dev;
 	uint8_t v = e->mem[e->ptr];
 
-	(void)master_acks;
 	e->ptr = (e->ptr + 1) % EE24LC32_SIZE;
 	return v;
 }

@@ -41,12 +41,11 @@ static int regdev_write(twi_dev_t *dev, uint8_t byte)
 	return 1;
 }
 
-static uint8_t regdev_read(twi_dev_t *dev, int master_acks)
+static uint8_t regdev_read(twi_dev_t *dev)
 {
 	regdev_t *d = (regdev_t *)dev;
 	uint8_t v;
 
-	(void)master_acks;
 	if (!d->selected) {
 		return 0xff;
 	}

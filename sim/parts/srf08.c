@@ -226,12 +226,11 @@ static int srf08_write(twi_dev_t *dev, uint8_t byte)
 	return 1;
 }
 
-static uint8_t srf08_read(twi_dev_t *dev, int master_acks)
+static uint8_t srf08_read(twi_dev_t *dev)
 {
 	srf08_t *s = (srf08_t *)dev;
 	uint8_t v;
 
-	(void)master_acks;
 	if (!s->selected || srf08_busy(s, s->bus->cycle)) {
 		return 0xff;	/* SDA left to the pull-up */
 	}

@@ -1,6 +1,7 @@
 /*
  * twi.c: TWI model, master and slave mode (twi.h).
  */
+#include <inttypes.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -58,203 +59,367 @@ static void twi_done(sim_twi_t *t, uint8_t status)
 	twi_sync(t);
 }
 
-/* The master lost arbitration in the byte that ended at WHEN (twi_fault.h):
- * it let SDA go from the lost bit on and clocked the byte to its end; it is
- * not the master any more: 0x38. */
-static void twi_arb_lost(sim_twi_t *t, avr_cycle_count_t when)
+/* --- master mode -----------------------------------------------------------
+ *
+ * An operation puts its bits on the lines one edge at a time, each edge a
+ * step of a cycle timer stamped with its exact cycle (simavr may call the
+ * timer a few cycles later; the lines get the exact one). With P the SCL
+ * period (16 + 2*TWBR*4^TWPS) and B the cycle a bit's SCL low began:
+ *
+ *   a bit: SDA set at B + P/4, SCL let go at B + P/2; from the cycle H SCL is
+ *   seen high (a device may hold it longer: clock synchronisation) the bit
+ *   is sampled, and SCL pulled low at H + P/2, which begins the next bit;
+ *   a byte is 8 bits and the acknowledge: 9P, TWINT at the 9th falling edge;
+ *   START on a free bus: SDA low at B + P/2, SCL low at B + P;
+ *   repeated START: SDA let go at B + P/4, SCL at B + P/2, SDA low at
+ *   H + P/4 (SCL high), SCL low at H + P/2;
+ *   STOP: SDA low at B + P/4, SCL let go at B + P/2, SDA let go at H + P/2.
+ *
+ * An operation begins when the firmware asks (TWINT cleared, TWSTA) and
+ * nothing but this master holds SCL: a slave's stretch after an
+ * acknowledge delays the whole operation (it then takes its full time
+ * from the release); a START waits for a free bus (SDA and SCL high).
+ */
+
+enum { M_LOW = 1, M_RISE, M_MID, M_FALL, M_GLITCH };
+
+static void twi_drive(sim_twi_t *t, int sda_low, int scl_low, avr_cycle_count_t cycle)
 {
-	trace_event(t->bus->trace, when, "twi arb-lost");
-	t->owner = 0;
-	twi_done(t, TW_MT_ARB_LOST);
+	twi_bus_drive(t->bus, &t->drv, sda_low, scl_low, cycle);
 }
 
-/* The master lost arbitration in its address byte: the address the devices
- * read (SEEN) goes to them all, this TWI among them now that it is no
- * longer the master; addressed (its TWAR, TWEA set) it is a slave from
- * here, 0x68 (written to) or 0xB0 (read from), else 0x38. (No general
- * call: 0x78 is not modelled.) */
-static void twi_arb_lost_addr(sim_twi_t *t, avr_cycle_count_t when, uint8_t seen)
+static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *param);
+
+/* The next STEP at CYCLE. */
+static void twi_at(sim_twi_t *t, avr_cycle_count_t cycle, uint8_t step)
 {
-	t->owner = 0;
-	t->op = TWI_OP_NONE;
-	twi_bus_address(t->bus, when, seen);
-	if (!t->addressed) {
-		twi_arb_lost(t, when);
+	avr_cycle_count_t now = t->avr->cycle;
+
+	t->step = step;
+	t->step_at = cycle;
+	avr_cycle_timer_register(t->avr, cycle > now ? cycle - now : 1, twi_timer, t);
+}
+
+static void twi_wait(sim_twi_t *t, twi_wait_t what, avr_cycle_count_t now)
+{
+	t->waiting = (uint8_t)what;
+	twi_bus_wait(t->bus, &t->master, &t->drv, what, now);
+}
+
+/* The operation begins on the lines at cycle B. */
+static void twi_go(sim_twi_t *t, avr_cycle_count_t b)
+{
+	t->half = sim_twi_scl_period(t) / 2;
+	t->bit_at = b;
+	t->bit = 0;
+	if (t->op == TWI_OP_START && !t->owner) {
+		/* SCL is high: SDA falls half a period on, SCL half a period later */
+		t->fall_at = b + 2 * t->half;
+		twi_at(t, b + t->half, M_MID);
 		return;
 	}
-	trace_event(t->bus->trace, when, "twi arb-lost %02X", t->sl_addr);
-	t->status = t->sl_status = t->addressed == TWI_SLAVE_TX ? TW_ST_ARB_LOST_SLA_ACK
-							       : TW_SR_ARB_LOST_SLA_ACK;
-	twi_sync(t);
-}
-
-/* A START or STOP in the middle of the byte under way, at t->glitch_at:
- * a bus error. The TWI stops and lets the lines go, TWINT rises with 0x00;
- * the firmware recovers with TWSTO (or TWEN off). */
-static void twi_glitch(sim_twi_t *t)
-{
-	int start = t->op_fault == TWI_FAULT_START;
-	avr_cycle_count_t at = t->glitch_at;
-
-	t->op_fault = TWI_FAULT_NONE;
-	twi_bus_glitch(t->bus, at, start);
-	trace_event(t->bus->trace, at, "twi bus-error");
-	t->owner = 0;
-	twi_done(t, TW_BUS_ERROR);
-}
-
-static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *param)
-{
-	sim_twi_t *t = param;
-	uint8_t *twcr = twi_reg(t, t->regs->twcr);
-	uint8_t *twdr = twi_reg(t, t->regs->twdr);
-	int ack, lost = 0;
-	unsigned bit = 0;
-	twi_fault_kind_t fault;
-	uint8_t sent;
-
-	(void)avr;
-	/* The bus events carry the exact completion cycle, not the cycle
-	 * simavr got round to calling us (1-4 later). */
-	when = t->op_end;
-	if (t->op_fault != TWI_FAULT_NONE) {
-		twi_glitch(t);
-		return 0;
+	if (t->op == TWI_OP_SLA || t->op == TWI_OP_TX) {
+		t->byte = *twi_reg(t, t->regs->twdr);
 	}
-	if (t->op != TWI_OP_NONE && !t->bus->scl_ext) {
-		/* SCL held low under the operation: its clock stops; it ends
-		 * one period after the release (the bit position is not kept). */
-		t->op_periods = 1;
-		if (!twi_bus_begin(t->bus, &t->master, TWI_BUS_DATA, when)) {
-			return 0;
+	if (t->op == TWI_OP_SLA || t->op == TWI_OP_TX || t->op == TWI_OP_RX) {
+		unsigned bit = 0;
+
+		t->lost = 0;
+		t->fault = (uint8_t)twi_fault_here(&t->bus->fault, &bit);
+		t->fault_bit = (uint8_t)bit;
+		twi_bus_byte(t->bus, b, b + 18 * t->half);
+	}
+	twi_at(t, b + t->half / 2, M_LOW);
+}
+
+/* The firmware asked for the operation at cycle NOW: begin when the bus
+ * lets it. */
+static void twi_begin(sim_twi_t *t, sim_twi_op_t op)
+{
+	twi_bus_t *bus = t->bus;
+	avr_cycle_count_t now = t->avr->cycle;
+
+	t->op = op;
+	if (op == TWI_OP_START && !t->owner) {
+		if (!bus->scl || !bus->sda) {
+			if (!bus->scl_ext || bus->sda) {
+				trace_event(bus->trace, now, "twi wait SCL");
+			} else {
+				trace_event(bus->trace, now, "twi wait SDA");
+			}
+			twi_wait(t, TWI_WAIT_BUS_FREE, now);
+			return;
 		}
+	} else if (twi_bus_scl_held(bus, &t->drv)) {
+		if (!bus->scl_ext) {
+			trace_event(bus->trace, now, "twi wait SCL");
+		}
+		twi_wait(t, TWI_WAIT_SCL_FREE, now);
+		return;
+	}
+	/* A slave that ran ahead inside the lock-step quantum may have let
+	 * SCL go after NOW: the operation begins at its release. */
+	if (t->owner && bus->scl_free_at > now) {
+		trace_event(bus->trace, bus->scl_free_at, "twi stretch %02X %" PRIu64,
+			    bus->scl_free_by, bus->scl_free_at - now);
+		now = bus->scl_free_at;
+	}
+	twi_go(t, now);
+}
+
+/* SCL was seen high from cycle H. */
+static void twi_high(sim_twi_t *t, avr_cycle_count_t h)
+{
+	int sda = t->bus->sda;
+
+	if ((t->fault == TWI_FAULT_START || t->fault == TWI_FAULT_STOP) &&
+	    t->bit == t->fault_bit) {
+		/* a glitch armed for this bit: in SCL's high half */
+		twi_at(t, h + t->half / 2, M_GLITCH);
+		return;
 	}
 	switch (t->op) {
 	case TWI_OP_START:
-		twi_bus_start(t->bus, when);
-		twi_done(t, t->owner ? TW_REP_START : TW_START);
-		t->owner = 1;
-		break;
+		t->fall_at = h + t->half;
+		twi_at(t, h + t->half / 2, M_MID);
+		return;
 	case TWI_OP_STOP:
 	case TWI_OP_STOP_START:
-		twi_bus_stop(t->bus, when);
-		t->owner = 0;
-		*twcr &= (uint8_t)~BIT(TWCR_TWSTO);
-		t->status = TW_NO_INFO;
-		if (t->op == TWI_OP_STOP_START) {
-			/* nothing holds SCL right after a STOP (twi_bus.h) */
-			t->op = TWI_OP_START;
-			t->op_end = when + sim_twi_scl_period(t);
-			return t->op_end;
-		}
-		t->op = TWI_OP_NONE;
-		twi_sync(t);	/* no TWINT after a STOP */
-		break;
-	case TWI_OP_SLA:
-		fault = twi_fault_here(&t->bus->fault, &bit);
-		sent = fault == TWI_FAULT_ARB ? twi_fault_arb_sent(*twdr, bit, &lost) : *twdr;
-		if (lost) {
-			twi_arb_lost_addr(t, when, sent);
-			break;
-		}
-		ack = twi_bus_address(t->bus, when, sent) || (fault == TWI_FAULT_ARB && bit == 8);
-		if (*twdr & 1) {
-			twi_done(t, ack ? TW_MR_SLA_ACK : TW_MR_SLA_NACK);
-		} else {
-			twi_done(t, ack ? TW_MT_SLA_ACK : TW_MT_SLA_NACK);
-		}
-		break;
-	case TWI_OP_TX:
-		fault = twi_fault_here(&t->bus->fault, &bit);
-		sent = fault == TWI_FAULT_ARB ? twi_fault_arb_sent(*twdr, bit, &lost) : *twdr;
-		ack = twi_bus_write(t->bus, when, sent) || (fault == TWI_FAULT_ARB && bit == 8);
-		if (lost) {
-			twi_arb_lost(t, when);
-		} else {
-			twi_done(t, ack ? TW_MT_DATA_ACK : TW_MT_DATA_NACK);
-		}
-		break;
+		twi_at(t, h + t->half, M_MID);
+		return;
 	case TWI_OP_RX:
-		/* the rival's low bit: a 0 read, or an ACK where the master
-		 * sends its NACK (it loses arbitration there) */
-		fault = twi_fault_here(&t->bus->fault, &bit);
-		lost = fault == TWI_FAULT_ARB && bit == 8 && !t->op_ack;
-		*twdr = twi_bus_read(t->bus, when, t->op_ack || lost);
-		if (fault == TWI_FAULT_ARB && bit < 8) {
-			*twdr = twi_fault_arb_read(*twdr, bit);
-		}
-		if (lost) {
-			twi_arb_lost(t, when);
-		} else {
-			twi_done(t, t->op_ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK);
+		if (t->bit < 8) {
+			t->byte = (uint8_t)(t->byte << 1 | sda);
+		} else if (!t->op_ack && !sda) {
+			t->lost = 1;	/* its NACK read low: arbitration lost */
 		}
 		break;
-	case TWI_OP_NONE:
+	default:
+		if (t->bit == 8) {
+			t->line_ack = (uint8_t)!sda;
+		} else {
+			t->line_byte = (uint8_t)(t->line_byte << 1 | sda);
+			if (!t->drv.sda_low && !sda) {
+				/* a bit sent high reads low: arbitration lost;
+				 * SDA let go for the rest of the byte, which it
+				 * clocks to its end */
+				t->lost = 1;
+			}
+		}
 		break;
 	}
-	return 0;
+	twi_at(t, h + t->half, M_FALL);
 }
 
-/* The operation in progress begins on the bus at cycle START. */
-static void twi_schedule(sim_twi_t *t, avr_cycle_count_t start)
+/* The rival (`i2c arb`, twi_fault.h) pulls SDA low for the bit that begins
+ * at WHEN (ON), or lets it go when it ends. */
+static void twi_rival(sim_twi_t *t, int on, avr_cycle_count_t when)
 {
-	avr_cycle_count_t now = t->avr->cycle, p = sim_twi_scl_period(t), at;
-	unsigned bit;
-
-	t->op_end = start + t->op_periods * p;
-	at = t->op_end;
-	/* a glitch armed for this byte: in SCL's high half of its bit */
-	t->op_fault = TWI_FAULT_NONE;
-	if (t->op_periods == 9) {
-		twi_fault_kind_t f = twi_fault_here(&t->bus->fault, &bit);
-
-		if (f == TWI_FAULT_START || f == TWI_FAULT_STOP) {
-			t->op_fault = f;
-			t->glitch_at = at = start + bit * p + 3 * p / 4;
-		}
+	if (t->fault == TWI_FAULT_ARB && t->bit == t->fault_bit) {
+		twi_bus_drive(t->bus, &t->bus->rival_drv, on, 0, when);
 	}
-	avr_cycle_timer_register(t->avr, at > now ? at - now : 1, twi_timer, t);
+}
+
+/* The master lost arbitration in the byte that ended at WHEN (SCL fell
+ * after its acknowledge): it is not the master any more. Addressed by the
+ * address the devices read (its TWAR, TWEA set: its own front acknowledged
+ * it, twi_dev_start) it is a slave from here, 0x68 (written to) or 0xB0
+ * (read from); else 0x38, holding SCL until TWINT is cleared. (0x78 needs
+ * the general call, not modelled.) */
+static void twi_arb_lost(sim_twi_t *t, avr_cycle_count_t when)
+{
+	t->owner = 0;
+	t->bus->clocked = 0;
+	if (t->addressed) {
+		trace_event(t->bus->trace, when, "twi arb-lost %02X", t->sl_addr);
+		twi_drive(t, 0, 0, when);	/* its slave side holds SCL */
+		t->op = TWI_OP_NONE;
+		t->status = t->sl_status = t->addressed == TWI_SLAVE_TX ? TW_ST_ARB_LOST_SLA_ACK
+								       : TW_SR_ARB_LOST_SLA_ACK;
+		twi_sync(t);
+		return;
+	}
+	trace_event(t->bus->trace, when, "twi arb-lost");
+	twi_drive(t, 0, 1, when);
+	twi_done(t, TW_MT_ARB_LOST);
+}
+
+/* A glitch in the bit under way, at WHEN: the condition to every device,
+ * and a bus error for this TWI, which lets the lines go (TWINT with 0x00;
+ * TWSTO or TWEN off recovers). */
+static void twi_glitch(sim_twi_t *t, avr_cycle_count_t when)
+{
+	twi_bus_glitch(t->bus, when, t->fault == TWI_FAULT_START);
+	trace_event(t->bus->trace, when, "twi bus-error");
+	t->owner = 0;
+	t->bus->clocked = 0;
+	twi_drive(t, 0, 0, when);
+	twi_done(t, TW_BUS_ERROR);
 }
 
 static void twi_master_resume(twi_bus_master_t *m, uint64_t cycle)
 {
 	sim_twi_t *t = (sim_twi_t *)((char *)m - offsetof(sim_twi_t, master));
+	twi_wait_t what = (twi_wait_t)t->waiting;
 
-	if (t->op != TWI_OP_NONE) {
-		twi_schedule(t, cycle);
+	t->waiting = TWI_WAIT_NONE;
+	if (t->op == TWI_OP_NONE) {
+		return;
+	}
+	if (what == TWI_WAIT_SCL_HIGH) {
+		twi_high(t, cycle);
+	} else {
+		twi_go(t, cycle);
 	}
 }
 
-/* Start OP, PERIODS SCL periods long, as soon as no slave holds SCL. */
-static void twi_begin(sim_twi_t *t, sim_twi_op_t op, avr_cycle_count_t periods)
+/* The byte and its acknowledge are done at cycle WHEN (SCL fell). */
+static void twi_byte_done(sim_twi_t *t, avr_cycle_count_t when)
 {
-	twi_bus_op_t kind = TWI_BUS_DATA;
-	uint64_t at;
+	uint8_t *twdr = twi_reg(t, t->regs->twdr);
 
-	switch (op) {
-	case TWI_OP_START:
-		kind = TWI_BUS_START;
-		break;
-	case TWI_OP_STOP:
-	case TWI_OP_STOP_START:
-		kind = TWI_BUS_STOP;
-		break;
+	switch (t->op) {
 	case TWI_OP_SLA:
-		kind = TWI_BUS_ADDR;
+		twi_bus_note_addr(t->bus, when, t->line_byte, t->line_ack);
+		if (t->lost) {
+			twi_arb_lost(t, when);
+		} else if (t->byte & 1) {
+			twi_done(t, t->line_ack ? TW_MR_SLA_ACK : TW_MR_SLA_NACK);
+		} else {
+			twi_done(t, t->line_ack ? TW_MT_SLA_ACK : TW_MT_SLA_NACK);
+		}
+		break;
+	case TWI_OP_TX:
+		twi_bus_note_write(t->bus, when, t->line_byte, t->line_ack);
+		if (t->lost) {
+			twi_arb_lost(t, when);
+		} else {
+			twi_done(t, t->line_ack ? TW_MT_DATA_ACK : TW_MT_DATA_NACK);
+		}
+		break;
+	default:
+		/* its acknowledge given, the master lets SDA go */
+		twi_drive(t, 0, 1, when);
+		*twdr = t->byte;
+		twi_bus_note_read(t->bus, when, t->byte, t->op_ack || t->lost);
+		if (t->lost) {
+			twi_arb_lost(t, when);
+		} else {
+			twi_done(t, t->op_ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK);
+		}
+		break;
+	}
+}
+
+/* The STOP is on the lines at cycle WHEN (SDA let go with SCL high). */
+static void twi_stop_done(sim_twi_t *t, avr_cycle_count_t when)
+{
+	twi_bus_note_stop(t->bus, when);
+	t->owner = 0;
+	*twi_reg(t, t->regs->twcr) &= (uint8_t)~BIT(TWCR_TWSTO);
+	t->status = TW_NO_INFO;
+	if (t->op == TWI_OP_STOP_START) {
+		t->op = TWI_OP_START;
+		twi_begin(t, TWI_OP_START);
+		return;
+	}
+	t->op = TWI_OP_NONE;
+	twi_sync(t);	/* no TWINT after a STOP */
+}
+
+static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *param)
+{
+	sim_twi_t *t = param;
+	int low;
+
+	(void)avr;
+	/* The lines get the exact cycle, not the one simavr called us at. */
+	when = t->step_at;
+	switch (t->step) {
+	case M_LOW:
+		switch (t->op) {
+		case TWI_OP_START:
+			low = 0;
+			break;
+		case TWI_OP_STOP:
+		case TWI_OP_STOP_START:
+			low = 1;
+			break;
+		case TWI_OP_RX:
+			low = t->bit == 8 && t->op_ack;
+			break;
+		default:
+			low = !t->lost && t->bit < 8 && !(t->byte & (0x80 >> t->bit));
+			break;
+		}
+		twi_drive(t, low, 1, when);
+		twi_rival(t, 1, when);
+		twi_at(t, t->bit_at + t->half, M_RISE);
+		break;
+	case M_RISE:
+		twi_drive(t, t->drv.sda_low, 0, when);
+		if (t->bus->scl) {
+			twi_high(t, when);
+		} else {
+			if (!t->bus->scl_ext) {
+				trace_event(t->bus->trace, when, "twi wait SCL");
+			}
+			twi_wait(t, TWI_WAIT_SCL_HIGH, when);
+		}
+		break;
+	case M_MID:
+		if (t->op == TWI_OP_START) {
+			twi_drive(t, 1, 0, when);
+			twi_at(t, t->fall_at, M_FALL);
+		} else {
+			twi_drive(t, 0, 0, when);
+			twi_stop_done(t, when);
+		}
+		break;
+	case M_FALL:
+		twi_drive(t, t->drv.sda_low, 1, when);
+		twi_rival(t, 0, when);
+		if (t->op == TWI_OP_START) {
+			twi_bus_note_start(t->bus, when);
+			twi_done(t, t->owner ? TW_REP_START : TW_START);
+			t->owner = 1;
+		} else if (++t->bit < 9) {
+			t->bit_at = when;
+			twi_at(t, when + t->half / 2, M_LOW);
+		} else {
+			twi_byte_done(t, when);
+		}
+		break;
+	case M_GLITCH:
+		twi_glitch(t, when);
 		break;
 	default:
 		break;
 	}
-	t->op = op;
-	t->op_periods = periods;
-	t->op_end = 0;
-	at = twi_bus_begin(t->bus, &t->master, kind, t->avr->cycle);
-	if (at) {
-		twi_schedule(t, at);
-	}
+	return 0;
 }
 
-/* --- slave mode ----------------------------------------------------------- */
+/* The master lets the lines go (TWI off, reset): SDA first, so no STOP. */
+static void twi_master_off(sim_twi_t *t)
+{
+	avr_cycle_timer_cancel(t->avr, twi_timer, t);
+	twi_bus_cancel(t->bus, &t->master);
+	t->waiting = TWI_WAIT_NONE;
+	twi_drive(t, 0, t->drv.scl_low, t->avr->cycle);
+	twi_drive(t, 0, 0, t->avr->cycle);
+	if (t->owner) {
+		t->bus->clocked = 0;
+	}
+	t->op = TWI_OP_NONE;
+	t->owner = 0;
+}
+
+/* --- slave mode -----------------------------------------------------------
+ *
+ * The TWI as a device behind the shared bit-level front (i2c_phy.c): it
+ * decides its acknowledges at the 8th falling edge of a byte, and at the
+ * end of the acknowledge bit raises TWINT and holds SCL until the firmware
+ * clears it. */
 
 static void twi_slave_rise(sim_twi_t *t)
 {
@@ -276,15 +441,12 @@ static avr_cycle_count_t twi_slave_timer(avr_t *avr, avr_cycle_count_t when, voi
 }
 
 /* A bus event for this slave completed at the bus's cycle: TWINT rises
- * then with STATUS (and DATA in TWDR), and SCL is held low until the
- * firmware clears TWINT. This board may be behind the master inside the
- * lock-step quantum: then the rise waits for its cycle. */
-static void twi_slave_deliver(sim_twi_t *t, uint8_t status, int has_data, uint8_t data,
-			      twi_hold_t hold)
+ * then with STATUS (and DATA in TWDR). This board may be behind the master
+ * inside the lock-step quantum: then the rise waits for its cycle. */
+static void twi_slave_deliver(sim_twi_t *t, uint8_t status, int has_data, uint8_t data)
 {
 	uint64_t at = t->bus->cycle;
 
-	twi_bus_hold(t->bus, &t->dev, hold);
 	t->sl_status = status;
 	t->sl_has_data = has_data;
 	t->sl_data = data;
@@ -306,7 +468,7 @@ static void twi_slave_release(sim_twi_t *t, uint8_t cr)
 	twi_bus_release(t->bus, &t->dev, t->avr->cycle, t->sl_addr);
 }
 
-/* TWI off or reset: forget the transfer, let SCL go. */
+/* TWI off or reset: forget the transfer, let the lines go. */
 static void twi_slave_abandon(sim_twi_t *t)
 {
 	if (t->sl_pending) {
@@ -315,6 +477,7 @@ static void twi_slave_abandon(sim_twi_t *t)
 	}
 	t->addressed = 0;
 	twi_bus_release(t->bus, &t->dev, t->avr->cycle, t->sl_addr);
+	twi_bus_forget(t->bus, &t->dev, t->avr->cycle);
 }
 
 static sim_twi_t *twi_of_dev(twi_dev_t *dev)
@@ -328,21 +491,18 @@ static int twi_dev_start(twi_dev_t *dev, uint8_t addr8)
 	uint8_t cr = *twi_reg(t, t->regs->twcr);
 	uint8_t twar = *twi_reg(t, t->regs->twar);
 
-	/* A master never answers its own address; a slave answers only while
-	 * enabled with TWEA and idle (the bus waits for a TWINT it holds). */
-	if (t->owner || t->op != TWI_OP_NONE || t->sl_pending || dev->hold ||
+	/* A master never answers its own address (but one that lost
+	 * arbitration in it may be the winner's slave); a slave answers only
+	 * while enabled with TWEA and idle (the bus waits for a TWINT it
+	 * holds). */
+	if (((t->owner || t->op != TWI_OP_NONE) && !t->lost) || t->sl_pending || dev->hold ||
 	    !(cr & BIT(TWCR_TWEN)) || !(cr & BIT(TWCR_TWEA)) || (cr & BIT(TWCR_TWINT)) ||
 	    (addr8 & 0xfe) != (twar & 0xfe)) {
 		return 0;
 	}
 	t->sl_addr = addr8 & 0xfe;
-	if (addr8 & 1) {
-		t->addressed = TWI_SLAVE_TX;
-		twi_slave_deliver(t, TW_ST_SLA_ACK, 0, 0, TWI_HOLD_ALL);
-	} else {
-		t->addressed = TWI_SLAVE_RX;
-		twi_slave_deliver(t, TW_SR_SLA_ACK, 0, 0, TWI_HOLD_ALL);
-	}
+	t->addressed = addr8 & 1 ? TWI_SLAVE_TX : TWI_SLAVE_RX;
+	t->sl_got_addr = 1;
 	return 1;
 }
 
@@ -353,26 +513,39 @@ static int twi_dev_write(twi_dev_t *dev, uint8_t byte)
 	if (t->addressed != TWI_SLAVE_RX) {
 		return 0;
 	}
-	if (t->sl_ea) {
-		twi_slave_deliver(t, TW_SR_DATA_ACK, 1, byte, TWI_HOLD_ALL);
-		return 1;
-	}
-	/* NACKed: not addressed any more until the next START */
-	t->addressed = 0;
-	twi_slave_deliver(t, TW_SR_DATA_NACK, 1, byte, TWI_HOLD_ALL);
-	return 0;
+	t->sl_rx = byte;
+	return t->sl_ea;
 }
 
-static uint8_t twi_dev_read(twi_dev_t *dev, int master_acks)
+static uint8_t twi_dev_read(twi_dev_t *dev)
 {
 	sim_twi_t *t = twi_of_dev(dev);
-	uint8_t byte = t->sl_tx;
+
+	return t->addressed == TWI_SLAVE_TX ? t->sl_tx : 0xff;	/* else the pull-ups */
+}
+
+static int twi_dev_ack_end(twi_dev_t *dev, int ack)
+{
+	sim_twi_t *t = twi_of_dev(dev);
 	uint8_t status;
 
-	if (t->addressed != TWI_SLAVE_TX) {
-		return 0xff;		/* SDA released: pull-ups */
+	if (t->sl_got_addr) {
+		t->sl_got_addr = 0;
+		twi_slave_deliver(t, t->addressed == TWI_SLAVE_TX ? TW_ST_SLA_ACK : TW_SR_SLA_ACK,
+				  0, 0);
+		return 1;
 	}
-	if (!master_acks) {
+	if (t->addressed == TWI_SLAVE_RX) {
+		if (!ack) {
+			t->addressed = 0;	/* NACKed: not addressed until the next START */
+		}
+		twi_slave_deliver(t, ack ? TW_SR_DATA_ACK : TW_SR_DATA_NACK, 1, t->sl_rx);
+		return 1;
+	}
+	if (t->addressed != TWI_SLAVE_TX) {
+		return 0;
+	}
+	if (!ack) {
 		status = TW_ST_DATA_NACK;
 	} else if (t->sl_ea) {
 		status = TW_ST_DATA_ACK;
@@ -382,8 +555,8 @@ static uint8_t twi_dev_read(twi_dev_t *dev, int master_acks)
 	if (status != TW_ST_DATA_ACK) {
 		t->addressed = 0;
 	}
-	twi_slave_deliver(t, status, 0, 0, TWI_HOLD_ALL);
-	return byte;
+	twi_slave_deliver(t, status, 0, 0);
+	return 1;
 }
 
 /* STOP, or a repeated START, ends a transfer this slave takes part in. */
@@ -391,25 +564,31 @@ static void twi_dev_end(twi_dev_t *dev)
 {
 	sim_twi_t *t = twi_of_dev(dev);
 
+	t->sl_got_addr = 0;
 	if (t->addressed == TWI_SLAVE_RX) {
 		t->addressed = 0;
-		twi_slave_deliver(t, TW_SR_STOP, 0, 0, TWI_HOLD_ADDR);
+		twi_slave_deliver(t, TW_SR_STOP, 0, 0);
+		twi_bus_hold(t->bus, dev, TWI_HOLD_ADDR);
 	} else {
 		/* the datasheet gives a transmitter no code for it */
 		t->addressed = 0;
 	}
 }
 
-/* A START or STOP in the middle of a byte of this slave's transfer: TWINT
- * with 0x00, the lines let go, not addressed; the firmware recovers with
- * TWSTO (twi_action). */
+/* A START or STOP in the middle of a byte this slave takes part in: TWINT
+ * with 0x00; the firmware recovers with TWSTO (twi_action). SCL is not
+ * held. */
 static void twi_dev_bus_error(twi_dev_t *dev)
 {
 	sim_twi_t *t = twi_of_dev(dev);
 
+	if (!t->addressed) {
+		return;
+	}
 	trace_event(t->bus->trace, t->bus->cycle, "twi bus-error %02X", t->sl_addr);
 	t->addressed = 0;
-	twi_slave_deliver(t, TW_BUS_ERROR, 0, 0, TWI_HOLD_NONE);
+	t->sl_got_addr = 0;
+	twi_slave_deliver(t, TW_BUS_ERROR, 0, 0);
 }
 
 static const twi_dev_ops_t twi_dev_ops = {
@@ -418,6 +597,7 @@ static const twi_dev_ops_t twi_dev_ops = {
 	.read = twi_dev_read,
 	.stop = twi_dev_end,
 	.bus_start = twi_dev_end,
+	.ack_end = twi_dev_ack_end,
 	.bus_error = twi_dev_bus_error,
 };
 
@@ -435,7 +615,7 @@ static void twi_pins_update(sim_twi_t *t)
 		scl_low = !!(low & BIT(t->pin_scl));
 		sda_low = !!(low & BIT(t->pin_sda));
 	}
-	twi_bus_pins(t->bus, &t->pins, sda_low, scl_low, t->avr->cycle);
+	twi_bus_drive(t->bus, &t->pins, sda_low, scl_low, t->avr->cycle);
 }
 
 static void twi_on_port(struct avr_irq_t *irq, uint32_t value, void *param)
@@ -478,9 +658,14 @@ static void twi_action(sim_twi_t *t, uint8_t cr)
 	int sta = !!(cr & BIT(TWCR_TWSTA));
 	int sto = !!(cr & BIT(TWCR_TWSTO));
 
+	if (t->status == TW_MT_ARB_LOST) {
+		/* the bus released, not addressed slave mode (or a START
+		 * once the bus is free) */
+		twi_drive(t, 0, 0, t->avr->cycle);
+	}
 	if (sto) {
 		if (t->owner) {
-			twi_begin(t, sta ? TWI_OP_STOP_START : TWI_OP_STOP, 1);
+			twi_begin(t, sta ? TWI_OP_STOP_START : TWI_OP_STOP);
 			return;
 		}
 		/* Not the master: TWSTO only recovers from a bus error. */
@@ -488,24 +673,24 @@ static void twi_action(sim_twi_t *t, uint8_t cr)
 		t->status = TW_NO_INFO;
 	}
 	if (sta) {
-		twi_begin(t, TWI_OP_START, 1);
+		twi_begin(t, TWI_OP_START);
 		return;
 	}
 	switch (t->status) {
 	case TW_START:
 	case TW_REP_START:
-		twi_begin(t, TWI_OP_SLA, 9);
+		twi_begin(t, TWI_OP_SLA);
 		break;
 	case TW_MT_SLA_ACK:
 	case TW_MT_SLA_NACK:
 	case TW_MT_DATA_ACK:
 	case TW_MT_DATA_NACK:
-		twi_begin(t, TWI_OP_TX, 9);
+		twi_begin(t, TWI_OP_TX);
 		break;
 	case TW_MR_SLA_ACK:
 	case TW_MR_DATA_ACK:
 		t->op_ack = !!(cr & BIT(TWCR_TWEA));
-		twi_begin(t, TWI_OP_RX, 9);
+		twi_begin(t, TWI_OP_RX);
 		break;
 	default:
 		/* After 48/58 only START/STOP are defined; when idle, the TWI
@@ -541,11 +726,8 @@ static void twi_write_twcr(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *para
 		} else if (t->addressed) {
 			trace_event(t->bus->trace, avr->cycle, "twi off %02X", t->sl_addr);
 		}
-		avr_cycle_timer_cancel(avr, twi_timer, t);
-		twi_bus_cancel(t->bus, &t->master);
+		twi_master_off(t);
 		twi_slave_abandon(t);
-		t->op = TWI_OP_NONE;
-		t->owner = 0;
 		t->status = TW_NO_INFO;
 		avr->data[addr] &= (uint8_t)~(BIT(TWCR_TWSTA) | BIT(TWCR_TWSTO));
 	} else if (t->op == TWI_OP_NONE &&
@@ -599,10 +781,8 @@ static void twi_reset(avr_io_t *io)
 
 	/* simavr wiped the cycle timers already */
 	t->sl_pending = 0;
-	twi_bus_cancel(t->bus, &t->master);
+	twi_master_off(t);
 	twi_slave_abandon(t);
-	t->op = TWI_OP_NONE;
-	t->owner = 0;
 	t->status = TW_NO_INFO;
 	avr->data[t->regs->twbr] = 0;
 	avr->data[t->regs->twsr] = TW_NO_INFO;
@@ -627,7 +807,8 @@ void sim_twi_init(sim_twi_t *t, avr_t *avr, const sim_mcu_twi_t *regs, twi_bus_t
 	t->dev.ops = &twi_dev_ops;
 	t->dev.name = "avr-twi";
 	twi_bus_attach(bus, &t->dev);
-	twi_bus_attach_pins(bus, &t->pins);
+	twi_bus_attach_drv(bus, &t->drv, 0);
+	twi_bus_attach_drv(bus, &t->pins, 1);
 
 	t->vect_twi = (avr_int_vector_t) {
 		.vector = regs->vect_twi,

@@ -56,19 +56,31 @@ typedef struct sim_twi_t {
 
 	uint8_t status;			/* TWSR bits 7..3 */
 	int owner;			/* this master holds the bus */
-	sim_twi_op_t op;			/* operation in progress (TWINT low) */
+	sim_twi_op_t op;		/* operation in progress (TWINT low) */
 	int op_ack;			/* RX: TWEA when the byte started */
-	avr_cycle_count_t op_periods;	/* its length in SCL periods */
-	avr_cycle_count_t op_end;	/* the cycle it completes (0: waits for SCL) */
-	twi_fault_kind_t op_fault;	/* a glitch in its byte (twi_fault.h) ... */
-	avr_cycle_count_t glitch_at;	/* ... at this cycle */
-	twi_bus_master_t master;	/* the bus resumes a waiting operation here */
+	twi_bus_master_t master;	/* the bus resumes a waiting master here */
+	twi_drv_t drv;			/* the master's pull on the lines */
+	/* the operation's bits (sim_twi.c, "master mode") */
+	avr_cycle_count_t half;		/* half an SCL period, cycles */
+	avr_cycle_count_t step_at;	/* the exact cycle of the next step */
+	avr_cycle_count_t bit_at;	/* the cycle the bit's SCL low began */
+	avr_cycle_count_t fall_at;	/* START: the cycle SCL falls */
+	uint8_t step;			/* what the timer does next */
+	uint8_t waiting;		/* twi_wait_t the master waits for */
+	uint8_t bit;			/* 0..8 in a byte (8: the acknowledge) */
+	uint8_t byte;			/* the byte going out or coming in */
+	uint8_t line_ack;		/* SLA/TX: the acknowledge on SDA */
+	uint8_t line_byte;		/* SLA/TX: the byte as SDA carried it */
+	uint8_t lost;			/* it lost arbitration in this byte */
+	uint8_t fault, fault_bit;	/* twi_fault_kind_t armed for this byte, its bit */
 
 	/* slave mode */
 	twi_dev_t dev;			/* this TWI as a device on the bus */
 	int addressed;			/* 0, or TWI_SLAVE_RX / TWI_SLAVE_TX */
+	int sl_got_addr;		/* the address acknowledged, no byte yet */
 	int sl_ea;			/* TWEA when TWINT was last cleared */
 	uint8_t sl_tx;			/* TWDR when TWINT was last cleared (ST) */
+	uint8_t sl_rx;			/* the byte received (SR) */
 	int sl_pending;			/* a TWINT rise is scheduled */
 	uint8_t sl_status;		/* ... with this status */
 	int sl_has_data;		/* ... and this received byte */
@@ -77,7 +89,7 @@ typedef struct sim_twi_t {
 	uint8_t sl_addr;		/* TWAR address it answered (trace) */
 
 	/* SCL/SDA as port pins while TWEN is off (sim_twi_wire_pins) */
-	twi_pins_t pins;
+	twi_drv_t pins;
 	int pins_wired;
 	uint8_t pin_scl, pin_sda;	/* bit numbers */
 	uint8_t pin_ddr, pin_port;	/* shadows of the port's DDR/PORT */

@@ -1,30 +1,21 @@
 /*
- * twi_bus.c: the bus object; it also writes the bus's trace lines, so a bus
- * shared by several simulated boards is traced once.
+ * twi_bus.c: the lines, their drivers and listeners (twi_bus.h); it also
+ * writes the bus's trace lines, so a bus shared by several simulated boards
+ * is traced once.
  */
 #include <inttypes.h>
 #include <stddef.h>
 
+#include "periph/i2c_phy.h"
 #include "periph/twi_bus.h"
 
 void twi_bus_init(twi_bus_t *bus, trace_t *trace)
 {
-	bus->devs = NULL;
-	bus->selected = NULL;
-	bus->busy = 0;
-	bus->trace = trace;
-	bus->activity = 0;
-	bus->cycle = 0;
-	bus->waiter = NULL;
-	bus->released_all = 0;
-	bus->released_addr = 0;
-	bus->sda = bus->scl = bus->scl_ext = 1;
-	bus->stuck = 0;
-	bus->hold_scl = 0;
-	bus->pins = NULL;
-	bus->nlisteners = 0;
-	bus->busy_signal = NULL;
-	twi_fault_arm(&bus->fault, TWI_FAULT_NONE, 0, 0);
+	*bus = (twi_bus_t) {
+		.trace = trace,
+		.sda = 1, .scl = 1, .sda_ext = 1, .scl_ext = 1,
+		.stuck_drv = { .ext = 1 }, .hold_drv = { .ext = 1 }, .rival_drv = { .ext = 1 },
+	};
 }
 
 void twi_bus_attach(twi_bus_t *bus, twi_dev_t *dev)
@@ -36,78 +27,202 @@ void twi_bus_attach(twi_bus_t *bus, twi_dev_t *dev)
 	}
 	dev->next = NULL;
 	dev->hold = TWI_HOLD_NONE;
+	dev->drv = (twi_drv_t) { 0 };
+	dev->phy = TWI_PHY_IDLE;
 	*link = dev;
 }
 
-void twi_bus_start(twi_bus_t *bus, uint64_t cycle)
+void twi_bus_attach_drv(twi_bus_t *bus, twi_drv_t *d, int ext)
+{
+	(void)bus;
+	*d = (twi_drv_t) { .ext = (uint8_t)!!ext };
+}
+
+/* --- telling the edges ------------------------------------------------------ */
+
+static void twi_bus_resume(twi_bus_t *bus, uint64_t cycle)
+{
+	twi_bus_master_t *m = bus->waiter;
+	uint64_t at = cycle > bus->waiter_since ? cycle : bus->waiter_since;
+
+	bus->waiter = NULL;
+	bus->waiting = TWI_WAIT_NONE;
+	m->resume(m, at);
+}
+
+/* Has what the waiting master waits for come? */
+static int twi_bus_wait_over(const twi_bus_t *bus)
+{
+	switch (bus->waiting) {
+	case TWI_WAIT_SCL_HIGH:
+		return bus->scl;
+	case TWI_WAIT_SCL_FREE:
+		return !twi_bus_scl_held(bus, bus->waiter_drv);
+	case TWI_WAIT_BUS_FREE:
+		return bus->scl && bus->sda;
+	default:
+		return 0;
+	}
+}
+
+/* One line changed level at CYCLE: tell everyone. */
+static void twi_bus_edge(twi_bus_t *bus, int scl_line, uint64_t cycle)
 {
 	bus->cycle = cycle;
-	bus->busy = 1;
-	bus->selected = NULL;
+	bus->activity++;
+	if (scl_line) {
+		if (bus->scl_signal) {
+			signal_set(bus->scl_signal, cycle, bus->scl);
+		}
+		if (!bus->scl && bus->stuck && --bus->stuck == 0) {
+			trace_event(bus->trace, cycle, "twi stuck 0");
+			twi_bus_drive(bus, &bus->stuck_drv, 0, 0, cycle);
+		}
+	} else if (bus->sda_signal) {
+		signal_set(bus->sda_signal, cycle, bus->sda);
+	}
+	for (int i = 0; i < bus->nlisteners; i++) {
+		bus->listener[i](bus->listener_param[i], cycle);
+	}
+	if (!scl_line && bus->scl) {
+		/* SDA changed with SCL high: START (falling) or STOP (rising) */
+		for (twi_dev_t *d = bus->devs; d; d = d->next) {
+			i2c_phy_condition(bus, d, !bus->sda);
+		}
+	} else if (bus->nactive) {
+		for (twi_dev_t *d = bus->devs; d; d = d->next) {
+			if (d->phy != TWI_PHY_IDLE || d->hold == TWI_HOLD_ADDR) {
+				i2c_phy_edge(bus, d, scl_line);
+			}
+		}
+	}
+	if (bus->waiter && twi_bus_wait_over(bus)) {
+		twi_bus_resume(bus, cycle);
+	}
+}
+
+/* The drivers changed at CYCLE: trace the ext lines, tell the edges. A
+ * change made while telling is told by the loop of the outer call. */
+static void twi_bus_lines(twi_bus_t *bus, uint64_t cycle)
+{
+	int scl_ext = !bus->ext_scl_lows, sda_ext = !bus->ext_sda_lows;
+
+	if (scl_ext != bus->scl_ext) {
+		bus->scl_ext = scl_ext;
+		trace_event(bus->trace, cycle, "twi line SCL %d", scl_ext);
+	}
+	if (sda_ext != bus->sda_ext) {
+		bus->sda_ext = sda_ext;
+		trace_event(bus->trace, cycle, "twi line SDA %d", sda_ext);
+	}
+	if (bus->telling) {
+		if (cycle > bus->cycle) {
+			bus->cycle = cycle;
+		}
+		return;
+	}
+	bus->telling = 1;
+	for (;;) {
+		int scl = !bus->scl_lows, sda = !bus->sda_lows;
+
+		if (scl != bus->scl) {
+			bus->scl = scl;
+			twi_bus_edge(bus, 1, cycle > bus->cycle ? cycle : bus->cycle);
+		} else if (sda != bus->sda) {
+			bus->sda = sda;
+			twi_bus_edge(bus, 0, cycle > bus->cycle ? cycle : bus->cycle);
+		} else {
+			break;
+		}
+	}
+	bus->telling = 0;
+	if (bus->waiter && twi_bus_wait_over(bus)) {
+		twi_bus_resume(bus, cycle > bus->cycle ? cycle : bus->cycle);
+	}
+}
+
+void twi_bus_drive(twi_bus_t *bus, twi_drv_t *d, int sda_low, int scl_low, uint64_t cycle)
+{
+	int ds = !!sda_low - d->sda_low, dc = !!scl_low - d->scl_low;
+
+	if (!ds && !dc) {
+		return;
+	}
+	d->sda_low = (uint8_t)!!sda_low;
+	d->scl_low = (uint8_t)!!scl_low;
+	bus->sda_lows += ds;
+	bus->scl_lows += dc;
+	if (d->ext) {
+		bus->ext_sda_lows += ds;
+		bus->ext_scl_lows += dc;
+	}
+	twi_bus_lines(bus, cycle);
+}
+
+/* --- the master ---------------------------------------------------------------- */
+
+void twi_bus_wait(twi_bus_t *bus, twi_bus_master_t *m, twi_drv_t *d, twi_wait_t what,
+		  uint64_t now)
+{
+	bus->waiter = m;
+	bus->waiter_drv = d;
+	bus->waiting = what;
+	bus->waiter_since = now;
+}
+
+void twi_bus_cancel(twi_bus_t *bus, twi_bus_master_t *m)
+{
+	if (bus->waiter == m) {
+		bus->waiter = NULL;
+		bus->waiting = TWI_WAIT_NONE;
+	}
+}
+
+void twi_bus_byte(twi_bus_t *bus, uint64_t begin, uint64_t end)
+{
+	bus->byte_end = end;
+	for (twi_dev_t *d = bus->devs; d; d = d->next) {
+		if (d->load) {
+			i2c_phy_load(bus, d, begin);
+		}
+	}
+}
+
+void twi_bus_note_start(twi_bus_t *bus, uint64_t cycle)
+{
+	bus->clocked = 1;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi start");
 	twi_fault_on_start(&bus->fault);
 	if (bus->busy_signal) {
 		signal_set(bus->busy_signal, cycle, 1);
 	}
-	for (twi_dev_t *d = bus->devs; d; d = d->next) {
-		if (d->ops->bus_start) {
-			d->ops->bus_start(d);
-		}
-	}
 }
 
-int twi_bus_address(twi_bus_t *bus, uint64_t cycle, uint8_t addr8)
+void twi_bus_note_addr(twi_bus_t *bus, uint64_t cycle, uint8_t addr8, int ack)
 {
-	bus->cycle = cycle;
-	bus->selected = NULL;
-	for (twi_dev_t *d = bus->devs; d; d = d->next) {
-		if (d->ops->start(d, addr8) && !bus->selected) {
-			bus->selected = d;
-		}
-	}
 	bus->activity++;
-	trace_event(bus->trace, cycle, "twi addr %02X %s", addr8,
-		    bus->selected ? "ack" : "nack");
+	trace_event(bus->trace, cycle, "twi addr %02X %s", addr8, ack ? "ack" : "nack");
 	twi_fault_byte_done(&bus->fault);
-	return bus->selected != NULL;
 }
 
-int twi_bus_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte)
+void twi_bus_note_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte, int ack)
 {
-	int ack;
-
-	bus->cycle = cycle;
-	ack = bus->selected ? bus->selected->ops->write(bus->selected, byte) : 0;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi write %02X %s", byte, ack ? "ack" : "nack");
 	twi_fault_byte_done(&bus->fault);
-	return ack;
 }
 
-uint8_t twi_bus_read(twi_bus_t *bus, uint64_t cycle, int master_acks)
+void twi_bus_note_read(twi_bus_t *bus, uint64_t cycle, uint8_t byte, int master_acks)
 {
-	uint8_t byte = 0xff;
-
-	bus->cycle = cycle;
-	if (bus->selected) {
-		byte = bus->selected->ops->read(bus->selected, master_acks);
-	}
 	bus->activity++;
-	trace_event(bus->trace, cycle, "twi read %02X %s", byte,
-		    master_acks ? "ack" : "nack");
+	trace_event(bus->trace, cycle, "twi read %02X %s", byte, master_acks ? "ack" : "nack");
 	twi_fault_byte_done(&bus->fault);
-	return byte;
 }
 
-void twi_bus_stop(twi_bus_t *bus, uint64_t cycle)
+void twi_bus_note_stop(twi_bus_t *bus, uint64_t cycle)
 {
-	bus->cycle = cycle;
-	for (twi_dev_t *d = bus->devs; d; d = d->next) {
-		d->ops->stop(d);
-	}
-	bus->selected = NULL;
-	bus->busy = 0;
+	bus->clocked = 0;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi stop");
 	if (bus->busy_signal) {
@@ -117,165 +232,65 @@ void twi_bus_stop(twi_bus_t *bus, uint64_t cycle)
 
 void twi_bus_glitch(twi_bus_t *bus, uint64_t cycle, int start)
 {
-	twi_dev_t *sel = bus->selected;
-
 	bus->cycle = cycle;
-	bus->selected = NULL;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi glitch %s", start ? "start" : "stop");
 	twi_fault_byte_done(&bus->fault);
+	/* every device hears the condition first; what their fronts let go
+	 * of then is told after */
+	bus->telling = 1;
 	for (twi_dev_t *d = bus->devs; d; d = d->next) {
-		if (d == sel && d->ops->bus_error) {
-			d->ops->bus_error(d);
-		} else if (!start) {
-			d->ops->stop(d);
-		} else if (d->ops->bus_start) {
-			d->ops->bus_start(d);
-		}
+		i2c_phy_condition(bus, d, start);
 	}
-	bus->busy = start;
-	if (bus->busy_signal) {
-		signal_set(bus->busy_signal, cycle, start);
-	}
+	bus->telling = 0;
+	twi_bus_lines(bus, cycle);
 }
 
-/* Does a hold HOW stop an operation OP? */
-static int twi_bus_blocks(twi_hold_t how, twi_bus_op_t op)
-{
-	return how == TWI_HOLD_ALL || (how == TWI_HOLD_ADDR && op == TWI_BUS_ADDR);
-}
-
-/* SCL as the devices and pins make it, a TWI's clock stretching aside. */
-static int twi_bus_scl_ext(const twi_bus_t *bus)
-{
-	if (bus->hold_scl) {
-		return 0;
-	}
-	for (const twi_pins_t *p = bus->pins; p; p = p->next) {
-		if (p->scl_low) {
-			return 0;
-		}
-	}
-	return 1;
-}
-
-/* Which line stops a master's OP: 'C' (SCL low: nothing moves), 'D' (SDA
- * low: no START), or 0. */
-static int twi_bus_line_blocks(const twi_bus_t *bus, twi_bus_op_t op)
-{
-	if (!twi_bus_scl_ext(bus)) {
-		return 'C';
-	}
-	if (op == TWI_BUS_START && !bus->sda) {
-		return 'D';
-	}
-	return 0;
-}
-
-static int twi_bus_blocked(const twi_bus_t *bus, twi_bus_op_t op)
-{
-	if (twi_bus_line_blocks(bus, op)) {
-		return 1;
-	}
-	for (const twi_dev_t *d = bus->devs; d; d = d->next) {
-		if (twi_bus_blocks(d->hold, op)) {
-			return 1;
-		}
-	}
-	return 0;
-}
-
-uint64_t twi_bus_begin(twi_bus_t *bus, twi_bus_master_t *m, twi_bus_op_t op, uint64_t now)
-{
-	uint64_t free_at = bus->released_all;
-	uint8_t by = bus->released_all_by;
-
-	if (op == TWI_BUS_ADDR && bus->released_addr > free_at) {
-		free_at = bus->released_addr;
-		by = bus->released_addr_by;
-	}
-	if (twi_bus_blocked(bus, op)) {
-		int line = twi_bus_line_blocks(bus, op);
-
-		if (line) {
-			trace_event(bus->trace, now, "twi wait %s", line == 'C' ? "SCL" : "SDA");
-		}
-		bus->waiter = m;
-		bus->waiter_op = op;
-		bus->waiter_since = now;
-		return 0;
-	}
-	/* A slave that ran ahead inside the lock-step quantum may have
-	 * released after NOW: the operation begins at the release. */
-	if (free_at > now) {
-		trace_event(bus->trace, free_at, "twi stretch %02X %" PRIu64, by, free_at - now);
-		return free_at;
-	}
-	return now;
-}
-
-void twi_bus_cancel(twi_bus_t *bus, twi_bus_master_t *m)
-{
-	if (bus->waiter == m) {
-		bus->waiter = NULL;
-	}
-}
+/* --- devices' holds ------------------------------------------------------------ */
 
 void twi_bus_hold(twi_bus_t *bus, twi_dev_t *dev, twi_hold_t how)
 {
 	dev->hold = how;
-	twi_bus_lines(bus, bus->cycle);
+	if (how == TWI_HOLD_ALL) {
+		twi_bus_drive(bus, &dev->drv, dev->drv.sda_low, 1, bus->cycle);
+	}
 }
 
 void twi_bus_release(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle, uint8_t addr8)
 {
-	twi_hold_t how = dev->hold;
+	int held = dev->drv.scl_low;
 
-	if (how == TWI_HOLD_NONE) {
+	if (dev->hold == TWI_HOLD_NONE) {
 		return;
 	}
 	dev->hold = TWI_HOLD_NONE;
-	if (how == TWI_HOLD_ALL && cycle >= bus->released_all) {
-		bus->released_all = cycle;
-		bus->released_all_by = addr8;
-	} else if (how == TWI_HOLD_ADDR && cycle >= bus->released_addr) {
-		bus->released_addr = cycle;
-		bus->released_addr_by = addr8;
+	if (!held) {
+		return;		/* a TWI_HOLD_ADDR whose falling edge never came */
 	}
-	if (bus->waiter && twi_bus_blocks(how, bus->waiter_op)) {
-		if (cycle > bus->waiter_since) {
-			trace_event(bus->trace, cycle, "twi stretch %02X %" PRIu64, addr8,
-				    cycle - bus->waiter_since);
-		}
-		if (!twi_bus_blocked(bus, bus->waiter_op)) {
-			twi_bus_master_t *m = bus->waiter;
-			uint64_t at = cycle > bus->waiter_since ? cycle : bus->waiter_since;
-
-			bus->waiter = NULL;
-			m->resume(m, at);
-		}
+	if (cycle >= bus->scl_free_at) {
+		bus->scl_free_at = cycle;
+		bus->scl_free_by = addr8;
 	}
-	twi_bus_lines(bus, cycle);
+	if (bus->waiter && bus->waiting == TWI_WAIT_SCL_FREE && cycle > bus->waiter_since) {
+		trace_event(bus->trace, cycle, "twi stretch %02X %" PRIu64, addr8,
+			    cycle - bus->waiter_since);
+	}
+	i2c_phy_released(bus, dev, cycle);
 }
 
-/* --- the lines ------------------------------------------------------------- */
-
-void twi_bus_attach_pins(twi_bus_t *bus, twi_pins_t *pins)
+void twi_bus_forget(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle)
 {
-	pins->sda_low = pins->scl_low = 0;
-	pins->next = bus->pins;
-	bus->pins = pins;
+	if (dev->phy != TWI_PHY_IDLE) {
+		bus->nactive--;
+	}
+	dev->phy = TWI_PHY_IDLE;
+	dev->hold = TWI_HOLD_NONE;
+	dev->waiting = 0;
+	dev->load = 0;
+	twi_bus_drive(bus, &dev->drv, 0, 0, cycle);
 }
 
-void twi_bus_pins(twi_bus_t *bus, twi_pins_t *pins, int sda_low, int scl_low, uint64_t cycle)
-{
-	if (pins->sda_low == !!sda_low && pins->scl_low == !!scl_low) {
-		return;
-	}
-	pins->sda_low = !!sda_low;
-	pins->scl_low = !!scl_low;
-	twi_bus_lines(bus, cycle);
-}
+/* --- listeners, fault devices -------------------------------------------------- */
 
 int twi_bus_listen(twi_bus_t *bus, twi_line_fn fn, void *param)
 {
@@ -292,7 +307,7 @@ void twi_bus_stuck(twi_bus_t *bus, uint32_t pulses, uint64_t cycle)
 	bus->stuck = pulses;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi stuck %" PRIu32, pulses);
-	twi_bus_lines(bus, cycle);
+	twi_bus_drive(bus, &bus->stuck_drv, pulses != 0, 0, cycle);
 }
 
 void twi_bus_hold_scl(twi_bus_t *bus, int on, uint64_t cycle)
@@ -300,53 +315,5 @@ void twi_bus_hold_scl(twi_bus_t *bus, int on, uint64_t cycle)
 	bus->hold_scl = !!on;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi hold-scl %s", on ? "on" : "off");
-	twi_bus_lines(bus, cycle);
-}
-
-void twi_bus_lines(twi_bus_t *bus, uint64_t cycle)
-{
-	int scl_ext = twi_bus_scl_ext(bus), scl = scl_ext, sda = 1, changed = 0;
-
-	for (const twi_dev_t *d = bus->devs; d; d = d->next) {
-		if (d->hold == TWI_HOLD_ALL) {
-			scl = 0;	/* clock stretching: not traced as a line */
-		}
-	}
-	if (scl_ext != bus->scl_ext) {
-		bus->scl_ext = scl_ext;
-		changed = 1;
-		trace_event(bus->trace, cycle, "twi line SCL %d", scl_ext);
-	}
-	if (scl != bus->scl) {
-		bus->scl = scl;
-		changed = 1;
-		if (!scl && bus->stuck && --bus->stuck == 0) {
-			trace_event(bus->trace, cycle, "twi stuck 0");
-		}
-	}
-	sda = !bus->stuck;
-	for (const twi_pins_t *p = bus->pins; p; p = p->next) {
-		if (p->sda_low) {
-			sda = 0;
-		}
-	}
-	if (sda != bus->sda) {
-		bus->sda = sda;
-		changed = 1;
-		trace_event(bus->trace, cycle, "twi line SDA %d", sda);
-	}
-	if (!changed) {
-		return;
-	}
-	bus->activity++;
-	for (int i = 0; i < bus->nlisteners; i++) {
-		bus->listener[i](bus->listener_param[i], cycle);
-	}
-	if (bus->waiter && !twi_bus_blocked(bus, bus->waiter_op)) {
-		twi_bus_master_t *m = bus->waiter;
-		uint64_t at = cycle > bus->waiter_since ? cycle : bus->waiter_since;
-
-		bus->waiter = NULL;
-		m->resume(m, at);
-	}
+	twi_bus_drive(bus, &bus->hold_drv, 0, on, cycle);
 }

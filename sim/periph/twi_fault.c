@@ -50,28 +50,6 @@ void twi_fault_byte_done(twi_fault_t *f)
 	f->seen++;
 }
 
-uint8_t twi_fault_arb_sent(uint8_t sent, unsigned bit, int *lost)
-{
-	uint8_t mask;
-
-	*lost = 0;
-	if (bit >= TWI_FAULT_ACK_BIT) {
-		return sent;
-	}
-	mask = (uint8_t)(0x80u >> bit);
-	if (!(sent & mask)) {
-		return sent;	/* the master pulls low too: nothing to see */
-	}
-	*lost = 1;
-	/* the bits before it as sent, it low, released (1) after it */
-	return (uint8_t)((sent | (mask - 1u)) & ~mask);
-}
-
-uint8_t twi_fault_arb_read(uint8_t byte, unsigned bit)
-{
-	return (uint8_t)(byte & ~(0x80u >> bit));
-}
-
 const char *twi_fault_describe(const twi_fault_t *f, char *buf, unsigned len)
 {
 	switch (f->kind) {

@@ -58,15 +58,6 @@ twi_fault_kind_t twi_fault_here(const twi_fault_t *f, unsigned *bit);
  * spent. */
 void twi_fault_byte_done(twi_fault_t *f);
 
-/* The rival at BIT of a byte the master transmits (SENT): the byte the
- * devices read; *LOST is 1 when the master lost arbitration (it sent a 1
- * there; it sends 1s, i.e. nothing, for the rest). For BIT 8 nothing is
- * lost and the byte is SENT. */
-uint8_t twi_fault_arb_sent(uint8_t sent, unsigned bit, int *lost);
-
-/* The rival at BIT 0..7 of a byte a device sends: the byte the master reads. */
-uint8_t twi_fault_arb_read(uint8_t byte, unsigned bit);
-
 /* "arb 2 3", "glitch start 1 8" or "none", for the control socket. */
 const char *twi_fault_describe(const twi_fault_t *f, char *buf, unsigned len);
 

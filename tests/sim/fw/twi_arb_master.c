@@ -8,7 +8,7 @@
  * address of TARGETS, TWEA kept set, and puts in PORTA the status the TWI
  * gives after it (0x18/0x20/0x40/0x48, or 0x38, 0x68, 0xB0 when it lost
  * arbitration there). As master it then sends a STOP; addressed as a slave
- * it answers one byte (0x5A for a read, a write's byte refused) and so
+ * it answers one byte (0xFF for a read, a write's byte refused) and so
  * leaves the frame; after 0x38 it lets the bus go. Between triggers it
  * clears any TWINT it gets as a slave. PORTC counts the triggers done.
  */
@@ -58,8 +58,10 @@ int main(void)
 		PORTA = st;
 		switch (st) {
 		case TW_ST_ARB_LOST_SLA_ACK:
-			TWDR = 0x5A;
-			TWCR = _BV(TWINT) | _BV(TWEN);	/* the last byte */
+			/* the last byte, all 1s: SDA stays free (the rival
+			 * clocks nothing out of it) */
+			TWDR = 0xFF;
+			TWCR = _BV(TWINT) | _BV(TWEN);
 			break;
 		case TW_SR_ARB_LOST_SLA_ACK:
 			TWCR = _BV(TWINT) | _BV(TWEN);	/* refuse its byte */
