@@ -46,6 +46,7 @@ typedef struct sim_t {
 	int twar_checked[WORLD_MAX_BOARDS];	/* slave's TWAR compared with --slave */
 	pty_t pty;
 	signal_t bus_busy;		/* "i2c", a signal of the gateway's */
+	signal_t bus_sda, bus_scl;	/* the lines "sda" and "scl", the gateway's too */
 	vcd_t vcd;
 	control_t control;
 	int idle_throttle;
@@ -515,11 +516,15 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 		return rc;
 	}
 	w->boards[w->nboards++] = gw;
-	if (signal_add(&gw->bm.signals, &sim->bus_busy, "i2c", 0) < 0) {
+	if (signal_add(&gw->bm.signals, &sim->bus_busy, "i2c", 0) < 0 ||
+	    signal_add(&gw->bm.signals, &sim->bus_sda, "sda", 1) < 0 ||
+	    signal_add(&gw->bm.signals, &sim->bus_scl, "scl", 1) < 0) {
 		fprintf(stderr, "orfa-sim: too many signals\n");
 		return 1;
 	}
 	w->bus.busy_signal = &sim->bus_busy;
+	w->bus.sda_signal = &sim->bus_sda;
+	w->bus.scl_signal = &sim->bus_scl;
 	for (int i = 0; i < args->slave_count; i++) {
 		rc = sim_board_init(&sim->slave[i], args->slave_board[i], args->slave_elf[i],
 				    args->slave_addr[i], &w->bus, &w->trace, sim_discard, NULL);

@@ -56,7 +56,7 @@ void i2c_phy_condition(twi_bus_t *bus, twi_dev_t *d, int start)
 {
 	/* A START or STOP comes in the high half of a byte's first bit (the
 	 * SCL pulse after an acknowledge); later in a byte it is a bus error. */
-	int illegal = d->phy != TWI_PHY_IDLE && d->nbits > 1;
+	int illegal = d->phy != TWI_PHY_IDLE && (d->nbits > 1 || bus->abort);
 
 	/* SDA moved, so this device does not pull it (a glitch moves no line,
 	 * twi_bus_glitch: then it lets SDA go, its front starting over); a

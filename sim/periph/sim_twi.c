@@ -399,14 +399,22 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 	return 0;
 }
 
-/* The master lets the lines go (TWI off, reset): SDA first, so no STOP. */
+/* The master lets the lines go (TWI off, reset): SDA first, so with SCL
+ * low it is no STOP. With SCL high in a byte's first bit, SDA rising would
+ * be a STOP on silicon, and a slave would take the frame cut there as
+ * whole; the model makes any release inside a byte a bus error to the
+ * devices instead (docs/simulator.md, "The lines"). */
 static void twi_master_off(sim_twi_t *t)
 {
+	int in_byte = t->op == TWI_OP_SLA || t->op == TWI_OP_TX || t->op == TWI_OP_RX;
+
 	avr_cycle_timer_cancel(t->avr, twi_timer, t);
 	twi_bus_cancel(t->bus, &t->master);
 	t->waiting = TWI_WAIT_NONE;
+	t->bus->abort = in_byte;
 	twi_drive(t, 0, t->drv.scl_low, t->avr->cycle);
 	twi_drive(t, 0, 0, t->avr->cycle);
+	t->bus->abort = 0;
 	if (t->owner) {
 		t->bus->clocked = 0;
 	}

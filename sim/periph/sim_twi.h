@@ -5,23 +5,25 @@
  * over TWBR/TWSR/TWAR/TWDR/TWCR after avr_init and drives a twi_bus_t.
  *
  * Master mode follows the datasheet (status codes 08..58, 38, F8; TWINT,
- * TWEA, TWSTA, TWSTO, TWWC, TWEN, TWIE). Timing: SCL period
- * P = 16 + 2*TWBR*4^TWPS cycles; START and STOP take P, a byte with its
- * acknowledge 9P; TWINT rises at the end.
+ * TWEA, TWSTA, TWSTO, TWWC, TWEN, TWIE). It puts every bit on the bus's
+ * lines at the SCL period P = 16 + 2*TWBR*4^TWPS cycles (sim_twi.c,
+ * "master mode"): START and STOP take P, a byte with its acknowledge 9P;
+ * TWINT rises at the end. It samples SDA with SCL high and waits for SCL to
+ * rise when a device holds it (clock synchronisation).
  *
- * Slave mode: every TWI is also a device on the bus (sim_twi_t.dev). With TWEN
- * and TWEA set it acknowledges its TWAR address (general call not
- * modelled) and gives the datasheet's slave codes 60/80/88/A0 (receiver)
- * and A8/B8/C0/C8 (transmitter). Its TWINT rises at the cycle the master's
- * operation completes (the end of the acknowledge bit, or the STOP /
- * repeated START); while it is set the slave holds SCL low (twi_bus_hold)
- * and the master's next operation waits until the firmware clears TWINT,
- * then takes its normal time from that release (clock stretching).
+ * Slave mode: every TWI is also a device on the bus (sim_twi_t.dev) behind
+ * the shared bit-level front (i2c_phy.c). With TWEN and TWEA set it
+ * acknowledges its TWAR address (general call not modelled) and gives the
+ * datasheet's slave codes 60/80/88/A0 (receiver), A8/B8/C0/C8
+ * (transmitter) and 00 (a START or STOP inside a byte). Its TWINT rises at
+ * the falling edge of SCL that ends the acknowledge bit (or at the STOP /
+ * repeated START); while it is set the slave holds SCL low and the
+ * master's next operation waits until the firmware clears TWINT, then
+ * takes its normal time from that release (clock stretching).
  *
  * Lines (twi_bus.h): with TWEN off the board's SCL/SDA port pins drive the
- * bus's wired-AND lines (sim_twi_wire_pins). A START waits while SDA is low; an
- * operation waits while SCL is held low, and one under way when SCL is
- * held ends one period after the release.
+ * bus's wired-AND lines (sim_twi_wire_pins). A START waits for a free bus
+ * (SDA and SCL high); an operation waits while another driver holds SCL.
  */
 #ifndef SIM_TWI_H
 #define SIM_TWI_H

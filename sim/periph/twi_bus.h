@@ -136,6 +136,9 @@ typedef struct twi_bus_t {
 	 * clocks a byte from cycle byte_begin to byte_end (twi_bus_byte). */
 	int clocked;
 	uint64_t byte_end;
+	/* the master lets go in the middle of a byte (its reset, TWEN off):
+	 * what its release does to SDA is a bus error to the devices */
+	int abort;
 	int nactive;		/* devices whose phy is not idle */
 
 	/* the master waiting (one master per bus: no arbitration yet) */
