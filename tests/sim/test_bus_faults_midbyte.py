@@ -16,12 +16,16 @@ nothing of a cut write is applied and the slave's status says DROPPED
 where data had arrived; the gateway sends no STOP; the lines are high and
 the next request is served, to the same slave or the other."""
 
+import shutil
+
 import pytest
+import serial
 
 from conftest import F_CPU, require_builds, require_slave, running
 from orfa.sim import REPO_ROOT, SimBoard
 from test_abandoned import (DROPPED, M128S, M32D, OK, SLAVES, applied_nothing, clear, mode,
                             robot, sp, status)  # noqa: F401 (robot: the fixture)
+from test_sigrok_i2c import sigrok_view, trace_view
 
 MS = F_CPU // 1000
 LEAD = 2000          # cycles from the batch to the request's first bit
@@ -298,3 +302,40 @@ def test_a_master_addressed_while_it_loses(arb_robot):
         ctl.wait(40 * MS)
         assert ctl.i2c()["sda"] == 1 and ctl.i2c()["scl"] == 1
         assert status(b, M128S) == OK
+
+
+# --- what a logic analyzer sees ------------------------------------------------
+
+@pytest.mark.skipif(shutil.which("sigrok-cli") is None,
+                    reason="needs sigrok-cli (tools/setup.sh installs it)")
+def test_a_logic_analyzer_sees_the_rivals_bit():
+    """The rival is on the wire: sigrok's i2c decoder, on the VCD's `sda`
+    and `scl`, reads the bytes the devices read (05 with its bit 5 pulled
+    low and the rest let go: 03; the address 10 with its bit 3: 0F, a read
+    from 07 nobody acknowledges) and nothing else the trace does not say:
+    no STOP after either (the gateway abandoned them), the next START
+    repeated to the analyzer."""
+    require_builds(["m32d"])
+    sim = SimBoard("m32d", slaves=[("m128s", M128S, require_slave("m128s", M128S))],
+                   control=True, vcd=True, trace=True).start()
+    try:
+        with serial.Serial(sim.port, 115200, timeout=5) as port:
+            for fault, want in (("i2c arb 3 5", b"ERROR 07"), ("i2c arb 0 3", b"ERROR 06"),
+                                (None, b"SWAAAAAAAP")):
+                if fault:
+                    sim.control.request(fault)
+                port.write(servo_write(M128S).encode() + b"\r")
+                assert port.readline().strip() == want
+            sim.control.wait(20000)
+    except BaseException:
+        sim.stop()
+        raise
+    sim.stop(keep_dir=True)
+    try:
+        trace = trace_view(sim.trace_events(kinds=["twi"]))
+        decoded = sigrok_view(sim.vcd_path)
+    finally:
+        shutil.rmtree(sim.dir, ignore_errors=True)
+    assert decoded == trace
+    assert ("DW", 0x03, 1) in decoded and ("AR", 0x0F >> 1, 0) in decoded
+    assert decoded.count("P") == 1
