@@ -414,6 +414,8 @@ static void twi_master_off(sim_twi_t *t)
 	t->bus->abort = in_byte;
 	twi_drive(t, 0, t->drv.scl_low, t->avr->cycle);
 	twi_drive(t, 0, 0, t->avr->cycle);
+	/* the rival's bit ends with the clock that made it */
+	twi_bus_drive(t->bus, &t->bus->rival_drv, 0, 0, t->avr->cycle);
 	t->bus->abort = 0;
 	if (t->owner) {
 		t->bus->clocked = 0;

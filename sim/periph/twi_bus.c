@@ -225,6 +225,9 @@ void twi_bus_note_stop(twi_bus_t *bus, uint64_t cycle)
 	bus->clocked = 0;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi stop");
+	if (twi_fault_on_stop(&bus->fault)) {
+		trace_event(bus->trace, cycle, "twi fault missed");
+	}
 	if (bus->busy_signal) {
 		signal_set(bus->busy_signal, cycle, 0);
 	}

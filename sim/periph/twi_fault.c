@@ -28,6 +28,15 @@ void twi_fault_on_start(twi_fault_t *f)
 	}
 }
 
+int twi_fault_on_stop(twi_fault_t *f)
+{
+	if (f->kind == TWI_FAULT_NONE || !f->counting) {
+		return 0;
+	}
+	twi_fault_arm(f, TWI_FAULT_NONE, 0, 0);
+	return 1;
+}
+
 twi_fault_kind_t twi_fault_here(const twi_fault_t *f, unsigned *bit)
 {
 	if (f->kind == TWI_FAULT_NONE || !f->counting || f->seen != f->byte) {

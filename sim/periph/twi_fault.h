@@ -19,7 +19,8 @@
  * BYTE counts the bytes on the bus from the next START after arming (0:
  * its address; a repeated START's address counts as a byte); BIT is 0..7
  * for the data bits, MSB first, and 8 for the acknowledge bit. A fault
- * fires once, at its byte, and is then disarmed.
+ * fires once, at its byte, and is then disarmed; a transaction that ends
+ * (STOP) before its byte disarms it too.
  */
 #ifndef SIM_TWI_FAULT_H
 #define SIM_TWI_FAULT_H
@@ -49,6 +50,10 @@ int twi_fault_arm(twi_fault_t *f, twi_fault_kind_t kind, unsigned byte, unsigned
 /* A START (or repeated START) completed: the first one after arming
  * begins the count. */
 void twi_fault_on_start(twi_fault_t *f);
+
+/* A STOP: a fault whose byte the transaction did not have is dropped.
+ * 1 when one was. */
+int twi_fault_on_stop(twi_fault_t *f);
 
 /* The fault armed for the byte that begins now, or TWI_FAULT_NONE; *BIT
  * gets its bit. */

@@ -236,6 +236,17 @@ def test_a_bit_the_master_sends_low_changes_nothing(rb):
         == b"SWAASR05DCP\r\n"
 
 
+def test_a_fault_past_the_last_byte_is_missed(rb):
+    """A fault armed for a byte the transaction does not have is dropped at
+    its STOP (`twi fault missed`); the next transaction is not hit."""
+    b = rb
+    reply, _, mark, _ = faulted(b, "i2c glitch start 8 3", servo_write(M32D))   # bytes 0..7
+    assert reply == b"SWAAAAAAAP\r\n"
+    assert ("twi fault", "missed") in [(e.kind,) + e.fields for e in b.events(mark, ["twi"])]
+    assert b.sim.control.i2c_armed() == "none"
+    assert b.ask(servo_write(M32D)[:-1] + "0205DCP") == b"SW" + b"A" * 10 + b"P\r\n"
+
+
 def test_control_requests_refuse_bad_arguments(rb):
     from orfa.simctl import SimControlError
     ctl = rb.sim.control

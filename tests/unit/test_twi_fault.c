@@ -38,6 +38,13 @@ static void test_counting(void)
 		CHECK(twi_fault_here(&f, &bit) == TWI_FAULT_NONE, "disarmed, byte %d", i);
 		twi_fault_byte_done(&f);
 	}
+	/* a transaction that ends before the byte: dropped at its STOP */
+	twi_fault_arm(&f, TWI_FAULT_START, 5, 1);
+	CHECK(!twi_fault_on_stop(&f) && f.kind == TWI_FAULT_START, "a STOP before the count");
+	twi_fault_on_start(&f);
+	twi_fault_byte_done(&f);
+	CHECK(twi_fault_on_stop(&f) && f.kind == TWI_FAULT_NONE, "missed at the STOP");
+	CHECK(!twi_fault_on_stop(&f), "once");
 	/* byte 0: the START's own address */
 	twi_fault_arm(&f, TWI_FAULT_STOP, 0, 8);
 	twi_fault_on_start(&f);
