@@ -43,13 +43,7 @@ static void phy_send(twi_bus_t *bus, twi_dev_t *d, uint64_t cycle)
 
 void i2c_phy_load(twi_bus_t *bus, twi_dev_t *d, uint64_t cycle)
 {
-	uint64_t edge = bus->cycle;
-
-	bus->cycle = cycle;
 	phy_send(bus, d, cycle);
-	if (!bus->telling) {
-		bus->cycle = edge > cycle ? edge : cycle;
-	}
 }
 
 void i2c_phy_condition(twi_bus_t *bus, twi_dev_t *d, int start)
