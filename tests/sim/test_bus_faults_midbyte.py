@@ -19,13 +19,12 @@ the next request is served, to the same slave or the other."""
 import shutil
 
 import pytest
-import serial
 
 from conftest import F_CPU, require_builds, require_slave, running
 from orfa.sim import REPO_ROOT, SimBoard
 from test_abandoned import (DROPPED, M128S, M32D, OK, SLAVES, applied_nothing, clear, mode,
                             robot, sp, status)  # noqa: F401 (robot: the fixture)
-from test_sigrok_i2c import sigrok_view, trace_view
+from test_sigrok_i2c import run_capture, sigrok_view, trace_view
 
 MS = F_CPU // 1000
 LEAD = 2000          # cycles from the batch to the request's first bit
@@ -328,20 +327,17 @@ def test_a_logic_analyzer_sees_the_rivals_bit():
     repeated to the analyzer."""
     require_builds(["m32d"])
     sim = SimBoard("m32d", slaves=[("m128s", M128S, require_slave("m128s", M128S))],
-                   control=True, vcd=True, trace=True).start()
-    try:
-        with serial.Serial(sim.port, 115200, timeout=5) as port:
-            for fault, want in (("i2c arb 3 5", b"ERROR 07"), ("i2c arb 0 3", b"ERROR 06"),
-                                (None, b"SWAAAAAAAP")):
-                if fault:
-                    sim.control.request(fault)
-                port.write(servo_write(M128S).encode() + b"\r")
-                assert port.readline().strip() == want
-            sim.control.wait(20000)
-    except BaseException:
-        sim.stop()
-        raise
-    sim.stop(keep_dir=True)
+                   control=True, vcd=True, trace=True)
+
+    def talk(port):
+        for fault, want in (("i2c arb 3 5", b"ERROR 07"), ("i2c arb 0 3", b"ERROR 06"),
+                            (None, b"SWAAAAAAAP")):
+            if fault:
+                sim.control.request(fault)
+            port.write(servo_write(M128S).encode() + b"\r")
+            assert port.readline().strip() == want
+
+    run_capture(sim, talk)
     try:
         trace = trace_view(sim.trace_events(kinds=["twi"]))
         decoded = sigrok_view(sim.vcd_path)
