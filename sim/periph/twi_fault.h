@@ -3,18 +3,20 @@
  * (`i2c arb BYTE BIT`, `i2c glitch start|stop BYTE BIT`; docs/simulator.md,
  * "Faults in the middle of a byte"):
  *
- *  - the rival: a device that pulls SDA low for one bit, as a second master
- *    that wins arbitration there would. Where the master sends a 1 (an
- *    address or data bit it transmits, or the NACK after a byte it reads)
- *    it loses arbitration: it lets SDA go for the rest of the byte, clocks
- *    the byte to its end and reports TW_MT_ARB_LOST / TW_MR_ARB_LOST
- *    (0x38). Elsewhere the low bit is only what everybody reads: a 0 in a
- *    byte a slave sends, an ACK;
+ *  - the rival: a driver of SDA that pulls it low for one bit, as a second
+ *    master that wins arbitration there would; the master TWI (sim_twi.c)
+ *    pulls it with its own clock. Where the master sends a 1 (an address
+ *    or data bit it transmits, or the NACK after a byte it reads) it loses
+ *    arbitration: it lets SDA go for the rest of the byte, clocks the byte
+ *    to its end and reports 0x38 (or 0x68/0xB0 when the address the
+ *    devices read is its own). Elsewhere the low bit is only what
+ *    everybody reads: a 0 in a byte a slave sends, an ACK;
  *  - the glitch: a START or a STOP condition in SCL's high half of a bit
  *    other than the first (bit 0 is where a legal repeated START or STOP
- *    goes): the master's TWI and the addressed slave's report a bus error
- *    (TW_BUS_ERROR, 0x00) and let go of the lines; every other device sees
- *    the condition as such.
+ *    goes), told to every device's bit-level front without moving the
+ *    lines (twi_bus_glitch): the master's TWI and a slave's taking part
+ *    report a bus error (TW_BUS_ERROR, 0x00) and let go of the lines;
+ *    every other device sees the condition as such.
  *
  * BYTE counts the bytes on the bus from the next START after arming (0:
  * its address; a repeated START's address counts as a byte); BIT is 0..7
