@@ -508,12 +508,13 @@ int board_model_init(board_model_t *bm, avr_t *avr, const sim_board_desc_t *boar
 	return 0;
 }
 
-static void bm_twi_lines(void *param, uint64_t cycle)
+static void bm_twi_lines(void *param, int scl_line, uint64_t cycle)
 {
 	board_model_t *bm = param;
 
-	/* only the TWI's two pins: this runs on every edge of the bus */
-	bm_port_update_pins(bm->twi_port, bm->twi_port->wired, cycle);
+	/* only the pin of the line that moved: this runs on every edge of the bus */
+	bm_port_update_pins(bm->twi_port, (uint8_t)(1u << (scl_line ? bm->twi_scl : bm->twi_sda)),
+			    cycle);
 }
 
 int board_model_wire_twi(board_model_t *bm, twi_bus_t *bus)

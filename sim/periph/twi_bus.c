@@ -82,7 +82,7 @@ static void twi_bus_edge(twi_bus_t *bus, int scl_line, uint64_t cycle)
 		signal_set(bus->sda_signal, cycle, bus->sda);
 	}
 	for (int i = 0; i < bus->nlisteners; i++) {
-		bus->listener[i](bus->listener_param[i], cycle);
+		bus->listener[i](bus->listener_param[i], scl_line, cycle);
 	}
 	if (!scl_line && bus->scl) {
 		/* SDA changed with SCL high: START (falling) or STOP (rising) */

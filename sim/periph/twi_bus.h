@@ -116,8 +116,9 @@ typedef enum twi_wait_t {
 	TWI_WAIT_BUS_FREE,	/* SDA and SCL high (a START) */
 } twi_wait_t;
 
-/* Told when a line's level changes (a board model's pin signals). */
-typedef void (*twi_line_fn)(void *param, uint64_t cycle);
+/* Told when a line's level changes (a board model's pin signals): SCL
+ * (SCL_LINE 1) or SDA, at CYCLE. */
+typedef void (*twi_line_fn)(void *param, int scl_line, uint64_t cycle);
 
 #define TWI_BUS_LISTENERS 16
 
@@ -223,7 +224,8 @@ void twi_bus_release(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle, uint8_t add
 /* DEV forgets its transfer and lets both lines go at CYCLE (its TWI off). */
 void twi_bus_forget(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle);
 
-/* Call FN(PARAM, cycle) whenever a line changes level. 0, -1 when full. */
+/* Call FN(PARAM, scl_line, cycle) whenever a line changes level. 0, -1
+ * when full. */
 int twi_bus_listen(twi_bus_t *bus, twi_line_fn fn, void *param);
 
 /* The stuck device holds SDA low until it has seen PULSES more SCL pulses
