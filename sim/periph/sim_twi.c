@@ -223,9 +223,9 @@ static void twi_rival(sim_twi_t *t, int on, avr_cycle_count_t when)
 /* The master lost arbitration in the byte that ended at WHEN (SCL fell
  * after its acknowledge): it is not the master any more. Addressed by the
  * address the devices read (its TWAR, TWEA set: its own front acknowledged
- * it, twi_dev_start) it is a slave from here, 0x68 (written to) or 0xB0
- * (read from); else 0x38, holding SCL until TWINT is cleared. (0x78 needs
- * the general call, not modelled.) */
+ * it, twi_dev_start) it is a slave from here, 0x68 (written to), 0x78 (the
+ * general call, with TWGCE) or 0xB0 (read from); else 0x38, holding SCL
+ * until TWINT is cleared. */
 static void twi_arb_lost(sim_twi_t *t, avr_cycle_count_t when)
 {
 	t->owner = 0;
@@ -234,8 +234,12 @@ static void twi_arb_lost(sim_twi_t *t, avr_cycle_count_t when)
 		trace_event(t->bus->trace, when, "twi arb-lost %02X", t->sl_addr);
 		twi_drive(t, 0, 0, when);	/* its slave side holds SCL */
 		t->op = TWI_OP_NONE;
-		t->status = t->sl_status = t->addressed == TWI_SLAVE_TX ? TW_ST_ARB_LOST_SLA_ACK
-								       : TW_SR_ARB_LOST_SLA_ACK;
+		if (t->addressed == TWI_SLAVE_TX) {
+			t->status = TW_ST_ARB_LOST_SLA_ACK;
+		} else {
+			t->status = t->sl_gcall ? TW_SR_ARB_LOST_GCALL_ACK : TW_SR_ARB_LOST_SLA_ACK;
+		}
+		t->sl_status = t->status;
 		twi_sync(t);
 		return;
 	}
@@ -501,15 +505,19 @@ static int twi_dev_start(twi_dev_t *dev, uint8_t addr8)
 	uint8_t cr = *twi_reg(t, t->regs->twcr);
 	uint8_t twar = *twi_reg(t, t->regs->twar);
 
+	/* the general call: address 0, a write, with TWGCE (TWAR bit 0) */
+	int gcall = addr8 == 0x00 && (twar & 1);
+
 	/* A master never answers its own address (but one that lost
 	 * arbitration in it may be the winner's slave); a slave answers only
 	 * while enabled with TWEA and idle (the bus waits for a TWINT it
 	 * holds). */
 	if (((t->owner || t->op != TWI_OP_NONE) && !t->lost) || t->sl_pending || dev->hold ||
 	    !(cr & BIT(TWCR_TWEN)) || !(cr & BIT(TWCR_TWEA)) || (cr & BIT(TWCR_TWINT)) ||
-	    (addr8 & 0xfe) != (twar & 0xfe)) {
+	    ((addr8 & 0xfe) != (twar & 0xfe) && !gcall)) {
 		return 0;
 	}
+	t->sl_gcall = gcall;
 	t->sl_addr = addr8 & 0xfe;
 	t->addressed = addr8 & 1 ? TWI_SLAVE_TX : TWI_SLAVE_RX;
 	t->sl_got_addr = 1;
@@ -541,15 +549,24 @@ static int twi_dev_ack_end(twi_dev_t *dev, int ack)
 
 	if (t->sl_got_addr) {
 		t->sl_got_addr = 0;
-		twi_slave_deliver(t, t->addressed == TWI_SLAVE_TX ? TW_ST_SLA_ACK : TW_SR_SLA_ACK,
-				  0, 0);
+		if (t->addressed == TWI_SLAVE_TX) {
+			status = TW_ST_SLA_ACK;
+		} else {
+			status = t->sl_gcall ? TW_SR_GCALL_ACK : TW_SR_SLA_ACK;
+		}
+		twi_slave_deliver(t, status, 0, 0);
 		return 1;
 	}
 	if (t->addressed == TWI_SLAVE_RX) {
 		if (!ack) {
 			t->addressed = 0;	/* NACKed: not addressed until the next START */
 		}
-		twi_slave_deliver(t, ack ? TW_SR_DATA_ACK : TW_SR_DATA_NACK, 1, t->sl_rx);
+		if (t->sl_gcall) {
+			status = ack ? TW_SR_GCALL_DATA_ACK : TW_SR_GCALL_DATA_NACK;
+		} else {
+			status = ack ? TW_SR_DATA_ACK : TW_SR_DATA_NACK;
+		}
+		twi_slave_deliver(t, status, 1, t->sl_rx);
 		return 1;
 	}
 	if (t->addressed != TWI_SLAVE_TX) {

@@ -88,7 +88,8 @@ typedef struct sim_twi_t {
 	int sl_has_data;		/* ... and this received byte */
 	uint8_t sl_data;
 	avr_cycle_count_t sl_at;	/* ... at this cycle */
-	uint8_t sl_addr;		/* TWAR address it answered (trace) */
+	uint8_t sl_addr;		/* TWAR address it answered (trace), 00: the general call */
+	int sl_gcall;			/* addressed by the general call (TWGCE) */
 
 	/* SCL/SDA as port pins while TWEN is off (sim_twi_wire_pins) */
 	twi_drv_t pins;

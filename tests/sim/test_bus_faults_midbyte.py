@@ -284,17 +284,19 @@ def arb_robot():
 
 
 def test_a_master_addressed_while_it_loses(arb_robot):
-    """The second master's TWI (TWEA set, TWAR 1E) loses arbitration in its
-    address byte: where the address the devices read is its own it is
-    addressed by it, 0xB0 (a read) or 0x68 (a write), else 0x38; with no
-    fault it is 0x20 (nobody at 20). The gateway's bus works after each."""
+    """The second master's TWI (TWEA set, TWAR 1E with TWGCE) loses
+    arbitration in its address byte: where the address the devices read is
+    its own it is addressed by it, 0xB0 (a read) or 0x68 (a write), 0x78
+    when it is the general call, else 0x38; with no fault it is 0x20
+    (nobody at 20). The gateway's bus works after each."""
     b = arb_robot
     ctl = b.sim.control
     arb = ctl.slave(ARB)
     for n, (fault, want, seen) in enumerate([("arb 0 2", 0xB0, "1F ack"),
                                               ("arb 0 7", 0x68, "1E ack"),
                                               (None, 0x20, "20 nack"),
-                                              ("arb 0 3", 0x38, "0F nack")], 1):
+                                              ("arb 0 3", 0x38, "0F nack"),
+                                              ("arb 0 7", 0x78, "00 ack")], 1):
         mark = b.mark()
         if fault:
             ctl.request("i2c " + fault)
@@ -307,11 +309,17 @@ def test_a_master_addressed_while_it_loses(arb_robot):
         assert ("twi addr",) + tuple(seen.split()) in ev, ev
         if want in (0x68, 0xB0):
             assert ("twi arb-lost", "1E") in ev, ev
+        elif want == 0x78:
+            assert ("twi arb-lost", "00") in ev, ev
         elif want == 0x38:
             assert ("twi arb-lost",) in ev, ev
         ctl.wait(40 * MS)
         assert ctl.i2c()["sda"] == 1 and ctl.i2c()["scl"] == 1
         assert status(b, M128S) == OK
+    # the general call from the gateway: acknowledged (TWGCE), 0x70 then a
+    # data byte 0x90, then the STOP
+    assert b.ask("S 00 5A P") == b"SWAP\r\n"
+    assert arb.peek(PORTA)[0] == 0x90
 
 
 # --- what a logic analyzer sees ------------------------------------------------
