@@ -2,6 +2,7 @@
 
 #include <avr/interrupt.h>
 #include <avr/wdt.h>
+#include <util/atomic.h>
 
 #include "firmware/mcu.h"
 
@@ -48,6 +49,14 @@ void uart_putc(uint8_t c)
 		wdt_reset();
 	}
 	uart.tx[head] = c;
-	uart.tx_head = next;
-	MCU_UCSRB |= _BV(UDRIE);
+	/* The byte joins the ring and UDRIE goes on in one piece: a UDRE
+	 * interrupt in between could send the byte, find the ring empty and
+	 * turn UDRIE off, and then UDRIE went on over an empty ring: a stale
+	 * byte sent and the tail run past the head (replies garbled now and
+	 * then at 460800). The M128-S's UCSR1B is beyond sbi's reach, so its
+	 * |= (a load and a store) made that window three instructions wide. */
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		uart.tx_head = next;
+		MCU_UCSRB |= _BV(UDRIE);
+	}
 }

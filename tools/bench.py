@@ -832,6 +832,110 @@ def print_sensor_reads(boards, width=38):
 
 # --- end of sensor reads -----------------------------------------------------------
 
+# --- a robot control loop (issue 20) ---------------------------------------------
+#
+# A block of its own (bench_control_loop, print_control_loop), called once from
+# main(). examples/control_loop.py run as a user runs it: each board as a
+# gateway at each rate from 115200 up (the gateway build for the rate), the
+# simulator at real time (--real-time: the PC gets a real board's time per
+# byte), every step's inputs checked against what the simulator senses. The
+# steps per second are simulated time (SimControl.time() around the run), the
+# Python CPU time is the process's (time.process_time()).
+
+sys.path.insert(0, str(ROOT / "examples"))
+LOOP_STEPS = 300
+LOOP_STEPS_ONE = 100
+#: Columns that break for a reason of their own, an xfail of the tests (the
+#: run's exit status does not count them)
+LOOP_KNOWN_BROKEN = {("m32d", r): "the servo interrupt loses received characters above"
+                     " 115200, tests/sim/test_fast_rates.py" for r in (230400, 460800)}
+#: Steps before the clock starts: the pipeline full (examples/control_loop.py timed)
+LOOP_WARMUP = 10
+
+
+def loop_rates():
+    """The Makefile's rates from 115200 up."""
+    out = subprocess.run(["make", "-s", "--no-print-directory", "print-baud-rates"], cwd=ROOT,
+                         check=True, capture_output=True, text=True).stdout.split()
+    return [int(r) for r in out if int(r) >= 115200]
+
+
+def bench_control_loop(board, rate, steps=LOOP_STEPS, steps_one=LOOP_STEPS_ONE):
+    """{"pipelined": (steps, cycles, cpu s), "one": (same, one request at a
+    time), "wire": (characters sent, received) per step}; {"error": why}
+    if a step's reply is refused or wrong, or its inputs are not what the
+    simulator senses (no figure for a broken loop)."""
+    import control_loop as cl
+    from orfa import Board, OrfaError
+    from orfa.gateway import Gateway
+    rows = {}
+    sim = cl.simulated_board(board, rate)
+    try:
+        with Gateway(sim.port, baudrate=rate, timeout=30) as gw:
+            ctl = sim.control
+            loop = cl.ControlLoop(Board(gw))
+            loop.setup()
+            ctl.wait(F_CPU // 100)                     # the IMU samples at 1 kHz
+            for name, n, pipelined in (("pipelined", steps, True), ("one", steps_one, False)):
+                rows[name] = (n - LOOP_WARMUP,) + cl.timed(loop, n, pipelined, ctl.time,
+                                                           cl.check_sim_inputs, LOOP_WARMUP)
+            rows["wire"] = loop.last.wire()
+    except (OrfaError, ValueError) as e:
+        return {"error": "%s at %d baud: %s (the serial line: %s)"
+                % (board, rate, e, " ".join("%s %s" % kv for kv in sim.control.line().items()))}
+    finally:
+        sim.stop()
+    return rows
+
+
+def cl_ahead():
+    import control_loop
+    return control_loop.AHEAD
+
+
+def print_control_loop(boards, width=38):
+    rates = loop_rates()
+    res = {(b, r): bench_control_loop(b, r) for b in boards for r in rates}
+    cols = [(b, r) for b in boards for r in rates]
+    print()
+    print("A robot control loop (issue 20, examples/control_loop.py): per step 16 servo")
+    print("widths and (M32-D) both motors written, the 8 ADC channels and the MPU-6050's")
+    print("14-byte burst read, through the Python API, every step's inputs checked;")
+    print("simulated time, the simulator at real time")
+    print()
+    print("%-*s" % (width, "figure") + "".join("%14s" % ("%s@%dk" % (b, r // 1000))
+                                            for b, r in cols) + "%10s" % "target")
+
+    def row(label, get, target=""):
+        print("%-*s" % (width, label) + "".join(
+            "%14s" % ("broken" if "error" in res[c] else get(res[c], c[1])) for c in cols)
+            + "%10s" % target)
+
+    def wire_steps(r, rate):
+        return rate / 10.0 / max(r["wire"])
+
+    row("characters sent / received a step", lambda r, _: "%d/%d" % r["wire"])
+    row("wire limit: steps/s", lambda r, rate: "%.1f" % wire_steps(r, rate))
+    for key, label in (("pipelined", "pipelined"), ("one", "one at a time")):
+        row("%s: steps/s" % label, lambda r, _: "%.1f" % (r[key][0] * F_CPU / r[key][1]))
+        row("%s: %% of wire" % label, lambda r, rate: "%.1f" % (
+            100.0 * r[key][0] * F_CPU / r[key][1] / wire_steps(r, rate)),
+            ">= 95" if key == "pipelined" else "")
+        row("%s: Python CPU ms a step" % label, lambda r, _: "%.2f" % (1e3 * r[key][2] / r[key][0]))
+    print()
+    print("Columns are board@rate. The wire limit: the longer way's characters of one step")
+    print("(10 bits each) at the rate. Pipelined: the next %d steps submitted before a" % cl_ahead())
+    print("step's replies are waited for (Board.submit, Gateway.submit_transactions, within")
+    print("the flow rule); one at a time: the same requests, each after the last one's reply.")
+    print("Timed from step %d's inputs to the last step's." % (LOOP_WARMUP - 1))
+    for col in cols:
+        if "error" in res[col]:
+            print("broken%s: %s" % (" (known: %s)" % LOOP_KNOWN_BROKEN[col]
+                                    if col in LOOP_KNOWN_BROKEN else "", res[col]["error"]))
+    return all("error" not in res[c] for c in cols if c not in LOOP_KNOWN_BROKEN)
+
+# --- end of the control loop --------------------------------------------------------
+
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -954,6 +1058,7 @@ def main():
     ok = bench_autobaud(args.boards) and ok
     ok = print_bus_faults(args.boards) and ok
     ok = print_sensor_reads(args.boards) and ok
+    ok = print_control_loop(args.boards) and ok
     print_watchdog(args.boards, width)
     return 0 if ok else 1
 

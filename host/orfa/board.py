@@ -185,6 +185,14 @@ class Board(Closing):
         groups are each followed by a status request, so a refusal's reason
         is the board's own even when later requests ran. The first refusal
         raises (after every group ran)."""
+        return self.submit(items).wait()
+
+    def submit(self, items: Sequence[Sequence[Op]]) -> "PendingOps":
+        """execute(items) without waiting: the requests join the gateway's
+        stream (Gateway.submit) and go out as the flow rule lets them;
+        PendingOps.wait() gives what execute() returns (or raises its
+        refusal). A robot loop submits its next outputs before it waits
+        for the last inputs (docs/python.md, "Pipelining across calls")."""
         items = [list(item) for item in items]
         paired = len(items) > 1
         requests: List[List[p.Frame]] = []
@@ -192,22 +200,7 @@ class Board(Closing):
             requests.append(self._frames(item))
             if paired:
                 requests.append(self._status_frames())
-        results = self.gateway.transactions(requests)
-        out: List[List[bytes]] = []
-        first: Optional[p.OrfaError] = None
-        for k, item in enumerate(items):
-            res = results[2 * k if paired else k]
-            if isinstance(res, p.OrfaError):
-                after = results[2 * k + 1] if paired else None
-                first = first or self._refusal(item, res, after)
-                out.append([])
-                continue
-            reads, err = self._parse(item, res)
-            first = first or err
-            out.append(reads)
-        if first is not None:
-            raise first
-        return out
+        return PendingOps(self, items, paired, self.gateway.submit_transactions(requests))
 
     def _parse(self, item: Sequence[Op], res) -> Tuple[List[bytes], Optional[p.OrfaError]]:
         reads: List[bytes] = []
@@ -292,6 +285,41 @@ class Board(Closing):
     motor = _Client()
     adc = _Client()
     spi = _Client()
+
+
+class PendingOps:
+    """Register accesses handed to Board.submit(), under way."""
+
+    def __init__(self, board: Board, items: List[List[Op]], paired: bool, pending):
+        self.board = board
+        self.items = items
+        self.paired = paired
+        self.pending = pending
+
+    @property
+    def done(self) -> bool:
+        return self.pending.done
+
+    def wait(self) -> List[List[bytes]]:
+        """For each group the data of its reads, as Board.execute(); the
+        first refusal raises."""
+        results = self.pending.wait()
+        paired = self.paired
+        out: List[List[bytes]] = []
+        first: Optional[p.OrfaError] = None
+        for k, item in enumerate(self.items):
+            res = results[2 * k if paired else k]
+            if isinstance(res, p.OrfaError):
+                after = results[2 * k + 1] if paired else None
+                first = first or self.board._refusal(item, res, after)
+                out.append([])
+                continue
+            reads, err = self.board._parse(item, res)
+            first = first or err
+            out.append(reads)
+        if first is not None:
+            raise first
+        return out
 
 
 # The board sits above the gateway (docs: host/README.md, "Layers"), so the

@@ -91,6 +91,70 @@ def _clip(text, size: int = 60):
 _STATUS_REGISTER = boardmap.load(boardmap.BOARDS[0]).reg("intro", "STATUS")
 
 
+class Pending:
+    """Requests handed to Gateway.submit() or submit_transactions(): on
+    their way to the board as the flow rule lets them; wait() for what
+    run() or transactions() would have returned."""
+
+    def __init__(self, gateway: "Gateway", lines: List[str]):
+        self.gateway = gateway
+        self.lines = lines
+        #: the transactions' frames (submit_transactions), else None
+        self.frames: Optional[List[List[p.Frame]]] = None
+        self.replies: List[Optional[Reply]] = [None] * len(lines)
+        #: requests still without an answer
+        self.left = len(lines)
+
+    @property
+    def done(self) -> bool:
+        """True once every request has its answer (wait() returns at once)."""
+        return not self.left
+
+    def wait(self):
+        """Read replies until these requests have theirs (the requests
+        submitted before are answered first, later ones go out meanwhile),
+        then: submitted as lines, their reply texts (the first error
+        raised, as run()); as transactions, each one's frame results or
+        OrfaError (as transactions())."""
+        if self.left:
+            self.gateway._wait(self)
+        if self.frames is None:
+            for reply in self.replies:
+                if isinstance(reply, p.OrfaError):
+                    raise reply
+            return list(self.replies)
+        out: List[Union[List[p.FrameResult], p.OrfaError]] = []
+        for frames, reply in zip(self.frames, self.replies):
+            if isinstance(reply, p.OrfaError):
+                out.append(reply)
+                continue
+            try:
+                out.append(p.parse_transaction(reply, frames))
+            except p.OrfaError as e:
+                out.append(e)
+        return out
+
+
+class _Request:
+    """One submitted request in the gateway's stream."""
+
+    __slots__ = ("line", "pattern", "cost", "pending", "index")
+
+    def __init__(self, line: str, pattern, pending: Pending, index: int):
+        self.line = line
+        self.pattern = pattern
+        self.cost = flow.request_cost(line)
+        self.pending = pending
+        self.index = index
+
+    def answer(self, reply: Reply) -> None:
+        """Its reply text or error; a second answer (out of step after
+        all) replaces the first."""
+        if self.pending.replies[self.index] is None:
+            self.pending.left -= 1
+        self.pending.replies[self.index] = reply
+
+
 class Gateway(Closing):
     """An ORFA gateway on one serial port; a context manager.
 
@@ -118,6 +182,16 @@ class Gateway(Closing):
         self._synced = not sync
         #: times the line was brought back in step (noise, stale lines, timeouts)
         self.resyncs = 0
+        #: bytes read from the port beyond the last line taken (_read_until)
+        self._rx = bytearray()
+        #: the stream of submitted requests (submit()): not yet sent, and
+        #: sent with their replies still to come (their characters: in_flight)
+        self._unsent: deque = deque()
+        self._sent: deque = deque()
+        self._in_flight = 0
+        #: requests answered since the first ERROR reply not yet confirmed
+        #: by a marker (an ERROR may be an extra line: see _confirm)
+        self._unsure: List["_Request"] = []
         if autobaud:
             self.preamble(wait)
 
@@ -152,16 +226,47 @@ class Gateway(Closing):
     def _read_until(self, left: float) -> bytes:
         """Bytes up to an LF, or what came within `left` seconds: the
         port's own timeout is shortened for this read when clearly less is
-        left (on a real port that reconfigures it: not for every line)."""
+        left (on a real port that reconfigures it: not for every line).
+        A pyserial port is read for all it holds at once (in_waiting), the
+        bytes after the LF kept for the next line: pyserial's read_until
+        takes one byte a call, and a USB-serial adapter hands over a
+        millisecond's bytes at once (46 at 460800 baud)."""
         port = self.serial
-        short = port.timeout is None or left < port.timeout - _TIMEOUT_GRACE
+        if not isinstance(port, serial.SerialBase):        # a wrapper, a test's fake
+            return self._port_call(port.read_until, b"\n", left)
+        buf = self._rx
+        deadline = time.monotonic() + left
+        first = True
+        while b"\n" not in buf:
+            waiting = self._port_waiting()
+            if waiting:
+                buf += self._port_call(port.read, waiting, None)
+                continue
+            left = deadline - time.monotonic()
+            if left <= 0 and not first:
+                break
+            # one byte, waited for; then what came with it
+            got = self._port_call(port.read, 1, max(left, 0.0))
+            first = False
+            if not got:
+                break
+            buf += got
+        end = buf.find(b"\n") + 1 or len(buf)
+        line = bytes(buf[:end])
+        del buf[:end]
+        return line
+
+    def _port_call(self, read, arg, left: Optional[float]):
+        """read(arg) on the port, its timeout shortened to `left` when
+        clearly less is left (None: as it is); its errors as SerialError."""
+        port = self.serial
         try:
-            if not short:
-                return port.read_until(b"\n")
+            if left is None or not (port.timeout is None or left < port.timeout - _TIMEOUT_GRACE):
+                return read(arg)
             kept = port.timeout
             port.timeout = left
             try:
-                return port.read_until(b"\n")
+                return read(arg)
             finally:
                 port.timeout = kept
         except (serial.SerialException, OSError) as e:
@@ -183,7 +288,9 @@ class Gateway(Closing):
         return p.strip_reply(bytes(buf))
 
     def request(self, line: str) -> str:
-        """Send one request, return its reply text (ERROR replies included)."""
+        """Send one request, return its reply text (ERROR replies included);
+        submitted requests still under way are answered first."""
+        self._drain()
         self.send(p.encode_request(line))
         return self.read_reply()
 
@@ -204,29 +311,126 @@ class Gateway(Closing):
         whose reply was lost to the noise raises ProtocolError (after the
         line is in step again). No reply in time: ReplyTimeout.
         """
-        replies = self._exchange(lines)
-        for reply in replies:
-            if isinstance(reply, p.OrfaError):
-                raise reply
-        return replies  # type: ignore[return-value]
+        return self.submit(lines).wait()
 
     def transactions(self, items: Sequence[Sequence[p.Frame]]
                      ) -> List[Union[List[p.FrameResult], p.OrfaError]]:
         """Run many transactions pipelined (see run()); for each, its frame
         results or the OrfaError its reply gave (an `ERROR xx`, a reply
         lost to noise), so one refused item leaves the others' results."""
+        return self.submit_transactions(items).wait()
+
+    def submit(self, lines: Sequence[str]) -> "Pending":
+        """run(lines) without waiting: the requests join the stream of
+        submitted ones and go out as the flow rule lets them (some at once,
+        the rest while the gateway waits for any reply); Pending.wait()
+        gives what run() returns. Requests submitted before are answered
+        first, in order, so a program can send its next requests while the
+        board still answers the last ones (docs/python.md, "Pipelining
+        across calls")."""
+        lines = [p.check_request(line) for line in lines]
+        patterns = []
+        for line in lines:
+            pattern = flow.reply_pattern(line)
+            if pattern is None:
+                raise ValueError("%r gets no reply (empty line or comment)" % line)
+            patterns.append(pattern)
+        if not self._unsent and not self._sent:
+            self.in_step()
+        pending = Pending(self, lines)
+        self._unsent.extend(_Request(line, pattern, pending, i)
+                            for i, (line, pattern) in enumerate(zip(lines, patterns)))
+        self._send_what_fits()
+        return pending
+
+    def submit_transactions(self, items: Sequence[Sequence[p.Frame]]) -> "Pending":
+        """transactions(items) without waiting, as submit(): Pending.wait()
+        gives what transactions() returns."""
         items = [list(frames) for frames in items]
-        lines = [p.format_transaction(frames) for frames in items]
-        out: List[Union[List[p.FrameResult], p.OrfaError]] = []
-        for frames, reply in zip(items, self._exchange(lines)):
-            if isinstance(reply, p.OrfaError):
-                out.append(reply)
-                continue
-            try:
-                out.append(p.parse_transaction(reply, frames))
-            except p.OrfaError as e:
-                out.append(e)
-        return out
+        pending = self.submit([p.format_transaction(frames) for frames in items])
+        pending.frames = items
+        return pending
+
+    def _send_what_fits(self) -> None:
+        """Send the submitted requests that the flow window has room for,
+        in one write; room for a marker is always kept."""
+        reserve = flow.request_cost(flow.MARKER)
+        batch = bytearray()
+        while self._unsent and \
+                self._in_flight + self._unsent[0].cost + reserve < flow.FLOW_WINDOW:
+            req = self._unsent.popleft()
+            batch += p.encode_request(req.line)
+            self._sent.append(req)
+            self._in_flight += req.cost
+        if batch:
+            self.send(bytes(batch))
+
+    def _wait(self, pending: "Pending") -> None:
+        """Read replies (sending what the window lets out) until every
+        request of `pending` has its answer; after an ERROR reply, until the
+        stream is empty and a marker confirms the line (_confirm)."""
+        try:
+            while pending.left or (self._unsure and (self._sent or self._unsent)):
+                self._step()
+            if self._unsure:
+                self._confirm()
+        except p.ReplyTimeout as e:
+            # the line is out of step (marked dirty): nothing under way will be answered
+            for req in list(self._sent) + list(self._unsent):
+                req.answer(e)
+            self._sent.clear()
+            self._unsent.clear()
+            self._in_flight = 0
+            self._unsure = []
+            raise
+
+    def _drain(self) -> None:
+        """Wait for every submitted request's reply."""
+        while self._sent or self._unsent:
+            self._wait((self._unsent or self._sent)[-1].pending)
+
+    def _step(self) -> None:
+        """Send what fits, then read one line and give it to the first
+        request under way; noise: resynchronise (_settle)."""
+        self._send_what_fits()
+        text = self._read_line()
+        req = self._sent[0]
+        if flow.plausible(req.pattern, text):
+            self._sent.popleft()
+            self._in_flight -= req.cost
+            req.answer(text)
+            if self._unsure or text.startswith("ERROR"):
+                self._unsure.append(req)
+            return
+        # noise: stop sending, mark, and sort out the lines up to the marker
+        self.resyncs += 1
+        # the noise may be the reply an extra ERROR line displaced
+        self._out_of_step(self._unsure)
+        self._write(p.encode_request(flow.MARKER))
+        self._settle(list(self._sent))
+        self._sent.clear()
+        self._in_flight = 0
+
+    def _out_of_step(self, reqs: Sequence["_Request"]) -> None:
+        for req in reqs:
+            req.answer(p.ProtocolError(
+                "replies out of step from %r on (an extra line on the serial "
+                "line); its result is unknown" % req.line))
+        self._unsure = []
+
+    def _confirm(self) -> None:
+        """After a run with an ERROR reply, the stream empty: an ERROR line
+        could have been an extra line (a garbled request the board
+        refused), so a `V` marker's reply must come next. If it does not, a
+        line too many came somewhere from the first ERROR on, and those
+        requests' results are not trusted."""
+        self._write(p.encode_request(flow.MARKER))
+        text = self._read_line()
+        if text != flow.MARKER_REPLY:
+            self.resyncs += 1
+            self._until_marker(time.monotonic() + self.timeout)
+            self._out_of_step(self._unsure)
+        self._unsure = []
 
     def sync_open(self) -> int:
         """End whatever partial line the board holds (a terminal's `S AA 0`
@@ -318,99 +522,36 @@ class Gateway(Closing):
             return "<noise: %s>" % e
 
     def _waiting(self) -> int:
+        """Bytes received that no line has taken yet."""
+        return len(self._rx) + self._port_waiting()
+
+    def _port_waiting(self) -> int:
         try:
             return self.serial.in_waiting
         except (AttributeError, NotImplementedError, serial.SerialException, OSError):
             return 0
 
-    def _exchange(self, lines: Sequence[str]) -> List[Reply]:
-        """Pipelined requests; each reply text, or the error for a reply
-        lost to noise. See run()."""
-        lines = [p.check_request(line) for line in lines]
-        patterns = []
-        for line in lines:
-            pattern = flow.reply_pattern(line)
-            if pattern is None:
-                raise ValueError("%r gets no reply (empty line or comment)" % line)
-            patterns.append(pattern)
-        self.in_step()
-        n = len(lines)
-        out: List[Optional[Reply]] = [None] * n
-        cost = [flow.request_cost(line) for line in lines]
-        reserve = flow.request_cost(flow.MARKER)        # room for a marker, always
-        pending: deque = deque()
-        in_flight = 0
-        sent = 0
-        #: first request whose reply was an ERROR line: an extra line of
-        #: noise (a garbled request the board refused) looks the same, so
-        #: from there on the run is checked with a marker at its end
-        unsure_from: Optional[int] = None
-        while sent < n or pending:
-            batch = bytearray()
-            while sent < n and in_flight + cost[sent] + reserve < flow.FLOW_WINDOW:
-                batch += p.encode_request(lines[sent])
-                pending.append(sent)
-                in_flight += cost[sent]
-                sent += 1
-            if batch:
-                self.send(bytes(batch))
-            text = self._read_line()
-            i = pending[0]
-            if flow.plausible(patterns[i], text):
-                out[i] = text
-                pending.popleft()
-                in_flight -= cost[i]
-                if text.startswith("ERROR") and unsure_from is None:
-                    unsure_from = i
-                continue
-            # noise: stop sending, mark, and sort out the lines up to the marker
-            self.resyncs += 1
-            if unsure_from is not None:
-                # the noise may be the reply an extra ERROR line displaced
-                for j in range(unsure_from, i):
-                    out[j] = p.ProtocolError(
-                        "replies out of step from %r on (an extra line on the serial "
-                        "line); its result is unknown" % lines[j])
-                unsure_from = None
-            self.send(p.encode_request(flow.MARKER))
-            self._settle(list(pending), patterns, out, lines)
-            pending.clear()
-            in_flight = 0
-        if unsure_from is not None:
-            self.send(p.encode_request(flow.MARKER))
-            text = self._read_line()
-            if text != flow.MARKER_REPLY:
-                # a reply too many: somewhere from unsure_from on, an extra
-                # line took a request's place; those results are not trusted
-                self.resyncs += 1
-                self._until_marker(time.monotonic() + self.timeout)
-                for i in range(unsure_from, n):
-                    out[i] = p.ProtocolError(
-                        "replies out of step from %r on (an extra line on the serial "
-                        "line); its result is unknown" % lines[i])
-        return out  # type: ignore[return-value]
-
-    def _settle(self, waiting: List[int], patterns, out: List[Optional[Reply]],
-                lines: Sequence[str]) -> None:
-        """After noise: read every line up to the marker's reply and give
-        them to the requests still waiting, if they line up; otherwise
-        those requests lost their replies (ProtocolError)."""
-        markers_due = 1 + sum(1 for i in waiting if lines[i].strip(" ").upper().startswith("V"))
+    def _settle(self, waiting: List["_Request"]) -> None:
+        """After noise (the marker sent): read every line up to the
+        marker's reply and give them to the requests still waiting, if
+        they line up; otherwise those requests lost their replies
+        (ProtocolError)."""
+        markers_due = 1 + sum(1 for r in waiting if r.line.strip(" ").upper().startswith("V"))
         seen = self._until_marker(time.monotonic() + self.timeout, markers_due)
-        candidates = [t for t in seen if any(flow.plausible(patterns[i], t) for i in waiting)]
+        candidates = [t for t in seen if any(flow.plausible(r.pattern, t) for r in waiting)]
         # the line that was noise came in the first waiting request's place:
         # an extra line (all replies follow) or its reply garbled (one fewer)
         for lost in (0, 1):
             rest = waiting[lost:]
             if len(candidates) == len(rest) and all(
-                    flow.plausible(patterns[i], t) for i, t in zip(rest, candidates)):
-                for i, t in zip(rest, candidates):
-                    out[i] = t
+                    flow.plausible(r.pattern, t) for r, t in zip(rest, candidates)):
+                for r, t in zip(rest, candidates):
+                    r.answer(t)
                 waiting = waiting[:lost]
                 break
-        for i in waiting:
-            out[i] = p.ProtocolError("the reply to %r was lost to noise on the serial line"
-                                     % lines[i])
+        for r in waiting:
+            r.answer(p.ProtocolError("the reply to %r was lost to noise on the serial line"
+                                     % r.line))
 
     # --- commands -------------------------------------------------------------
     def version(self) -> str:

@@ -33,6 +33,8 @@
 
 #define SIM_BATCH_CYCLES (SIM_FREQUENCY / 1000)	/* 1 ms simulated */
 #define SIM_IDLE_AFTER_S 0.5
+/* --real-time: further behind wall time than this, it starts again from now. */
+#define SIM_REAL_TIME_BEHIND_S 0.002
 #define SIM_BOOT_MAX_CYCLES (SIM_FREQUENCY / 10)	/* 100 ms simulated */
 #define SIM_UCSRB_RXEN 0x10
 
@@ -50,6 +52,7 @@ typedef struct sim_t {
 	vcd_t vcd;
 	control_t control;
 	int idle_throttle;
+	int real_time;		/* --real-time: simulated time never ahead of wall time */
 } sim_t;
 
 static volatile sig_atomic_t sim_stop;
@@ -84,7 +87,7 @@ static void sim_usage(void)
 	fprintf(stderr,
 		"usage: orfa-sim --board %s --link PATH [--part KIND@ADDR[:OPTIONS]]...\n"
 		"                [--eeprom ADDR[:wp]]... [--srf08 ADDR]...\n"
-		"                [--trace FILE] [--no-idle-throttle] [--control PATH]\n"
+		"                [--trace FILE] [--no-idle-throttle] [--real-time] [--control PATH]\n"
 		"                [--vcd FILE] [--spi [SLAVE/]KIND@PIN[:mode=N][:lsb]]...\n"
 		"                [--adc CH=MV]... [--avcc MV] [--aref MV]\n"
 		"                [--slave BOARD:ADDR:ELF]... GATEWAY.elf\n"
@@ -345,6 +348,7 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		{ "part", required_argument, NULL, 'P' },
 		{ "trace", required_argument, NULL, 't' },
 		{ "no-idle-throttle", no_argument, NULL, 'n' },
+		{ "real-time", no_argument, NULL, 'r' },
 		{ "control", required_argument, NULL, 'c' },
 		{ "vcd", required_argument, NULL, 'v' },
 		{ "spi", required_argument, NULL, 's' },
@@ -384,6 +388,9 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 			break;
 		case 'n':
 			sim->idle_throttle = 0;
+			break;
+		case 'r':
+			sim->real_time = 1;
 			break;
 		case 'c':
 			args->control = optarg;
@@ -599,7 +606,7 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 
 /* Idle throttle: after SIM_IDLE_AFTER_S of wall time with nothing on the
  * serial line or the bus (and no `wait` or scheduled byte ahead), simulated
- * time is held to wall time. */
+ * time is held to wall time; with --real-time always (th->on from the start). */
 typedef struct sim_throttle_t {
 	uint32_t last_activity;
 	double t_last_activity;
@@ -612,7 +619,9 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 {
 	uint32_t act = sim_activity(sim);
 
-	if (host_bytes || act != th->last_activity || control_waiting(&sim->control) ||
+	if (sim->real_time) {
+		/* held to wall time from the start, activity or not */
+	} else if (host_bytes || act != th->last_activity || control_waiting(&sim->control) ||
 	    usart_inject_pending(&sim->gateway.usart)) {
 		th->last_activity = act;
 		th->t_last_activity = now;
@@ -626,6 +635,13 @@ static void sim_throttle(sim_t *sim, sim_throttle_t *th, int host_bytes, double 
 	if (th->on) {
 		double ahead = (double)(world_cycle(&sim->world) - th->cycle0) / SIM_FREQUENCY -
 			       (now - th->wall0);
+		if (sim->real_time && ahead < -SIM_REAL_TIME_BEHIND_S) {
+			/* Fallen behind (the machine busy): go on at real time
+			 * from here rather than run free to catch up, which
+			 * would give the PC less than a real board's time. */
+			th->wall0 = now;
+			th->cycle0 = world_cycle(&sim->world);
+		}
 		if (ahead > 0.0005) {
 			/* Wait for wall time, or for the PC or a control
 			 * client to send. */
@@ -644,6 +660,10 @@ static int sim_run(sim_t *sim)
 {
 	sim_throttle_t th = { .last_activity = sim_activity(sim) };
 	double t_start = sim_now(), t_free = 0;
+
+	th.on = sim->real_time;
+	th.wall0 = t_start;
+	th.cycle0 = world_cycle(&sim->world);
 	avr_cycle_count_t cyc_free = 0;	/* only time running free counts */
 	int rc = 0;
 

@@ -351,6 +351,49 @@ def test_timeout_then_resync(fake):
     assert line.written[-2:] == ["V", "SA102P"]
 
 
+# --- submit: pipelining across calls ------------------------------------------------------
+
+def test_submitted_batches_share_the_window_and_keep_their_order(fake):
+    """Three batches submitted before any is waited for: one stream within
+    the flow rule, each batch its own replies, whichever is waited for first."""
+    gw, line = fake(echo_answers)
+    lines, want = reads(90)
+    batches = [gw.submit(lines[i:i + 30]) for i in (0, 30, 60)]
+    assert 200 < line.max_in_flight < 256 and len(line.written) < 90
+    assert batches[2].wait() == want[60:]                 # the earlier ones are read on the way
+    assert batches[0].done and batches[1].done
+    assert batches[0].wait() + batches[1].wait() == want[:60]
+    assert line.written == lines
+
+
+def test_submit_sends_at_once_and_a_request_waits_for_the_stream(fake):
+    gw, line = fake(echo_answers)
+    first = gw.submit(["SA101P", "SA102P"])
+    assert line.written == ["SA101P", "SA102P"] and not first.done
+    assert gw.request("SA103P") == "SR030303P"            # after the two submitted
+    assert first.done and first.wait() == ["SR01P", "SR0202P"]
+
+
+def test_submitted_transactions_and_board_ops(fake):
+    b, line = make_board(fake, table={"SAA0DSAB02P": "SWASR0123P", "SA102P": "SR0202P"})
+    ops = b.submit([[b.op_read("adc", "RD", 2)]])
+    tx = b.gateway.submit_transactions([[p_read(2)]])
+    assert line.written == ["SAA0DSAB02P", "SA102P"]
+    assert tx.wait()[0][0].data == b"\x02\x02" and ops.done
+    assert ops.wait() == [[b"\x01\x23"]]
+
+
+def test_an_error_reply_is_confirmed_after_the_later_batches(fake):
+    """An ERROR reply in one batch: its wait reads the later batches too,
+    then a marker checks the line was in step."""
+    gw, line = fake(echo_answers)
+    first = gw.submit(["SA101P", "Q"])
+    second = gw.submit(["SA102P"])
+    assert first.wait() == ["SR01P", "ERROR 02"]
+    assert second.done and second.wait() == ["SR0202P"]
+    assert line.written == ["SA101P", "Q", "SA102P", "V"]
+
+
 # --- the serial port ----------------------------------------------------------------------
 
 def test_bad_port_is_one_line():

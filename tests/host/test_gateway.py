@@ -120,6 +120,23 @@ def test_loop_reply_lines():
             gw.read_reply()
 
 
+def test_lines_that_came_together_are_read_at_once(monkeypatch):
+    """What the port holds is taken in one read (a USB-serial adapter hands
+    over a millisecond's bytes at once), the bytes after a line kept for the
+    next one and counted as waiting; a partial line times out."""
+    with Gateway("loop://", timeout=0.3, sync=False) as gw:
+        reads = []
+        read = gw.serial.read
+        monkeypatch.setattr(gw.serial, "read", lambda n=1: reads.append(n) or read(n))
+        gw.send(b"SR" + b"41" * 60 + b"P\r\nV1.1\r\nERR")
+        assert gw.read_reply() == "SR" + "41" * 60 + "P"
+        assert reads == [len("SR" + "41" * 60 + "P\r\nV1.1\r\nERR")]
+        assert gw._waiting() == len("V1.1\r\nERR")
+        assert gw.read_reply() == "V1.1" and len(reads) == 1
+        with pytest.raises(p.ReplyTimeout, match="ERR"):
+            gw.read_reply(timeout=0.05)
+
+
 def test_pipeline_is_run(fake):
     """Replies in order, ERROR replies as text; after an ERROR reply a marker
     checks that no extra line took a request's place (Gateway.run)."""

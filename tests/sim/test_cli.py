@@ -38,6 +38,23 @@ def test_request_command(board_name):
                                  " (no device, bus not to be had, register not readable)\n")
 
 
+@pytest.mark.parametrize("rate", [230400, 460800])
+def test_commands_at_the_fast_rates(rate):
+    """`--baud` sets the port's rate: a gateway built for 230400 or 460800
+    answers `orfa` at it, and says nothing to 115200."""
+    from conftest import build_gateway
+    require_builds(["m128s"])
+    with SimBoard("m128s", firmware=build_gateway("m128s", rate), trace=False) as sim:
+        result = orfa("request", "--port", sim.port, "--baud", str(rate),
+                      "V", "S AA 00 00 S AB 01 P")
+        assert (result.returncode, result.stdout, result.stderr) == (0, "V1.1\nSWAASR06P\n", "")
+        result = orfa("--baud", str(rate), "version", "--port", sim.port)
+        assert (result.returncode, result.stderr) == (0, "")
+        assert result.stdout.startswith("protocol 1.1\nboard    m128s")
+        result = orfa("version", "--port", sim.port, "--timeout", "0.5")
+        assert result.returncode == 1 and result.stderr.startswith("orfa: no reply line")
+
+
 def test_request_refused_on_the_host():
     result = orfa("request", "--port", "loop://", "V" * 129)
     assert result.returncode == 1

@@ -90,6 +90,21 @@ def test_a_gateway_at_a_rate_termios_has_no_name_for(get_drivers):
         sim.stop()
 
 
+@pytest.mark.parametrize("board, rate", [("m32d", 230400), ("m32d", 460800), ("m128s", 460800)])
+def test_a_gateway_at_the_fast_rates(get_drivers, board, rate):
+    """ORFA_BAUD=230400/460800: B230400 and B460800 (termios's names)."""
+    from conftest import build_gateway
+    require_builds([board])
+    sim = SimBoard(board, firmware=build_gateway(board, rate), trace=False).start()
+    try:
+        r = subprocess.run([str(EXAMPLE), sim.port], capture_output=True, text=True,
+                           timeout=PROG_TIMEOUT, env=dict(os.environ, ORFA_BAUD=str(rate)))
+        assert (r.returncode, r.stderr) == (0, "")
+        assert r.stdout == listing(boardmap.load(board).drivers)
+    finally:
+        sim.stop()
+
+
 @pytest.mark.parametrize("value", ["fast", "0", "-9600", "9600x"])
 def test_bad_orfa_baud(get_drivers, value):
     r = subprocess.run([str(EXAMPLE), "/nonexistent/tty"], capture_output=True, text=True,
