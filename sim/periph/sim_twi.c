@@ -127,6 +127,7 @@ static void twi_go(sim_twi_t *t, avr_cycle_count_t b)
 		t->lost = 0;
 		t->fault = (uint8_t)twi_fault_here(&t->bus->fault, &bit);
 		t->fault_bit = (uint8_t)bit;
+		t->bus->in_byte = &t->master;
 		twi_bus_byte(t->bus, b, b + 18 * t->half);
 	}
 	twi_at(t, b + t->half / 2, M_LOW);
@@ -248,17 +249,47 @@ static void twi_arb_lost(sim_twi_t *t, avr_cycle_count_t when)
 	twi_done(t, TW_MT_ARB_LOST);
 }
 
-/* A glitch in the bit under way, at WHEN: the condition to every device,
- * and a bus error for this TWI, which lets the lines go (TWINT with 0x00;
- * TWSTO or TWEN off recovers). */
-static void twi_glitch(sim_twi_t *t, avr_cycle_count_t when)
+/* This master's byte is over (done, cut): the lines' conditions are no
+ * longer its bus error. */
+static void twi_byte_over(sim_twi_t *t)
 {
-	twi_bus_glitch(t->bus, when, t->fault == TWI_FAULT_START);
+	if (t->bus->in_byte == &t->master) {
+		t->bus->in_byte = NULL;
+	}
+}
+
+/* A bus error at WHEN in the byte under way: the TWI lets the lines go
+ * and sets TWINT with 0x00 (TWSTO or TWEN off recovers). */
+static void twi_bus_error(sim_twi_t *t, avr_cycle_count_t when)
+{
 	trace_event(t->bus->trace, when, "twi bus-error");
 	t->owner = 0;
 	t->bus->clocked = 0;
 	twi_drive(t, 0, 0, when);
 	twi_done(t, TW_BUS_ERROR);
+}
+
+/* A glitch in the bit under way, at WHEN: the condition to every device,
+ * and this TWI's bus error. */
+static void twi_glitch(sim_twi_t *t, avr_cycle_count_t when)
+{
+	twi_byte_over(t);
+	twi_bus_glitch(t->bus, when, t->fault == TWI_FAULT_START);
+	twi_bus_error(t, when);
+}
+
+/* A START or STOP on the lines at CYCLE while this master clocks a byte
+ * (another driver moved SDA with SCL high): its bus error, as the
+ * datasheet's TWI detects it. */
+static void twi_master_condition(twi_bus_master_t *m, uint64_t cycle)
+{
+	sim_twi_t *t = (sim_twi_t *)((char *)m - offsetof(sim_twi_t, master));
+
+	avr_cycle_timer_cancel(t->avr, twi_timer, t);
+	twi_bus_cancel(t->bus, &t->master);
+	t->waiting = TWI_WAIT_NONE;
+	twi_bus_drive(t->bus, &t->bus->rival_drv, 0, 0, cycle);
+	twi_bus_error(t, cycle);
 }
 
 static void twi_master_resume(twi_bus_master_t *m, uint64_t cycle)
@@ -282,6 +313,7 @@ static void twi_byte_done(sim_twi_t *t, avr_cycle_count_t when)
 {
 	uint8_t *twdr = twi_reg(t, t->regs->twdr);
 
+	twi_byte_over(t);
 	switch (t->op) {
 	case TWI_OP_SLA:
 		twi_bus_note_addr(t->bus, when, t->line_byte, t->line_ack);
@@ -415,6 +447,7 @@ static void twi_master_off(sim_twi_t *t)
 	avr_cycle_timer_cancel(t->avr, twi_timer, t);
 	twi_bus_cancel(t->bus, &t->master);
 	t->waiting = TWI_WAIT_NONE;
+	twi_byte_over(t);
 	t->bus->abort = in_byte;
 	twi_drive(t, 0, t->drv.scl_low, t->avr->cycle);
 	twi_drive(t, 0, 0, t->avr->cycle);
@@ -831,6 +864,7 @@ void sim_twi_init(sim_twi_t *t, avr_t *avr, const sim_mcu_twi_t *regs, twi_bus_t
 	t->io.kind = "orfa-twi";
 	t->io.reset = twi_reset;
 	t->master.resume = twi_master_resume;
+	t->master.condition = twi_master_condition;
 	t->dev.ops = &twi_dev_ops;
 	t->dev.name = "avr-twi";
 	twi_bus_attach(bus, &t->dev);

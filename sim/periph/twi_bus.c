@@ -86,8 +86,14 @@ static void twi_bus_edge(twi_bus_t *bus, int scl_line, uint64_t cycle)
 	}
 	if (!scl_line && bus->scl) {
 		/* SDA changed with SCL high: START (falling) or STOP (rising) */
+		twi_bus_master_t *m = bus->in_byte;
+
 		for (twi_dev_t *d = bus->devs; d; d = d->next) {
 			i2c_phy_condition(bus, d, !bus->sda);
+		}
+		if (m) {
+			bus->in_byte = NULL;
+			m->condition(m, cycle);
 		}
 	} else if (bus->nactive) {
 		for (twi_dev_t *d = bus->devs; d; d = d->next) {

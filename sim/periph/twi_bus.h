@@ -106,6 +106,9 @@ struct twi_dev_t {
  * (twi_bus_wait) came, with the cycle it came at. */
 typedef struct twi_bus_master_t {
 	void (*resume)(struct twi_bus_master_t *m, uint64_t cycle);
+	/* A START or STOP the lines carried at CYCLE while it clocked a byte
+	 * (twi_bus_t.in_byte): its bus error. */
+	void (*condition)(struct twi_bus_master_t *m, uint64_t cycle);
 } twi_bus_master_t;
 
 /* What a master waits for. */
@@ -158,6 +161,9 @@ typedef struct twi_bus_t {
 	 * and the rival's pull on SDA (twi_fault.h) */
 	twi_fault_t fault;
 	twi_drv_t rival_drv;
+	/* the master clocking an address or data byte (NULL: none), told of
+	 * a START or STOP the lines carry meanwhile */
+	twi_bus_master_t *in_byte;
 
 	twi_line_fn listener[TWI_BUS_LISTENERS];
 	void *listener_param[TWI_BUS_LISTENERS];

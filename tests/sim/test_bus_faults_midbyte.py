@@ -354,3 +354,44 @@ def test_a_logic_analyzer_sees_the_rivals_bit():
     assert decoded == trace
     assert ("DW", 0x03, 1) in decoded and ("AR", 0x0F >> 1, 0) in decoded
     assert decoded.count("P") == 1
+
+
+# --- a START the lines themselves carry --------------------------------------
+
+def test_a_start_on_the_lines_in_a_byte_is_a_bus_error(rb):
+    """A device that pulls SDA low while SCL is high, in the middle of a
+    bit the gateway sends high, makes a real START on the lines (no glitch
+    involved): the gateway's TWI and the slave's see the bus error as the
+    datasheet's TWI detects it (ERROR 07, the write dropped). At the
+    slowest clock (C0001, an SCL period of 7447 cycles) so the pull lands
+    in the high half of byte 4's bit 1 (DC: a 1) however long the slave
+    stretched before it."""
+    b = rb
+    ctl = b.sim.control
+    req = (servo_write(M128S) + "\n").encode()
+    try:
+        assert b.ask("C0001") == b"C0000\r\n"
+        # where that bit's SCL high half is, from a run not cut
+        start = int(ctl.requests(["time", "rx +%d %s" % (LEAD, req.hex().upper())])[0])
+        assert b.read_lines(1) == b"SWAAAAAAAP\r\n"
+        rises = [c for c, lvl in ctl.edges("scl", start) if lvl == 1]
+        falls = [c for c, lvl in ctl.edges("scl", start) if lvl == 0]
+        rise = rises[9 * 4 + 1]
+        fall = next(c for c in falls if c > rise)
+        clear(b, M128S)
+        mark = b.mark()
+        out = ctl.requests(["time", "rx +%d %s" % (LEAD, req.hex().upper()),
+                            "wait %d" % ((rise + fall) // 2 - start),
+                            "i2c stuck 1"])
+        assert b.read_lines(1) == b"ERROR 07\r\n"
+        ev = [(e.kind,) + e.fields for e in b.events(mark, ["twi"])]
+        assert ("twi line", "SDA", "0") in ev and ("twi bus-error",) in ev, ev
+        assert ("twi bus-error", "%02X" % M128S) in ev and not any(
+            e[0] == "twi glitch" for e in ev), ev
+        # the device lets go (SCL high: a STOP, after the frame was dropped)
+        ctl.i2c_stuck(0)
+        assert status(b, M128S) == DROPPED
+        applied_nothing(b, M128S, int(out[0]))
+    finally:
+        ctl.i2c_stuck(0)
+        assert b.ask("C0064") == b"C0063\r\n"
