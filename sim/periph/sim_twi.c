@@ -106,6 +106,42 @@ static void twi_wait(sim_twi_t *t, twi_wait_t what, avr_cycle_count_t now)
 	twi_bus_wait(t->bus, &t->master, &t->drv, what, now);
 }
 
+/* Whether the master pulls SDA low in the low half of the bit under way. */
+static int twi_low_sda(const sim_twi_t *t)
+{
+	switch (t->op) {
+	case TWI_OP_START:
+		return 0;
+	case TWI_OP_STOP:
+	case TWI_OP_STOP_START:
+		return 1;
+	case TWI_OP_RX:
+		return t->bit == 8 && t->op_ack;
+	default:
+		/* after a lost bit the master sends nothing (1s) */
+		return !t->lost && t->bit < 8 && !(t->byte & (0x80 >> t->bit));
+	}
+}
+
+/* The rival (`i2c arb`, twi_fault.h) acts in the bit under way. */
+static int twi_rival_bit(const sim_twi_t *t)
+{
+	return t->fault == TWI_FAULT_ARB && t->bit == t->fault_bit;
+}
+
+/* A bit's SCL low half began at cycle B: SDA changes a quarter period on
+ * (a step only when it changes: an edge-less step costs as much), SCL is
+ * let go half a period on. */
+static void twi_low_half(sim_twi_t *t, avr_cycle_count_t b)
+{
+	t->bit_at = b;
+	if (twi_low_sda(t) != t->drv.sda_low || twi_rival_bit(t)) {
+		twi_at(t, b + t->half / 2, M_LOW);
+	} else {
+		twi_at(t, b + t->half, M_RISE);
+	}
+}
+
 /* The operation begins on the lines at cycle B. */
 static void twi_go(sim_twi_t *t, avr_cycle_count_t b)
 {
@@ -130,7 +166,7 @@ static void twi_go(sim_twi_t *t, avr_cycle_count_t b)
 		t->bus->in_byte = &t->master;
 		twi_bus_byte(t->bus, b, b + 18 * t->half);
 	}
-	twi_at(t, b + t->half / 2, M_LOW);
+	twi_low_half(t, b);
 }
 
 /* The firmware asked for the operation at cycle NOW: begin when the bus
@@ -216,7 +252,7 @@ static void twi_high(sim_twi_t *t, avr_cycle_count_t h)
  * at WHEN (ON), or lets it go when it ends. */
 static void twi_rival(sim_twi_t *t, int on, avr_cycle_count_t when)
 {
-	if (t->fault == TWI_FAULT_ARB && t->bit == t->fault_bit) {
+	if (twi_rival_bit(t)) {
 		twi_bus_drive(t->bus, &t->bus->rival_drv, on, 0, when);
 	}
 }
@@ -366,29 +402,13 @@ static void twi_stop_done(sim_twi_t *t, avr_cycle_count_t when)
 static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *param)
 {
 	sim_twi_t *t = param;
-	int low;
 
 	(void)avr;
 	/* The lines get the exact cycle, not the one simavr called us at. */
 	when = t->step_at;
 	switch (t->step) {
 	case M_LOW:
-		switch (t->op) {
-		case TWI_OP_START:
-			low = 0;
-			break;
-		case TWI_OP_STOP:
-		case TWI_OP_STOP_START:
-			low = 1;
-			break;
-		case TWI_OP_RX:
-			low = t->bit == 8 && t->op_ack;
-			break;
-		default:
-			low = !t->lost && t->bit < 8 && !(t->byte & (0x80 >> t->bit));
-			break;
-		}
-		twi_drive(t, low, 1, when);
+		twi_drive(t, twi_low_sda(t), 1, when);
 		twi_rival(t, 1, when);
 		twi_at(t, t->bit_at + t->half, M_RISE);
 		break;
@@ -420,8 +440,7 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 			twi_done(t, t->owner ? TW_REP_START : TW_START);
 			t->owner = 1;
 		} else if (++t->bit < 9) {
-			t->bit_at = when;
-			twi_at(t, when + t->half / 2, M_LOW);
+			twi_low_half(t, when);
 		} else {
 			twi_byte_done(t, when);
 		}
