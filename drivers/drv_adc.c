@@ -47,19 +47,16 @@ reg_status_t drv_adc_write(uint8_t reg, const uint8_t *data, uint8_t len)
 			return REG_PIN_BUSY;
 		}
 	}
+	uint8_t giving = adc_cfg.mask & (uint8_t)~mask;
 	for (uint8_t ch = 0; ch < 8; ch++) {
 		if (taking & (1u << ch)) {
 			pins_claim((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC);
+		} else if (giving & (1u << ch)) {
+			pins_release((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC);
 		}
 	}
 	port_io_dir(ADC_PORT, taking, 0);
 	port_io_write(ADC_PORT, taking, 0);
-	uint8_t giving = adc_cfg.mask & (uint8_t)~mask;
-	for (uint8_t ch = 0; ch < 8; ch++) {
-		if (giving & (1u << ch)) {
-			pins_release((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC);
-		}
-	}
 	uint8_t ref = settings & ADC_SET_REF_MASK;
 	adc_hw_config(ref >= 2 ? 3 : ref, mask);
 	adc_cfg.settings = settings;

@@ -47,14 +47,12 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	if (len % 3 != 0 || len > 3 * SERVO_MAX_TRIPLES) {
 		return REG_BAD_LENGTH;
 	}
-	for (uint8_t i = 0; i < len; i += 3) {
-		if (data[i] >= SERVO_CHANNELS) {
-			return REG_BAD_VALUE;
-		}
-	}
 	uint16_t next[SERVO_CHANNELS];
 	memcpy(next, servo.width, sizeof next);
 	for (uint8_t i = 0; i < len; i += 3) {
+		if (data[i] >= SERVO_CHANNELS) {
+			return REG_BAD_VALUE;  /* nothing applied yet: next is a copy */
+		}
 		next[data[i]] = servo_clamp((uint16_t)(data[i + 1] << 8 | data[i + 2]));
 	}
 	/* Only the channels written can change: the loops below go over the

@@ -4,7 +4,6 @@
 #include "drivers/spi_hw.h"
 #include "firmware/board_pins.h"
 #include "firmware/pins.h"
-#include "firmware/port_io.h"
 
 #define SPI_REG_DATA 0
 #define SPI_REG_CONFIG 1
@@ -81,8 +80,7 @@ static reg_status_t spi_config(const uint8_t *data, uint8_t len)
 		pins_release(spi.cs[ch], PIN_SPI_CS);
 	}
 	spi.cs[ch] = pin;
-	port_io_write(PIN_PORT(pin), PIN_MASK(pin), PIN_MASK(pin));  /* deselected */
-	port_io_dir(PIN_PORT(pin), PIN_MASK(pin), PIN_MASK(pin));
+	pins_drive(pin, true);  /* deselected */
 	return REG_OK;
 }
 
@@ -103,9 +101,9 @@ static reg_status_t spi_data(const uint8_t *data, uint8_t len)
 	for (uint8_t i = 0; i < n; i++) {
 		spi.rx[i] = data[1 + i];
 	}
-	port_io_write(PIN_PORT(pin), PIN_MASK(pin), 0);
+	pins_level(pin, false);
 	spi_hw_exchange(spi.rx, n);
-	port_io_write(PIN_PORT(pin), PIN_MASK(pin), PIN_MASK(pin));
+	pins_level(pin, true);
 	spi.rx_len = n;
 	return REG_OK;
 }

@@ -10,7 +10,6 @@
 
 #include "firmware/board_pins.h"
 #include "firmware/pins.h"
-#include "firmware/port_io.h"
 
 #define MOTOR_TOP 367  /* 368 timer cycles per PWM period */
 
@@ -23,10 +22,14 @@ void motor_hw_init(void)
 	motor_hw_apply(zero, zero, 0x03);
 }
 
-/* High for OCR+1 of 368 cycles: OCR = round(pwm * 368 / 255) - 1. */
+/* High for OCR+1 of 368 cycles: OCR = round(pwm * 368 / 255) - 1, with
+ * 368 = 255 + 113 taken apart so the division is 16-bit (no 32-bit
+ * division linked): pwm * 255 divides exactly. */
+_Static_assert(MOTOR_TOP + 1 >= 255 && 255u * (MOTOR_TOP + 1 - 255) + 127u <= 0xFFFFu,
+	       "pwm * (368 - 255) + 127 fits 16 bits");
 static uint16_t motor_ocr(uint8_t pwm)
 {
-	return (uint16_t)(((uint32_t)pwm * (MOTOR_TOP + 1) + 127) / 255 - 1);
+	return (uint16_t)(pwm + (uint16_t)(pwm * (uint16_t)(MOTOR_TOP + 1 - 255) + 127u) / 255u - 1);
 }
 
 void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
@@ -59,16 +62,14 @@ void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
 	}
 	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
 		uint8_t d = board_pin(BF_MOTOR_DIR, m);
-		port_io_write(PIN_PORT(d), PIN_MASK(d), dir[m] ? PIN_MASK(d) : 0);
-		port_io_dir(PIN_PORT(d), PIN_MASK(d), PIN_MASK(d));
+		pins_drive(d, dir[m]);
 		if (lines & (1u << m)) {
 			/* 0 and 255 are steady levels from the port with the compare
 			 * output disconnected: at OCR 0 the output would still spike
 			 * once a period, and OCR = TOP relies on compare and overflow
 			 * meeting in the same cycle. */
 			uint8_t p = board_pin(BF_MOTOR_PWM, m);
-			port_io_write(PIN_PORT(p), PIN_MASK(p), pwm[m] == 255 ? PIN_MASK(p) : 0);
-			port_io_dir(PIN_PORT(p), PIN_MASK(p), PIN_MASK(p));
+			pins_drive(p, pwm[m] == 255);
 		}
 	}
 }

@@ -38,7 +38,6 @@
 #include "firmware/board_pins.h"
 #include "firmware/mcu.h"
 #include "firmware/pins.h"
-#include "firmware/port_io.h"
 
 #define SERVO_TICK_HZ (F_CPU / 8)           /* 921.6 kHz */
 #define SERVO_FRAME   18432u                /* 20 ms in ticks */
@@ -192,15 +191,13 @@ void servo_hw_init(void)
 	for (uint8_t c = 0; c < SERVO_COUNTERS; c++) {
 		uint8_t pin = board_pin(BF_SERVO_CLK, c);
 		pins_claim(pin, PIN_SERVO_CLK);
-		port_io_write(PIN_PORT(pin), PIN_MASK(pin), 0);
-		port_io_dir(PIN_PORT(pin), PIN_MASK(pin), PIN_MASK(pin));
+		pins_drive(pin, false);
 	}
 	uint8_t rst = board_pin(BF_SERVO_RST, 0);
 	pins_claim(rst, PIN_SERVO_CLK);
 	pulses.rst_port = mcu_port(PIN_PORT(rst)).port;
 	pulses.rst_mask = PIN_MASK(rst);
-	port_io_write(PIN_PORT(rst), pulses.rst_mask, pulses.rst_mask);
-	port_io_dir(PIN_PORT(rst), pulses.rst_mask, pulses.rst_mask);
+	pins_drive(rst, true);
 	/* Timer1 and Timer3: normal mode, clk/8, started together. */
 	SFIOR = _BV(TSM) | _BV(PSR321);
 	TCCR1A = 0;

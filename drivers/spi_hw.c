@@ -9,8 +9,8 @@
 static void spi_pin(board_fn_t fn, uint8_t output, uint8_t level)
 {
 	uint8_t pin = board_pin(fn, 0);
-	port_io_write(PIN_PORT(pin), PIN_MASK(pin), level ? PIN_MASK(pin) : 0);
-	port_io_dir(PIN_PORT(pin), PIN_MASK(pin), output ? PIN_MASK(pin) : 0);
+	pins_level(pin, level);
+	port_io_dir(PIN_PORT(pin), PIN_MASK(pin), output ? 0xFF : 0);
 }
 
 void spi_hw_init(void)

@@ -41,18 +41,27 @@ void pins_release(uint8_t pin, pin_owner_t who)
 	if (owner[pin] != who) {
 		return;
 	}
-	uint8_t port = PIN_PORT(pin);
-	uint8_t mask = PIN_MASK(pin);
 	if (who == PIN_SERVO && board_pin_has(pin, BF_MOTOR_PWM)) {
 		/* Lent by a stopped motor: back to it, driven low. */
 		owner[pin] = PIN_MOTOR_IDLE;
-		port_io_write(port, mask, 0);
-		port_io_dir(port, mask, mask);
+		pins_drive(pin, false);
 		return;
 	}
 	owner[pin] = PIN_FREE;
-	port_io_dir(port, mask, 0);
-	port_io_write(port, mask, 0);
+	port_io_dir(PIN_PORT(pin), PIN_MASK(pin), 0);
+	pins_level(pin, false);
+}
+
+void pins_level(uint8_t pin, bool high)
+{
+	uint8_t mask = PIN_MASK(pin);
+	port_io_write(PIN_PORT(pin), mask, high ? mask : 0);
+}
+
+void pins_drive(uint8_t pin, bool high)
+{
+	pins_level(pin, high);
+	port_io_dir(PIN_PORT(pin), PIN_MASK(pin), 0xFF);
 }
 
 pin_owner_t pins_owner(uint8_t pin)

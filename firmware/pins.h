@@ -48,6 +48,14 @@ void pins_release(uint8_t pin, pin_owner_t who);
 
 pin_owner_t pins_owner(uint8_t pin);
 
+/* The pin's output latch high or low (a level when it is an output, the
+ * pull-up when an input). */
+void pins_level(uint8_t pin, bool high);
+
+/* The pin an output at that level: the latch first, so it never shows the
+ * other one. */
+void pins_drive(uint8_t pin, bool high);
+
 /* The lines of `port` that GPIO may change. */
 uint8_t pins_gpio_mask(uint8_t port);
 

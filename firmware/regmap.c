@@ -64,12 +64,12 @@ static const ORFA_FLASH uint8_t regmap_records[][REGMAP_RECORD_LEN] = {
 
 /* selected.entry when no register is selected (after an unmapped one). */
 #define REGMAP_NO_ENTRY 0xFF
-_Static_assert(REGMAP_NDRIVERS < REGMAP_NO_ENTRY, "a driver index is never 0xFF");
 
 /* The register that reads and writes go to, and how the last one ended. */
 static struct {
 	uint8_t reg;     /* selected register */
-	uint8_t entry;   /* its driver's index in regmap_table, or REGMAP_NO_ENTRY */
+	uint8_t entry;   /* its driver's row's offset in regmap_table, or REGMAP_NO_ENTRY */
+	uint8_t off;     /* the register's number within its driver */
 	uint8_t status;  /* result of the last write or read that reached a driver */
 } selected;
 
@@ -80,7 +80,19 @@ void regmap_init(void)
 	}
 	selected.reg = REGMAP_INTRO_REG;
 	selected.entry = 0;
+	selected.off = 0;
 	selected.status = REG_OK;
+}
+
+/* The selected driver's row: its offset in the table kept as a byte at
+ * selection (an index times 8 as a 16-bit product was a shift loop on
+ * every call, on the latency path of every local request). */
+_Static_assert((REGMAP_NDRIVERS - 1) * sizeof(regmap_entry_t) < REGMAP_NO_ENTRY,
+	       "a row's offset in the table fits a byte, never REGMAP_NO_ENTRY");
+static const ORFA_FLASH regmap_entry_t *regmap_row(void)
+{
+	return (const ORFA_FLASH regmap_entry_t *)((const ORFA_FLASH uint8_t *)regmap_table +
+						   selected.entry);
 }
 
 bool regmap_select(uint8_t reg)
@@ -97,7 +109,8 @@ bool regmap_select(uint8_t reg)
 		i++;
 	}
 	selected.reg = reg;
-	selected.entry = i;
+	selected.entry = (uint8_t)(i * sizeof(regmap_entry_t));
+	selected.off = (uint8_t)(reg - regmap_starts[i]);
 	return true;
 }
 
@@ -109,8 +122,7 @@ reg_status_t regmap_check(const uint8_t *data, uint8_t len)
 	if (selected.reg == REGMAP_STATUS_REG) {
 		return REG_NOT_WRITABLE;
 	}
-	const ORFA_FLASH regmap_entry_t *e = &regmap_table[selected.entry];
-	return e->check((uint8_t)(selected.reg - regmap_starts[selected.entry]), data, len);
+	return regmap_row()->check(selected.off, data, len);
 }
 
 reg_status_t regmap_write(const uint8_t *data, uint8_t len)
@@ -122,8 +134,7 @@ reg_status_t regmap_write(const uint8_t *data, uint8_t len)
 	} else if (selected.reg == REGMAP_STATUS_REG) {
 		st = REG_NOT_WRITABLE;
 	} else {
-		const ORFA_FLASH regmap_entry_t *e = &regmap_table[selected.entry];
-		st = e->write((uint8_t)(selected.reg - regmap_starts[selected.entry]), data, len);
+		st = regmap_row()->write(selected.off, data, len);
 	}
 	selected.status = st;
 	return st;
@@ -148,8 +159,7 @@ uint8_t regmap_read(uint8_t *dst, uint8_t max)
 		}
 		return max;
 	}
-	const ORFA_FLASH regmap_entry_t *e = &regmap_table[selected.entry];
-	uint8_t got = e->read((uint8_t)(selected.reg - regmap_starts[selected.entry]), dst, max);
+	uint8_t got = regmap_row()->read(selected.off, dst, max);
 	if (got == 0) {  /* (a driver gives at most max: tests/unit checks each) */
 		selected.status = REG_NOT_READABLE;
 		return 0;

@@ -59,6 +59,21 @@ reg_status_t drv_sys_check(uint8_t reg, const uint8_t *data, uint8_t len)
 	return len > SYS_REG_LEN(reg) ? REG_BAD_LENGTH : REG_OK;
 }
 
+/* ceil(ms * CLOCK_HZ / 1000) in 16 bits (no 32-bit division linked): the
+ * ticks a millisecond, TICKS_NUM / TICKS_DEN, as a whole part and a
+ * remainder, whose product with the longest FAILSAFE fits. */
+#define SYS_TICKS_NUM ((uint16_t)(CLOCK_HZ / 200u))
+#define SYS_TICKS_DEN 5u
+_Static_assert(CLOCK_HZ % 200u == 0, "ticks a millisecond: CLOCK_HZ / 200 fifths");
+_Static_assert((uint32_t)SYS_FAILSAFE_MAX_MS * (SYS_TICKS_NUM % SYS_TICKS_DEN) + SYS_TICKS_DEN
+	       <= 0xFFFFu, "the remainder's product fits 16 bits");
+static uint16_t sys_ticks_up(uint16_t ms)
+{
+	uint16_t whole = (uint16_t)(SYS_TICKS_NUM / SYS_TICKS_DEN);
+	uint16_t part = (uint16_t)(SYS_TICKS_NUM % SYS_TICKS_DEN);
+	return (uint16_t)(ms * whole + (uint16_t)(ms * part + SYS_TICKS_DEN - 1u) / SYS_TICKS_DEN);
+}
+
 reg_status_t drv_sys_write(uint8_t reg, const uint8_t *data, uint8_t len)
 {
 	if (len != SYS_REG_LEN(reg)) {
@@ -76,7 +91,7 @@ reg_status_t drv_sys_write(uint8_t reg, const uint8_t *data, uint8_t len)
 	/* Rounded up, and one tick more: the clock is read in whole ticks, so
 	 * the request may have come up to a tick after the one counted from.
 	 * Never early, at most two ticks (0.56 ms) late. */
-	sys.ticks = ms ? (uint16_t)(((uint32_t)ms * CLOCK_HZ + 999u) / 1000u + 1u) : 0;
+	sys.ticks = ms ? (uint16_t)(sys_ticks_up(ms) + 1u) : 0;
 	sys.last = clock_now();
 	sys.tripped = 0;
 	sys_heard = 0;

@@ -77,7 +77,8 @@ static twi_result_t twi_abandon(void)
 void twi_init(void)
 {
 	TWCR = _BV(TWEN);
-	twi_set_khz(100);
+	/* The rate is the front end's to set (sg_exec_init: the one
+	 * default, SG_KHZ_DEFAULT), before any transfer. */
 	/* This board may have reset in the middle of a frame. */
 	twi_fence_up();
 }
@@ -100,7 +101,7 @@ uint16_t twi_set_khz(uint16_t khz)
  * that gets nowhere abandons the transaction, so the next request starts
  * clean. The watchdog is fed only when the bus made progress: a wait that
  * never ends cannot keep a hung board alive. */
-static bool twi_wait_for(uint8_t mask, uint8_t want)
+static inline __attribute__((always_inline)) bool twi_wait_here(uint8_t mask, uint8_t want)
 {
 	uint8_t t0 = clock_now8();
 	while ((TWCR & mask) != want) {
@@ -111,6 +112,11 @@ static bool twi_wait_for(uint8_t mask, uint8_t want)
 	}
 	wdt_reset();
 	return true;
+}
+
+static bool twi_wait_for(uint8_t mask, uint8_t want)
+{
+	return twi_wait_here(mask, want);
 }
 
 /* Waits for TWINT; false on timeout. */
@@ -155,30 +161,45 @@ twi_result_t twi_start(uint8_t addr8)
 	}
 }
 
-twi_result_t twi_write(uint8_t byte)
+/* The bytes of a frame loop here, each the next step as soon as the last
+ * one's TWINT is seen: a slave's bus time counts every cycle between two
+ * (make bench, "bus time % of wire"). */
+twi_result_t twi_write_bytes(const uint8_t *data, uint8_t n)
 {
-	if (!twi_send(byte)) {
-		return TWI_FAIL;
+	for (; n; n--) {
+		if (!twi_send(*data++)) {
+			return TWI_FAIL;
+		}
+		uint8_t st = TW_STATUS;
+		if (st != TW_MT_DATA_ACK) {
+			return st == TW_MT_DATA_NACK ? TWI_NACK : twi_abandon();
+		}
 	}
-	switch (TW_STATUS) {
-	case TW_MT_DATA_ACK:
-		return TWI_ACK;
-	case TW_MT_DATA_NACK:
-		return TWI_NACK;
-	default:
-		return twi_abandon();
-	}
+	return TWI_ACK;
 }
 
-twi_result_t twi_read(uint8_t *byte, bool ack)
+twi_result_t twi_read_bytes(uint8_t *data, uint8_t n)
 {
-	TWCR = _BV(TWINT) | _BV(TWEN) | (ack ? _BV(TWEA) : 0);
-	if (!twi_wait()) {
-		return TWI_FAIL;
+	while (n) {
+		/* acknowledged but the last: the slave sends no more */
+		uint8_t cr = _BV(TWINT) | _BV(TWEN) | _BV(TWEA);
+		uint8_t want = TW_MR_DATA_ACK;
+		if (!--n) {
+			cr = _BV(TWINT) | _BV(TWEN);
+			want = TW_MR_DATA_NACK;
+		}
+		TWCR = cr;
+		/* waited for here, not through a call: the next byte's step
+		 * follows TWINT sooner */
+		if (!twi_wait_here(_BV(TWINT), _BV(TWINT))) {
+			return TWI_FAIL;
+		}
+		*data++ = TWDR;
+		if (TW_STATUS != want) {
+			return twi_abandon();
+		}
 	}
-	*byte = TWDR;
-	uint8_t want = ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK;
-	return TW_STATUS == want ? TWI_ACK : twi_abandon();
+	return TWI_ACK;
 }
 
 bool twi_stop(void)

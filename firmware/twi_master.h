@@ -19,6 +19,7 @@ typedef enum {
 	TWI_FAIL,      /* bus error, arbitration lost or timeout: abandoned */
 } twi_result_t;
 
+/* The TWI on, the quiet fence up; twi_set_khz() then, before a transfer. */
 void twi_init(void);
 
 /* Sets the fastest SCL rate the TWI can make that is not above `khz` and
@@ -28,9 +29,12 @@ uint16_t twi_set_khz(uint16_t khz);
 /* START (or repeated START) and the address byte (8-bit form, bit 0 = read);
  * first waits out the quiet fence if it is up. */
 twi_result_t twi_start(uint8_t addr8);
-twi_result_t twi_write(uint8_t byte);
-/* Reads a byte; `ack` tells the slave more bytes are wanted. */
-twi_result_t twi_read(uint8_t *byte, bool ack);
+/* The n data bytes of a write frame, up to the first one not acknowledged
+ * (TWI_NACK) or a failed step (TWI_FAIL). */
+twi_result_t twi_write_bytes(const uint8_t *data, uint8_t n);
+/* The n data bytes of a read frame, each acknowledged but the last (the
+ * slave sends no more); TWI_FAIL when a step fails. */
+twi_result_t twi_read_bytes(uint8_t *data, uint8_t n);
 /* From the front end's idle loop: lets the quiet fence come down when its
  * time is over (cheap: one byte test while it is down). */
 void twi_idle(void);

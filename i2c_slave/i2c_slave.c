@@ -1,14 +1,16 @@
 /*
  * The I2C slave front end (MODE=slave): the TWI answers at ORFA_ADDR and
  * slave_fsm.c decides; this file only moves its decisions into TWCR/TWDR.
- * The interrupt does byte moves and quick checks only, with other
- * interrupts allowed; work that reaches a driver runs in
- * front_poll() while TWINT stays set, so the TWI holds SCL low (clock
- * stretching) and the master waits for it.
+ * The main loop polls the TWI (TWINT) and answers each event there: while
+ * TWINT is set the TWI holds SCL low (clock stretching) and the master
+ * waits, so the sooner the answer, the sooner the bus goes on. Polled, an
+ * answer costs no interrupt entry and exit (a TWI interrupt saved and
+ * restored 20 registers around every byte) and other interrupts (the
+ * M32-D's cycle-exact servo edges) are never held off by a bus byte. The
+ * main loop has nothing else to do but the link-loss failsafe.
  */
 #include "firmware/front.h"
 
-#include <avr/interrupt.h>
 #include <avr/io.h>
 #include <util/twi.h>
 
@@ -25,75 +27,76 @@
 _Static_assert((ORFA_ADDR & 1) == 0, "ADDR is the 8-bit form: even");
 _Static_assert(I2C_ADDR_OK(ORFA_ADDR), "ADDR is an I2C reserved address (firmware/i2c_addr.h)");
 
-/* Interrupt on, acknowledging: the TWI's resting state as a slave. */
-#define SLAVE_TWCR (_BV(TWEN) | _BV(TWIE) | _BV(TWEA))
+/* Enabled, acknowledging its address, no interrupt: the TWI's resting
+ * state as a slave. */
+#define SLAVE_TWCR (_BV(TWEN) | _BV(TWEA))
 
-static volatile uint8_t slave_deferred;
 /* Low byte of the clock tick of the last TWI event, or of the end of the
- * work it was deferred to (the master waited on us meanwhile). */
-static volatile uint8_t slave_seen;
+ * work it needed (the master waited on us meanwhile). */
+static uint8_t slave_seen;
 
-/* Has the open frame had no bus event for longer than a healthy master
- * leaves one? Its master abandoned it (twi_quiet.h). */
+/* No bus event for longer than a healthy master leaves between two? */
+static bool slave_quiet_since(void)
+{
+	return (uint8_t)(clock_now8() - slave_seen) > TWI_QUIET_DROP_TICKS;
+}
+
+/* Has the open frame gone so quiet? Its master abandoned it
+ * (twi_quiet.h). */
 static bool slave_quiet(void)
 {
-	return slave_fsm_in_frame() &&
-	       (uint8_t)(clock_now8() - slave_seen) > TWI_QUIET_DROP_TICKS;
+	return slave_fsm_in_frame() && slave_quiet_since();
 }
 
+/* The answer into TWDR/TWCR: TWINT written 1 lets the bus go on. */
 static void slave_apply(slave_action_t act, uint8_t byte)
 {
-	switch (act) {
-	case SLAVE_SEND:
+	/* the common answers tested first */
+	if (act == SLAVE_SEND) {
 		TWDR = byte;
 		TWCR = _BV(TWINT) | SLAVE_TWCR;
-		break;
-	case SLAVE_NACK:
-		TWCR = _BV(TWINT) | _BV(TWEN) | _BV(TWIE);
-		break;
-	case SLAVE_DEFER:
-		/* TWINT not written: it stays set and SCL stays low. */
-		slave_deferred = 1;
-		TWCR = _BV(TWEN) | _BV(TWEA);
-		break;
-	case SLAVE_RECOVER:
-		TWCR = _BV(TWINT) | _BV(TWSTO) | SLAVE_TWCR;
-		break;
-	default:
+	} else if (act == SLAVE_ACK || act == SLAVE_DEFER_ACK) {
 		TWCR = _BV(TWINT) | SLAVE_TWCR;
-		break;
+	} else if (act == SLAVE_NACK) {
+		TWCR = _BV(TWINT) | _BV(TWEN);
+	} else if (act == SLAVE_RECOVER) {
+		TWCR = _BV(TWINT) | _BV(TWSTO) | SLAVE_TWCR;
 	}
+	/* SLAVE_RESUME: the event was answered before its work */
 }
 
-/* Interruptible: the TWI's own interrupt is held off (TWIE clear) and
- * TWINT stays set, holding SCL, while other interrupts may come first (the
- * M32-D's cycle-exact servo edges must not wait for a bus byte). */
-ISR(TWI_vect)
+/* One TWI event (TWINT set), answered. */
+static void slave_event(void)
 {
-	/* TWIE off before interrupts are on again, or this one would come
-	 * back at once: TWINT is a level. Writing TWINT 0 leaves it set. */
-	TWCR = (uint8_t)(TWCR & ~(_BV(TWINT) | _BV(TWIE)));
-	uint8_t now = clock_now8();
-	uint8_t quiet = (uint8_t)(now - slave_seen);  /* ticks since the last event */
-	slave_seen = now;
-	sei();
 	uint8_t byte = TWDR;
 	uint8_t status = TW_STATUS;
-	/* Its own address (SLA+W or SLA+R) keeps the link alive; frames for
-	 * other addresses never reach here. */
-	if (status == TW_SR_SLA_ACK || status == TW_ST_SLA_ACK) {
-		SYS_HEARD();
-	}
 	/* The one event that applies a write (STOP or repeated START) ends
-	 * a frame gone quiet, however soon the main loop would have looked:
+	 * a frame gone quiet, however soon it comes after the quiet spell:
 	 * then it is dropped, not applied. (A START in the middle of a frame
 	 * is a repeated START to this TWI.) */
-	if (status == TW_SR_STOP && quiet > TWI_QUIET_DROP_TICKS) {
+	if (status == TW_SR_STOP && slave_quiet_since()) {
 		slave_fsm_drop();
 	}
 	slave_action_t act = slave_fsm_event(status, &byte);
-	cli();
+	if (act == SLAVE_DEFER) {
+		/* a driver's read answer: SCL held meanwhile */
+		act = slave_fsm_work(&byte);
+	}
 	slave_apply(act, byte);
+	if (act == SLAVE_DEFER_ACK) {
+		/* a write applied while the bus goes on: the next event
+		 * waits in TWINT until this one is done */
+		slave_fsm_work(&byte);
+	}
+	slave_seen = clock_now8();
+	/* Its own address (SLA+W or SLA+R) keeps the link alive; frames for
+	 * other addresses never reach here. Booked at once: the main loop
+	 * may go from event to event for a while. */
+	if (status == TW_SR_SLA_ACK || status == TW_ST_SLA_ACK) {
+		SYS_HEARD();
+		sys_poll();
+	}
+	slave_fsm_after();
 }
 
 void front_init(void)
@@ -105,27 +108,24 @@ void front_init(void)
 
 void front_poll(void)
 {
-	if (!slave_deferred) {
-		/* A master gone in the middle of a frame must not leave this
-		 * TWI addressed for good (a transmitter could hold SDA low):
-		 * start again, the frame dropped (a write is not applied).
-		 * Checked again with interrupts off: an event may just come. */
-		if (slave_quiet()) {
-			cli();
-			if (slave_quiet()) {
-				TWCR = 0;
-				slave_fsm_drop();
-				TWCR = SLAVE_TWCR;
-			}
-			sei();
+	/* TWINT first and often: a bus event waits for nothing else (the
+	 * failsafe and the quiet check are looked at when the bus has been
+	 * still for a thousand cycles or so, far more often than they need;
+	 * the keep-alive is booked by the event itself). */
+	uint8_t i = 0;
+	do {
+		if (TWCR & _BV(TWINT)) {
+			slave_event();
+			return;
 		}
-		sys_poll();  /* idle: the failsafe's turn */
-		return;
+	} while (--i);
+	/* A master gone in the middle of a frame must not leave this TWI
+	 * addressed for good (a transmitter could hold SDA low): start
+	 * again, the frame dropped (a write is not applied). */
+	if (slave_quiet()) {
+		TWCR = 0;
+		slave_fsm_drop();
+		TWCR = SLAVE_TWCR;
 	}
-	/* The interrupt is off until slave_apply() turns it on again. */
-	slave_deferred = 0;
-	uint8_t byte = 0xFF;
-	slave_action_t act = slave_fsm_work(&byte);
-	slave_seen = clock_now8();
-	slave_apply(act, byte);
+	sys_poll();  /* idle: the failsafe's turn */
 }

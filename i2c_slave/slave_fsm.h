@@ -19,7 +19,10 @@
  * Work that calls a driver (applying a write, a driver's read answer) is
  * never done in the interrupt: the event returns SLAVE_DEFER, TWINT stays
  * set so the TWI stretches SCL, and the main loop calls slave_fsm_work().
- * Everything else is a few byte moves.
+ * Applying a write needs nothing of the bus: SLAVE_DEFER_ACK lets the bus
+ * go on (the next address is acknowledged by the TWI alone) and holds the
+ * next event until the write is applied. Everything else is a few byte
+ * moves, with the bookkeeping after the answer (slave_fsm_after()).
  */
 #ifndef SLAVE_FSM_H
 #define SLAVE_FSM_H
@@ -37,6 +40,12 @@ typedef enum {
 	SLAVE_DEFER,    /* keep TWINT (SCL held low), turn the interrupt off;
 			 * the main loop calls slave_fsm_work() */
 	SLAVE_RECOVER,  /* bus error: TWSTO releases the lines, then as ACK */
+	SLAVE_DEFER_ACK, /* as SLAVE_ACK at once, but the interrupt stays off:
+			  * the main loop calls slave_fsm_work(), which says
+			  * SLAVE_RESUME (the next event waits, SCL held, until
+			  * then) */
+	SLAVE_RESUME,   /* from slave_fsm_work() after SLAVE_DEFER_ACK: the
+			 * interrupt on again, TWINT as it is */
 } slave_action_t;
 
 void slave_fsm_init(void);
@@ -54,8 +63,14 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte);
  * repeated START, refused byte or last byte yet). */
 bool slave_fsm_in_frame(void);
 
-/* The deferred work of the last SLAVE_DEFER; returns SLAVE_ACK or
- * SLAVE_SEND (with *byte) to release the bus with. */
+/* The deferred work of the last SLAVE_DEFER or SLAVE_DEFER_ACK; returns
+ * SLAVE_SEND (with *byte) to release the bus with, or SLAVE_RESUME. */
 slave_action_t slave_fsm_work(uint8_t *byte);
+
+/* After each answer, once the bus has it (the TWI's interrupt still off):
+ * in a read frame the byte the master reads next is taken ahead from what
+ * the driver answered already (never a driver call), so that its event
+ * sends it at once. */
+void slave_fsm_after(void);
 
 #endif

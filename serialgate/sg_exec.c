@@ -72,37 +72,30 @@ static uint8_t run_bus(uint8_t addr, uint8_t *data, uint8_t n)
 		/* no ACK, or the bus could not be had (held, lost, timeout) */
 		return SG_ERR_ADDR_NACK;
 	}
-	for (uint8_t i = 0; i < n; i++) {
-		if (addr & 1) {
-			r = twi_read(&data[i], (uint8_t)(i + 1) < n);
-		} else {
-			r = twi_write(data[i]);
-		}
-		if (r != TWI_ACK) {
-			/* refused, or the bus was lost or stuck after the
-			 * address was acknowledged */
-			return SG_ERR_DATA_NACK;
-		}
-	}
-	return SG_OK;
+	r = (addr & 1) ? twi_read_bytes(data, n) : twi_write_bytes(data, n);
+	/* refused, or the bus was lost or stuck after the address was
+	 * acknowledged */
+	return r == TWI_ACK ? SG_OK : SG_ERR_DATA_NACK;
 }
 
 static void run_i2c(sg_parser_t *p)
 {
-	uint8_t *buf = p->buf;
+	uint8_t *const end = p->buf + p->nbytes;
 	uint8_t err = SG_OK;
 	bool on_bus = false;
 
-	for (uint8_t i = 0; i < p->nbytes && err == SG_OK;) {
-		uint8_t addr = buf[i];
-		uint8_t n = buf[i + 1];
-		if ((addr & 0xFE) == gate.local) {
-			err = run_local(addr, &buf[i + 2], n);
+	/* frames as [addr][n][n bytes], walked with a pointer */
+	for (uint8_t *f = p->buf; f < end && err == SG_OK;) {
+		uint8_t addr = f[0];
+		uint8_t n = f[1];
+		uint8_t *data = f + 2;
+		f = data + n;
+		if ((uint8_t)(addr & 0xFE) == gate.local) {
+			err = run_local(addr, data, n);
 		} else {
 			on_bus = true;
-			err = run_bus(addr, &buf[i + 2], n);
+			err = run_bus(addr, data, n);
 		}
-		i = (uint8_t)(i + 2 + n);
 	}
 	/* A STOP that cannot be made leaves the last frame unfinished: its
 	 * slave drops it (twi_quiet.h), so the request failed. */
@@ -113,11 +106,15 @@ static void run_i2c(sg_parser_t *p)
 		out_error(err);
 		return;
 	}
-	for (uint8_t i = 0; i < p->nbytes;) {
-		uint8_t addr = buf[i];
-		uint8_t n = buf[i + 1];
-		uint8_t *data = &buf[i + 2];
+	/* A request has a frame at least (the parser's): the reply's first
+	 * byte leaves before anything else is looked at. */
+	uint8_t *f = p->buf;
+	do {
 		sg_out('S');
+		uint8_t addr = f[0];
+		uint8_t n = f[1];
+		uint8_t *data = f + 2;
+		f = data + n;
 		if (addr & 1) {
 			sg_out('R');
 			for (uint8_t k = 0; k < n; k++) {
@@ -129,8 +126,7 @@ static void run_i2c(sg_parser_t *p)
 				sg_out('A');
 			}
 		}
-		i = (uint8_t)(i + 2 + n);
-	}
+	} while (f < end);
 	sg_out('P');
 	out_end();
 }
@@ -153,6 +149,11 @@ void sg_exec(sg_parser_t *p)
 {
 	if (p->err != SG_OK) {
 		out_error(p->err);
+		return;
+	}
+	if (p->cmd == SG_CMD_I2C) {
+		/* first: the requests whose latency counts */
+		run_i2c(p);
 		return;
 	}
 	switch (p->cmd) {
@@ -184,9 +185,6 @@ void sg_exec(sg_parser_t *p)
 		out_hex((uint8_t)(gate.khz >> 8));
 		out_hex((uint8_t)gate.khz);
 		break;
-	case SG_CMD_I2C:
-		run_i2c(p);
-		return;
 	default:
 		out_error(SG_ERR_INTERNAL);
 		return;

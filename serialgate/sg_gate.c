@@ -36,7 +36,15 @@ void front_init(void)
 
 void front_poll(void)
 {
-	int16_t c = sg_rx_get();
+	/* A character is looked for a while (16 looks, a few hundred
+	 * cycles: nothing to autobaud's watch of the pin) before the idle
+	 * work: a request's end is taken within a few cycles of its
+	 * arrival, not after the rest of an idle round. */
+	int16_t c;
+	uint8_t spin = 16;
+	do {
+		c = sg_rx_get();
+	} while (c < 0 && --spin);
 	if (c < 0) {
 		if (!sg_rx_losing()) {
 			if (uart_line_poll()) {

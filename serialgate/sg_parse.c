@@ -29,7 +29,7 @@ static uint8_t hex_value(uint8_t c)
 	return NO_DIGIT;
 }
 
-static sg_event_t fail(sg_parser_t *p, uint8_t err)
+static __attribute__((noinline)) sg_event_t fail(sg_parser_t *p, uint8_t err)
 {
 	if (p->err == SG_OK) {
 		p->err = err;

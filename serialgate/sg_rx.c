@@ -99,18 +99,28 @@ void sg_rx_put(uint8_t c)
 	uint8_t head = rx.head;
 	uint8_t line = rx.line;
 
-	/* The common case first: a character inside a line, room to spare. */
-	if (c != '\r' && c != '\n' && !rx.losing &&
-		(uint8_t)(rx.tail - head - 1) > SG_RX_RECORD && (line & LINE_STARTED)) {
-		if (c != ' ') {
-			rx.line = line | LINE_CONTENT;
+	/* The common cases first, room to spare: a character inside a line,
+	 * and the end of a line that lost nothing (on the latency path of
+	 * every request). */
+	if (!rx.losing && (uint8_t)(rx.tail - head - 1) > SG_RX_RECORD) {
+		if (c == '\r' || c == '\n') {
+			if (!(line & LINE_LOST)) {
+				rx.line = 0;
+				rx.buf[head] = c;
+				rx.head = (uint8_t)(head + 1);
+				return;
+			}
+		} else if (line & LINE_STARTED) {
+			if (c != ' ') {
+				rx.line = line | LINE_CONTENT;
+			}
+			if (c >= SG_RX_MARK_LOST) {
+				c = 0x7F;
+			}
+			rx.buf[head] = c;
+			rx.head = (uint8_t)(head + 1);
+			return;
 		}
-		if (c >= SG_RX_MARK_LOST) {
-			c = 0x7F;
-		}
-		rx.buf[head] = c;
-		rx.head = (uint8_t)(head + 1);
-		return;
 	}
 	put_slow(c, head);
 }

@@ -53,6 +53,7 @@ typedef struct sim_t {
 	control_t control;
 	int idle_throttle;
 	int real_time;		/* --real-time: simulated time never ahead of wall time */
+	int no_park;			/* --no-park: run every board every quantum */
 } sim_t;
 
 static volatile sig_atomic_t sim_stop;
@@ -87,8 +88,8 @@ static void sim_usage(void)
 	fprintf(stderr,
 		"usage: orfa-sim --board %s --link PATH [--part KIND@ADDR[:OPTIONS]]...\n"
 		"                [--eeprom ADDR[:wp]]... [--srf08 ADDR]...\n"
-		"                [--trace FILE] [--no-idle-throttle] [--real-time] [--control PATH]\n"
-		"                [--vcd FILE] [--spi [SLAVE/]KIND@PIN[:mode=N][:lsb]]...\n"
+		"                [--trace FILE] [--no-idle-throttle] [--real-time] [--no-park]\n"
+		"                [--control PATH] [--vcd FILE] [--spi [SLAVE/]KIND@PIN[:mode=N][:lsb]]...\n"
 		"                [--adc CH=MV]... [--avcc MV] [--aref MV]\n"
 		"                [--slave BOARD:ADDR:ELF]... GATEWAY.elf\n"
 		"\n"
@@ -349,6 +350,7 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 		{ "trace", required_argument, NULL, 't' },
 		{ "no-idle-throttle", no_argument, NULL, 'n' },
 		{ "real-time", no_argument, NULL, 'r' },
+		{ "no-park", no_argument, NULL, 'N' },
 		{ "control", required_argument, NULL, 'c' },
 		{ "vcd", required_argument, NULL, 'v' },
 		{ "spi", required_argument, NULL, 's' },
@@ -391,6 +393,9 @@ static int sim_parse_args(sim_t *sim, sim_args_t *args, int argc, char **argv)
 			break;
 		case 'r':
 			sim->real_time = 1;
+			break;
+		case 'N':
+			sim->no_park = 1;
 			break;
 		case 'c':
 			args->control = optarg;
@@ -502,6 +507,7 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 	int rc;
 
 	world_init(w);
+	w->no_park = sim->no_park;
 	if (args->trace && trace_open(&w->trace, args->trace) < 0) {
 		fprintf(stderr, "orfa-sim: cannot write trace '%s': %s\n",
 			args->trace, strerror(errno));

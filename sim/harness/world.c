@@ -36,51 +36,123 @@ static int world_state_dead(int state)
 	return state == cpu_Done || state == cpu_Crashed;
 }
 
-/* One board alone needs no lock-step: the loop stays as tight as the
- * single-board simulator's always was. */
+/* One board alone needs no lock-step: it runs to TARGET at once, parked
+ * (park.h) wherever it idles, tried every WORLD_QUANTUM cycles. */
 static int world_run_one(world_t *w, uint64_t target)
 {
 	avr_t *avr = w->boards[0]->avr;
+	park_t *park = &w->park[0];
 
 	while (avr->cycle < target) {
-		int state = avr_run(avr);
+		uint64_t end = avr->cycle + WORLD_QUANTUM;
+		int state;
 
+		if (park->parked && park_stays(park, avr, target)) {
+			break;
+		}
+		if (w->no_park || end > target) {
+			end = target;
+		}
+		state = park_run(park, avr, end, !w->no_park);
 		if (world_state_dead(state)) {
 			w->dead = 0;
 			w->dead_state = state;
 			return 1;
 		}
 	}
+	if (park->parked) {
+		park_leave(park, avr);
+	}
 	w->now = avr->cycle;
 	return 0;
 }
 
+/* Every parked board leaves its loop: between runs the boards are as
+ * lock-step left them, for the control interface and the next run. */
+static void world_unpark(world_t *w)
+{
+	for (int i = 0; i < w->nboards; i++) {
+		if (w->park[i].parked) {
+			park_leave(&w->park[i], w->boards[i]->avr);
+		}
+	}
+}
+
+/* Every board parked with nothing pending: no board runs an instruction
+ * before the first timer any of them has, so nothing reaches any of them
+ * from another, and every quantum until then only moves their cycles.
+ * Those quanta are done at once: each board goes to the first boundary at
+ * or past the last of them (a boundary is at most 4 cycles past an end:
+ * the margin keeps it before every board's first timer). */
+#define WORLD_SKIP_MARGIN 8
+
+static void world_skip(world_t *w, uint64_t target)
+{
+	uint64_t horizon = target, end;
+
+	for (int i = 0; i < w->nboards; i++) {
+		const park_t *park = &w->park[i];
+
+		if (!park_quiet(park, w->boards[i]->avr)) {
+			return;
+		}
+		if (park->limit < horizon + WORLD_SKIP_MARGIN) {
+			horizon = park->limit > WORLD_SKIP_MARGIN ? park->limit - WORLD_SKIP_MARGIN : 0;
+		}
+	}
+	if (horizon <= w->now + WORLD_QUANTUM) {
+		return;
+	}
+	end = horizon == target ? target :
+	      w->now + (horizon - w->now) / WORLD_QUANTUM * WORLD_QUANTUM;
+	for (int i = 0; i < w->nboards; i++) {
+		park_stays(&w->park[i], w->boards[i]->avr, end);
+	}
+	w->now = end;
+}
+
 int world_run(world_t *w, uint64_t target)
 {
+	int parked = 0;
+
 	if (w->nboards == 1) {
 		return world_run_one(w, target);
 	}
 	while (w->now < target) {
-		uint64_t end = w->now + WORLD_QUANTUM;
+		uint64_t end;
 
+		if (parked == w->nboards) {
+			world_skip(w, target);
+			if (w->now >= target) {
+				break;
+			}
+		}
+		end = w->now + WORLD_QUANTUM;
 		if (end > target) {
 			end = target;
 		}
+		parked = 0;
 		for (int i = 0; i < w->nboards; i++) {
 			avr_t *avr = w->boards[i]->avr;
+			park_t *park = &w->park[i];
+			int state;
 
-			while (avr->cycle < end) {
-				int state = avr_run(avr);
-
-				if (world_state_dead(state)) {
-					w->dead = i;
-					w->dead_state = state;
-					return 1;
-				}
+			if (park->parked && park_stays(park, avr, end)) {
+				parked++;
+				continue;
 			}
+			state = park_run(park, avr, end, !w->no_park);
+			if (world_state_dead(state)) {
+				w->dead = i;
+				w->dead_state = state;
+				world_unpark(w);
+				return 1;
+			}
+			parked += park->parked;
 		}
 		w->now = end;
 	}
+	world_unpark(w);
 	return 0;
 }
 

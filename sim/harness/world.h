@@ -18,6 +18,7 @@
 #include <stdint.h>
 
 #include "boards/sim_board.h"
+#include "harness/park.h"
 #include "harness/trace.h"
 #include "periph/twi_bus.h"
 #include "parts/part.h"
@@ -38,6 +39,8 @@ typedef struct world_t {
 	uint64_t now;			/* every board has reached this cycle */
 	int dead;			/* index of a board that crashed or stopped, -1 */
 	int dead_state;
+	park_t park[WORLD_MAX_BOARDS];	/* boards idling in a loop (park.h) */
+	int no_park;			/* run every board every quantum */
 } world_t;
 
 /* An empty world: no boards, a bus traced to TRACE (opened by the caller). */

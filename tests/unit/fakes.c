@@ -68,7 +68,7 @@ twi_result_t twi_start(uint8_t addr8)
 	return TWI_ACK;
 }
 
-twi_result_t twi_write(uint8_t byte)
+static twi_result_t twi_write(uint8_t byte)
 {
 	logf_("W%02X", byte);
 	if (bus.device == 0x62) {
@@ -90,11 +90,33 @@ twi_result_t twi_write(uint8_t byte)
 	return TWI_ACK;
 }
 
-twi_result_t twi_read(uint8_t *byte, bool ack)
+static twi_result_t twi_read(uint8_t *byte, bool ack)
 {
 	*byte = bus.device == 0xA0 ? eeprom[bus.ptr++] : 0xFF;
 	logf_("R%02X", *byte);
 	logf_(ack ? "+ " : "- ", 0);
+	return TWI_ACK;
+}
+
+twi_result_t twi_write_bytes(const uint8_t *data, uint8_t n)
+{
+	for (uint8_t i = 0; i < n; i++) {
+		twi_result_t r = twi_write(data[i]);
+		if (r != TWI_ACK) {
+			return r;
+		}
+	}
+	return TWI_ACK;
+}
+
+twi_result_t twi_read_bytes(uint8_t *data, uint8_t n)
+{
+	for (uint8_t i = 0; i < n; i++) {
+		twi_result_t r = twi_read(&data[i], (uint8_t)(i + 1) < n);
+		if (r != TWI_ACK) {
+			return r;
+		}
+	}
 	return TWI_ACK;
 }
 

@@ -76,7 +76,12 @@ slave_action_t xact_model_twi_event(uint8_t status, uint8_t *byte)
 	slave_action_t act = slave_fsm_event(status, byte);
 	if (act == SLAVE_DEFER) {
 		act = slave_fsm_work(byte);
+	} else if (act == SLAVE_DEFER_ACK) {
+		/* acknowledged at once; the next event waits for the work */
+		CHECK_EQ(slave_fsm_work(byte), SLAVE_RESUME);
+		act = SLAVE_ACK;
 	}
+	slave_fsm_after();
 	return act;
 }
 
