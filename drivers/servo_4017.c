@@ -36,6 +36,7 @@
 #include "board.h"
 #include "drivers/drv_servo.h"
 #include "firmware/board_pins.h"
+#include "firmware/front.h"
 #include "firmware/mcu.h"
 #include "firmware/pins.h"
 
@@ -89,6 +90,16 @@ static struct {
 	uint8_t rst_mask;
 } pulses;
 
+/* The compare interrupts outrank the serial line's receive interrupt and
+ * can come back to back (four counters, and the frame start): above 115200
+ * baud that is longer than the USART holds received characters (two: 320
+ * cycles at 460800). Each ends letting a waiting character's interrupt in:
+ * every width is the hardware's, and the next rise is programmed already. */
+static inline __attribute__((always_inline)) void rx_poll_after_rise(void)
+{
+	front_rx_poll(FRONT_HOLD_ALL);
+}
+
 /*
  * Counter c's compare unit made a rising edge: the counter moved on. Bring
  * the clock low, pass the off outputs that follow, program the next rise
@@ -121,6 +132,7 @@ servo_rise(uint8_t c, volatile uint16_t *ocr, volatile uint16_t *tcnt, volatile 
 	}
 	if (steps & SERVO_REST) {
 		*tccr &= (uint8_t)~(3u << com0);
+		rx_poll_after_rise();
 		return;
 	}
 	*tccr ^= flip;          /* clear -> set: the next rise */
@@ -130,6 +142,7 @@ servo_rise(uint8_t c, volatile uint16_t *ocr, volatile uint16_t *tcnt, volatile 
 		at = now + SERVO_AHEAD;
 	}
 	*ocr = at;
+	rx_poll_after_rise();
 }
 
 ISR(TIMER3_COMPA_vect) { servo_rise(0, &OCR3A, &TCNT3, &TCCR3A, COM3A0, &TCCR3C, _BV(FOC3A)); }
@@ -179,6 +192,7 @@ ISR(TIMER1_COMPA_vect)
 	}
 	*pulses.rst_port &= (uint8_t)~pulses.rst_mask;
 	OCR1A = f + s->frame;
+	rx_poll_after_rise();
 }
 
 void servo_hw_init(void)

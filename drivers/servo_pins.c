@@ -24,21 +24,46 @@
 #include "drivers/servo_plan.h"
 #include "firmware/board_pins.h"
 #include "firmware/clock.h"
+#include "firmware/front.h"
 #include "firmware/pins.h"
 #include "firmware/port_io.h"
+#include "firmware/uart.h"
 
-#define SERVO_LEAD   480       /* wake-up before an edge, cycles */
+#define SERVO_LEAD   640       /* wake-up before an edge, cycles */
 #define SERVO_NEAR   (SERVO_LEAD + 80)  /* closer than this: wait in place */
 #define SERVO_FINE   96        /* last stretch, waited on Timer0 */
+/* The receive interrupt's longest run (BOARD_RX_BURST characters, ~70
+ * cycles each, and its entry), and the interrupt's own from the wake-up to
+ * the last stretch, cycles: the lead allows for both. */
+#define SERVO_RX_CHAR 72
+#define SERVO_RX_ISR  (BOARD_RX_BURST * SERVO_RX_CHAR + 80)
+#define SERVO_ENTRY   300
+_Static_assert(SERVO_LEAD >= SERVO_RX_ISR + SERVO_ENTRY, "the lead allows a receive interrupt");
+/* An edge this far away leaves time to hand on the whole hold. */
+#define SERVO_FAR (SERVO_LEAD + SERVO_RX_CHAR * (UART_HOLD + 2))
+/*
+ * Interrupts are off from the wake-up to the edge, longer than the USART
+ * holds received characters above 115200 baud (two: 320 cycles at 460800
+ * baud). So the interrupt takes them into the receiver's hold
+ * (front_rx_hold(), ~30 cycles with the call) as it starts, every turn of
+ * its wait until SERVO_HOLD_TICKS Timer2 ticks before the last stretch (a
+ * turn that holds one must end inside that stretch) and right after each
+ * edge, and lets the receive interrupt hand them on (front_rx_poll()) as it
+ * returns, within the next wake-up's lead. Every Timer2 wrap wakes it while
+ * servos run (0.28 ms), so nothing stays held longer than that.
+ */
+#define SERVO_HOLD_TICKS 3
 
 static struct {
 	servo_sched_t sched[2];
 	volatile uint8_t active;     /* sched[] the interrupt runs */
 	volatile uint8_t pending;    /* the other one is newer */
 	volatile uint8_t running;
-	uint8_t next;                /* next edge of the active schedule */
-	uint32_t frame;              /* Timer0 cycle of the frame's start */
-	uint32_t target;             /* Timer0 cycle of the next edge */
+	const servo_edge_t *edge;    /* the next edge, in sched[active] */
+	const servo_edge_t *end;     /* past sched[active]'s last edge */
+	uint16_t frame;              /* Timer2 tick of the frame's start */
+	uint16_t target;             /* Timer2 tick of the next edge */
+	uint8_t target_t0;           /* TCNT0 at the next edge's cycle */
 	uint8_t t0_offset;           /* TCNT0 - 8 * TCNT2, measured at start */
 } pulses;
 
@@ -53,6 +78,10 @@ static const __flash uint8_t line_mask[8] = { 1, 2, 4, 8, 16, 32, 64, 128 };
 /* Timer2 is shared: the time base (firmware/clock.c) runs it and counts
  * its overflows, this driver uses its compare unit (OCR2). */
 _Static_assert(BOARD_CLOCK_TIMER == 2, "servo_pins.c plans edges on the time base's Timer2");
+/* Frames start on a Timer2 tick: an edge's tick and Timer0 count follow
+ * from its cycle in the frame with 16- and 8-bit sums. */
+_Static_assert(SERVO_FRAME % 8 == 0 && SERVO_LEAD % 8 == 0 && SERVO_FINE % 8 == 0,
+	       "frames, the lead and the last stretch are whole Timer2 ticks");
 
 /*
  * Now in Timer2 ticks (8 cycles) as a 16-bit count: edges are never more
@@ -77,46 +106,72 @@ static uint16_t servo_ticks(void)
 	return (uint16_t)(clock_wraps << 8 | t);
 }
 
-/* Ticks from now until `cycle`. */
-static int16_t servo_ticks_to(uint32_t cycle)
+/* Ticks from now until the next edge. */
+static int16_t servo_ticks_left(void)
 {
-	return (int16_t)((uint16_t)(cycle >> 3) - servo_ticks());
+	return (int16_t)(pulses.target - servo_ticks());
 }
 
-/* Arms Timer2 to wake SERVO_LEAD cycles before pulses.target; false if that is
- * too close: the caller then waits for the edge in place. The compare fires
- * once per Timer2 wrap; the interrupt ignores the wraps before the edge's. */
+/* Makes `e` the next edge: its tick and Timer0 count. */
+static void servo_aim(const servo_edge_t *e)
+{
+	uint16_t at = e->at;
+	uint8_t hi = (uint8_t)(e->code >> 4) & 3;  /* the cycle's bits 16-17 */
+
+	pulses.edge = e;
+	pulses.target = (uint16_t)(pulses.frame + (uint16_t)(hi << 13) + (at >> 3));
+	pulses.target_t0 = (uint8_t)((uint8_t)(pulses.frame << 3) + (uint8_t)at + pulses.t0_offset);
+}
+
+/* Arms Timer2 to wake SERVO_LEAD cycles before the next edge; false if that
+ * is too close: the caller then waits for the edge in place. The compare
+ * fires once per Timer2 wrap; the interrupt ignores the wraps before the
+ * edge's. */
 static bool servo_arm(void)
 {
-	if (servo_ticks_to(pulses.target) < SERVO_NEAR / 8) {
+	if (servo_ticks_left() < SERVO_NEAR / 8) {
 		return false;
 	}
-	OCR2 = (uint8_t)((pulses.target - SERVO_LEAD) >> 3);
+	OCR2 = (uint8_t)(pulses.target - SERVO_LEAD / 8);
 	return true;
+}
+
+/* Lets the receive interrupt hand on what the hold keeps: all of it when
+ * the next edge is SERVO_FAR away, else what the next wake-up's lead
+ * allows for. */
+static void servo_rx_release(void)
+{
+	front_rx_poll(servo_ticks_left() > SERVO_FAR / 8 ? FRONT_HOLD_ALL : BOARD_RX_BURST);
 }
 
 ISR(TIMER2_COMP_vect)
 {
-	if (!pulses.running || servo_ticks_to(pulses.target) > SERVO_NEAR / 8) {
+	front_rx_hold();
+	if (!pulses.running || servo_ticks_left() > SERVO_NEAR / 8) {
+		servo_rx_release();
 		return;  /* an earlier wrap, or a stale flag */
 	}
 	for (;;) {
-		const servo_sched_t *s = &pulses.sched[pulses.active];
-		uint8_t e = s->edge[pulses.next].code;
+		const servo_edge_t *edge = pulses.edge;
+		uint8_t e = edge->code;
 		uint8_t pin = servo_pin[e & SERVO_CHAN];
 		volatile uint8_t *reg = (volatile uint8_t *)(uint16_t)port_addr[PIN_PORT(pin)];
 		uint8_t mask = line_mask[pin & 7];
-		uint8_t lo = (uint8_t)(pulses.target + pulses.t0_offset);
+		uint8_t lo = pulses.target_t0;
 		uint8_t and_mask = (e & SERVO_FALL) ? (uint8_t)~mask : 0xFF;
 		uint8_t or_mask = (e & SERVO_FALL) ? 0 : mask;
-		uint16_t fine_from = (uint16_t)((pulses.target - SERVO_FINE) >> 3);
+		int16_t left = (int16_t)(servo_ticks_left() - SERVO_FINE / 8);
 
 		/* Wait on Timer2 until SERVO_FINE cycles before the edge, then on
 		 * Timer0 for its cycle. An edge already past (the lead time should
 		 * prevent it) is written at once, not after Timer0 comes round
 		 * again. */
-		if ((int16_t)(fine_from - servo_ticks()) > -(SERVO_FINE / 8)) {
-			while ((int16_t)(fine_from - servo_ticks()) > 0) {
+		if (left > -(SERVO_FINE / 8)) {
+			while (left > 0) {
+				if (left > SERVO_HOLD_TICKS) {
+					front_rx_hold();
+				}
+				left = (int16_t)(servo_ticks_left() - SERVO_FINE / 8);
 			}
 			/* In assembly for 4 cycles a turn, so the write comes within
 			 * 3 cycles of the edge's cycle (the loop in C takes 8). */
@@ -130,24 +185,29 @@ ISR(TIMER2_COMP_vect)
 		/* The same instructions for a rise and a fall: both come equally
 		 * long after the wait. */
 		*reg = (uint8_t)((*reg & and_mask) | or_mask);
+		front_rx_hold();
 
-		if (++pulses.next == s->n) {
+		if (++edge == pulses.end) {
 			/* Frame done: take a newer schedule over, start the next. */
-			pulses.next = 0;
-			pulses.frame += SERVO_FRAME;
+			pulses.frame += SERVO_FRAME / 8;
 			if (pulses.pending) {
 				pulses.active ^= 1;
 				pulses.pending = 0;
-				s = &pulses.sched[pulses.active];
+				const servo_sched_t *s = &pulses.sched[pulses.active];
 				if (s->n == 0) {
 					pulses.running = 0;
 					TIMSK &= (uint8_t)~_BV(OCIE2);
+					front_rx_poll(FRONT_HOLD_ALL);  /* no more edges */
 					return;
 				}
+				pulses.end = &s->edge[s->n];
 			}
+			edge = pulses.sched[pulses.active].edge;
 		}
-		pulses.target = pulses.frame + servo_cycle(&s->edge[pulses.next]);
+		servo_aim(edge);
 		if (servo_arm()) {
+			front_rx_hold();
+			servo_rx_release();
 			return;
 		}
 	}
@@ -215,9 +275,9 @@ void servo_hw_apply(const uint16_t *widths_us)
 		} else if (n) {
 			/* Start: the first frame begins a little from now. */
 			pulses.active ^= 1;
-			pulses.next = 0;
-			pulses.frame = ((uint32_t)servo_ticks() << 3) + 4096;
-			pulses.target = pulses.frame + servo_cycle(&s->edge[0]);
+			pulses.end = &s->edge[n];
+			pulses.frame = servo_ticks() + 4096 / 8;
+			servo_aim(s->edge);
 			servo_arm();
 			pulses.running = 1;
 			/* (A stale compare flag needs no clearing: the interrupt it

@@ -12,7 +12,7 @@
  *   DETECT  the pin's runs are recorded from a falling edge until the line
  *           is quiet for AB_QUIET (6.7 ms; the host waits 20 ms after its
  *           preamble); a record with two frames in a row that last nine
- *           bits of the same of the ten rates, one of them 0x0D's shape,
+ *           bits of the same rate, one of them 0x0D's shape,
  *           gives the rate: UBRR is set and the receiver turned on while
  *           the line is quiet, so it starts in step with the next start bit;
  *   FRESH   no good request yet: the pin is still recorded whenever the main
@@ -64,7 +64,7 @@ _Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart
 #define AB_LOOP_CYCLES 6
 #define AB_STEP_CYCLES 12
 
-/* The ten rates: bit time in cycles and UBRR, exact at 7.3728 MHz. */
+/* The rates: bit time in cycles and UBRR, exact at 7.3728 MHz. */
 #define AB_RATE(r) { (uint16_t)(F_CPU / (r)), (uint8_t)(F_CPU / (16UL * (r)) - 1) },
 #define AB_EXACT(r) _Static_assert(F_CPU % (16UL * (r)) == 0 && F_CPU / (16UL * (r)) <= 256, \
 				   "UBRR exact and 8-bit for " #r);
@@ -207,14 +207,17 @@ static uint8_t ab_frame(const uint16_t *run)
 	return 0;
 }
 
-/* The five runs from RUN match 0x0D's 1 1 1 2 4 bit times at BIT. */
+/* The five runs from RUN match 0x0D's 1 1 1 2 4 bit times at BIT, each
+ * within a third of a bit and half a counting iteration: a run is measured
+ * to an iteration (6 cycles), which at 460800 (16 cycles a bit) is more than
+ * a third of a bit. */
 static uint8_t ab_shape(const uint16_t *run, uint16_t bit)
 {
 	for (uint8_t i = 0; i < 5; i++) {
 		uint16_t want = (uint16_t)(ab_pattern[i] * bit);
 		uint16_t c = ab_cycles(run[i]);
 
-		if ((c > want ? c - want : want - c) > bit / 3) {
+		if ((c > want ? c - want : want - c) > bit / 3 + AB_LOOP_CYCLES / 2) {
 			return 0;
 		}
 	}
@@ -360,3 +363,4 @@ void uart_line_confirm(void)
 		autobaud.state = AB_TALK;
 	}
 }
+

@@ -3,9 +3,30 @@
 #ifndef ORFA_FRONT_H
 #define ORFA_FRONT_H
 
+#include <stdint.h>
+
 void front_init(void);
 /* One step of the front end's work; when it has none, it calls sys_poll()
  * (the link-loss failsafe): the busy path pays nothing for it. */
 void front_poll(void);
+
+/*
+ * For an interrupt that keeps interrupts off longer than the serial line's
+ * receiver holds characters (two in UDR: 320 cycles at 460800 baud) and
+ * cannot let the receive interrupt run at every point (drivers/servo_pins.c
+ * between its wake-up and an edge). Both are empty in the I2C slave.
+ *
+ * front_rx_hold(): takes a waiting character from UDR into a small hold
+ * (a dozen cycles), from which the receive interrupt hands it on first.
+ * front_rx_poll(most): lets the receive interrupt run now, if anything is
+ * held or waits in UDR, to hand on `most` characters at most (about 70
+ * cycles each; FRONT_HOLD_ALL: everything); a pending interrupt of higher
+ * priority may run instead: the caller allows for the longest. Called with
+ * interrupts off, returns with them off.
+ */
+#define FRONT_HOLD_ALL 0xFF
+
+void front_rx_hold(void);
+void front_rx_poll(uint8_t most);
 
 #endif

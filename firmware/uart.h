@@ -8,6 +8,8 @@
 
 #include <stdint.h>
 
+#include "board.h"
+
 /* Transmit ring: half a longest reply (127 + CR LF). A long reply holds the
  * main loop for the other half's wire time, while the receive ring takes
  * what arrives; the reply's first byte goes out at once, so latency is not
@@ -16,12 +18,28 @@
  * of two. */
 #define UART_TX_SIZE 64
 
+/*
+ * The receive hold (front_rx_hold(), firmware/front.h), on a board whose
+ * interrupts keep characters from the receive interrupt (BOARD_RX_BURST in
+ * its board file: the M32-D's servo interrupt, which waits for cycle-exact
+ * edges with interrupts off): UART_HOLD characters, more than reach UDR
+ * while that interrupt runs at 460800 baud (about 800 cycles for an edge,
+ * 400 more for each close one); a receive interrupt hands on
+ * BOARD_RX_BURST of them at most. Elsewhere the receive interrupt takes
+ * UDR's character alone and there is no hold.
+ */
+#define UART_HOLD 16
+
 /* uart_init() (set the rate, enable the USART) is the line's: see
  * firmware/uart_line.h. */
 #include "firmware/uart_line.h"
 
 /* Each received byte, from the receive interrupt: the front end's. */
 void uart_received(uint8_t c);
+
+/* From the main loop when the front end has nothing to do: hands on what
+ * the receive hold still keeps. */
+void uart_rx_flush(void);
 
 /* Queue one byte for sending; waits only while the transmit ring is full. */
 void uart_putc(uint8_t c);

@@ -46,6 +46,7 @@ void front_poll(void)
 		c = sg_rx_get();
 	} while (c < 0 && --spin);
 	if (c < 0) {
+		uart_rx_flush();
 		if (!sg_rx_losing()) {
 			if (uart_line_poll()) {
 				/* The line's rate changed (autobaud): what the ring

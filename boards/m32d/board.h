@@ -46,6 +46,10 @@
 /* Servo driver (UID 0x0031): 16 channels, each on its own pin. */
 #define BOARD_SERVO_UID 0x0031
 #define BOARD_SERVO_CHANNELS 16
+/* Received characters one receive interrupt hands on at most: its servo
+ * interrupt waits for cycle-exact edges, and its wake-up's lead allows for
+ * a receive interrupt of about this many (drivers/servo_pins.c). */
+#define BOARD_RX_BURST 3
 
 /*
  * Fixed wiring: X(port, bit, function, index).

@@ -39,8 +39,8 @@ DEFAULT_CLOCK_KHZ = 0x64
 #: The serial line's rates (docs/protocol.md, "The line"): a fixed-rate build
 #: takes any of BAUD_RATES, BAUD=auto detects AUTOBAUD_RATES. The Makefile's
 #: lists are the source (a host test keeps them equal).
-AUTOBAUD_RATES = (2400, 4800, 9600, 14400, 19200, 28800, 38400, 57600, 76800, 115200)
-BAUD_RATES = AUTOBAUD_RATES + (230400, 460800)
+AUTOBAUD_RATES = (2400, 4800, 9600, 14400, 19200, 28800, 38400, 57600, 76800, 115200, 230400, 460800)
+BAUD_RATES = AUTOBAUD_RATES
 DEFAULT_BAUD = 115200
 #: With BAUD=auto the host opens the line with these eight CRs and then
 #: stays quiet for at least AUTOBAUD_QUIET_S before it talks.

@@ -99,7 +99,8 @@ class SimControl(Closing):
         return _SlaveView(self, addr)
 
     def pin(self, name: str) -> Tuple[int, str]:
-        """(level, "out" | "in" | "in pullup" | "in ext" | "out oc" | "out spi")."""
+        """(level, "out" | "in" | "in pullup" | "in ext" | "out oc" | "out spi" |
+        "in spi" (MISO, driven by the SPI bus) | "out uart")."""
         level, how = self.request("pin %s" % self._name(name)).split(" ", 1)
         return int(level), how
 

@@ -50,6 +50,9 @@ static int bm_pin_level(const bm_port_t *p, int bit)
 	if (p->uart_mask & m) {
 		return !!(p->uart_level & m);
 	}
+	if (p->spi_mask & p->spi_input & m) {
+		return !!(p->spi_level & m);
+	}
 	if (p->ddr & m) {
 		if (p->spi_mask & m) {
 			return !!(p->spi_level & m);
@@ -102,7 +105,7 @@ static uint8_t bm_read_pin(avr_t *avr, avr_io_addr_t addr, void *param)
 	for (int b = 0; b < 8; b++) {
 		levels |= (uint8_t)(p->pin[b].level << b);
 	}
-	uint8_t own = (uint8_t)(p->ddr | p->wired | p->uart_mask);
+	uint8_t own = (uint8_t)(p->ddr | p->wired | p->uart_mask | (p->spi_mask & p->spi_input));
 
 	v = (uint8_t)((v & ~own) | (levels & own));
 	avr->data[addr] = v;
@@ -235,6 +238,8 @@ void board_model_pin_text(board_model_t *bm, bm_port_t *p, int bit, char *buf, i
 	(void)bm;
 	if (p->uart_mask & m) {
 		how = "out uart";
+	} else if (p->spi_mask & p->spi_input & m) {
+		how = "in spi";
 	} else if (p->ddr & m) {
 		how = (p->spi_mask & m) ? "out spi" : bm_pin_oc(p, bit) ? "out oc" : "out";
 	} else if (p->ext_mask & m) {
@@ -491,11 +496,17 @@ int board_model_init(board_model_t *bm, avr_t *avr, const sim_board_desc_t *boar
 	board_model_set_avcc(bm, 5000);
 	board_model_set_aref(bm, 5000);
 
-	for (int k = 0; k < 2; k++) {
-		const sim_pin_t *bp = sim_wiring_pin(w, k ? BF_SPI_MOSI : BF_SPI_SCK, 0);
+	static const int spi_fn[SPI_PINS] = {
+		[SPI_PIN_SCK] = BF_SPI_SCK, [SPI_PIN_MOSI] = BF_SPI_MOSI, [SPI_PIN_MISO] = BF_SPI_MISO,
+	};
+	for (int k = 0; k < SPI_PINS; k++) {
+		const sim_pin_t *bp = sim_wiring_pin(w, spi_fn[k], 0);
 
 		bm->spi_port[k] = bp ? board_model_port(bm, bp->port) : NULL;
 		bm->spi_bit[k] = bp ? bp->bit : 0;
+	}
+	if (bm->spi_port[SPI_PIN_MISO]) {
+		bm->spi_port[SPI_PIN_MISO]->spi_input = (uint8_t)(1u << bm->spi_bit[SPI_PIN_MISO]);
 	}
 	spi_init(&bm->spi, avr, mcu->spi.spcr, mcu->spi.spsr, mcu->spi.spdr,
 		 mcu->spi.vect_spi, trace, bm_spi_drive, bm);

@@ -58,7 +58,8 @@ typedef struct bm_port_t {
 	avr_irq_t *irq;			/* the port's IRQs */
 	uint8_t ddr, port;		/* shadows of DDRx/PORTx */
 	uint8_t ext_mask, ext_value;	/* driven from outside */
-	uint8_t spi_mask, spi_level;	/* driven by the SPI master */
+	uint8_t spi_mask, spi_level;	/* driven by the SPI bus */
+	uint8_t spi_input;		/* MISO: its device drives it whatever DDR says */
 	uint8_t uart_mask, uart_level;	/* driven by the USART's transmitter */
 	uint8_t wired;			/* the I2C bus's lines (board_model_wire_twi) */
 	signal_t pin[8];
@@ -106,8 +107,8 @@ typedef struct board_model_t {
 	int nservo;
 
 	spi_t spi;
-	bm_port_t *spi_port[2];		/* SCK, MOSI */
-	int spi_bit[2];
+	bm_port_t *spi_port[SPI_PINS];	/* SCK, MOSI, MISO */
+	int spi_bit[SPI_PINS];
 	part_list_t spi_parts;		/* the parts on its SPI bus (--spi) */
 	uint32_t activity;		/* control-visible changes */
 

@@ -104,6 +104,38 @@ void spi_dev_byte_init(spi_dev_t *d)
 	d->next_out = spi_byte_out;
 }
 
+/* The device that drives MISO: the first one selected (NULL: none). */
+static spi_dev_t *spi_selected(const spi_t *s)
+{
+	for (int i = 0; i < s->ndev; i++) {
+		if (s->dev[i]->selected) {
+			return s->dev[i];
+		}
+	}
+	return NULL;
+}
+
+static int spi_master_on(const spi_t *s)
+{
+	uint8_t cr = spi_spcr(s);
+
+	return (cr & BIT(SPCR_SPE)) && (cr & BIT(SPCR_MSTR));
+}
+
+/* Show on the MISO pin what drives it at CYCLE: the selected device's bit;
+ * with none, 1 (what the master reads) while the master is on, else the
+ * port's own. A byte on the wire shows its edges when it ends. */
+static void spi_miso_show(spi_t *s, uint64_t cycle)
+{
+	spi_dev_t *d = spi_selected(s);
+
+	if (!s->drive || s->busy) {
+		return;
+	}
+	s->miso_level = d ? d->out : 1;
+	s->drive(s->drive_param, SPI_PIN_MISO, d || spi_master_on(s), s->miso_level, cycle);
+}
+
 static void spi_cs_changed(void *param, signal_t *sig, uint64_t cycle, int level)
 {
 	spi_dev_t *d = param;
@@ -120,6 +152,9 @@ static void spi_cs_changed(void *param, signal_t *sig, uint64_t cycle, int level
 		d->out = 1;
 		d->deselect(d, cycle);
 	}
+	if (d->bus) {
+		spi_miso_show(d->bus, cycle);
+	}
 }
 
 int spi_attach(spi_t *s, spi_dev_t *d, signal_t *cs)
@@ -128,6 +163,7 @@ int spi_attach(spi_t *s, spi_dev_t *d, signal_t *cs)
 		return -1;
 	}
 	d->cs = cs;
+	d->bus = s;
 	d->selected = 0;
 	d->out = 1;
 	s->dev[s->ndev++] = d;
@@ -142,11 +178,23 @@ int spi_attach(spi_t *s, spi_dev_t *d, signal_t *cs)
 
 static void spi_edge_note(spi_t *s, uint64_t cycle, int pin, int level)
 {
-	if (s->nedges < 32) {
+	if (s->nedges < (int)(sizeof(s->edge_cycle) / sizeof(s->edge_cycle[0]))) {
 		s->edge_cycle[s->nedges] = cycle;
 		s->edge_pin[s->nedges] = (uint8_t)pin;
 		s->edge_level[s->nedges] = (uint8_t)level;
 		s->nedges++;
+	}
+}
+
+/* MISO as device D (NULL: none, the line reads 1) drives it at WHEN, noted
+ * among the byte's edges when it changes. */
+static void spi_miso_note(spi_t *s, const spi_dev_t *d, uint64_t when)
+{
+	int level = d ? d->out : 1;
+
+	if (level != s->miso_level) {
+		s->miso_level = level;
+		spi_edge_note(s, when, SPI_PIN_MISO, level);
 	}
 }
 
@@ -169,6 +217,7 @@ static uint8_t spi_clock_byte(spi_t *s, uint8_t tx, uint64_t t0, unsigned half)
 		}
 	}
 	s->nedges = 0;
+	spi_miso_note(s, nsel ? sel[0] : NULL, t0);
 #define TXBIT(k) (lsb ? (tx >> (k)) & 1 : (tx >> (7 - (k))) & 1)
 	if (!cpha && s->mosi_level != TXBIT(0)) {
 		s->mosi_level = TXBIT(0);
@@ -215,6 +264,7 @@ static uint8_t spi_clock_byte(spi_t *s, uint8_t tx, uint64_t t0, unsigned half)
 				d->out = d->next_out(d);
 			}
 		}
+		spi_miso_note(s, nsel ? sel[0] : NULL, when);
 	}
 #undef TXBIT
 	s->pending_cs = nsel ? sel[0]->cs->name : "-";
@@ -237,6 +287,7 @@ static avr_cycle_count_t spi_done(avr_t *avr, avr_cycle_count_t when, void *para
 		}
 	}
 	s->nedges = 0;
+	spi_miso_show(s, when);
 	trace_event(s->trace, when, "spi %s %02X %02X", s->pending_cs, s->tx, s->rx);
 	if (s->log_len == SPI_LOG) {
 		s->log_head = (s->log_head + 1) % SPI_LOG;
@@ -288,22 +339,22 @@ static uint8_t spi_read_spdr(avr_t *avr, avr_io_addr_t addr, void *param)
 static void spi_pins(spi_t *s)
 {
 	uint8_t cr = spi_spcr(s);
-	int on = (cr & BIT(SPCR_SPE)) && (cr & BIT(SPCR_MSTR));
+	int on = spi_master_on(s);
 
 	if (s->drive && !s->busy) {
-		s->drive(s->drive_param, 0, on, !!(cr & BIT(SPCR_CPOL)), s->avr->cycle);
-		s->drive(s->drive_param, 1, on, s->mosi_level, s->avr->cycle);
+		s->drive(s->drive_param, SPI_PIN_SCK, on, !!(cr & BIT(SPCR_CPOL)), s->avr->cycle);
+		s->drive(s->drive_param, SPI_PIN_MOSI, on, s->mosi_level, s->avr->cycle);
+		spi_miso_show(s, s->avr->cycle);
 	}
 }
 
 static void spi_write_spdr(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *param)
 {
 	spi_t *s = param;
-	uint8_t cr = spi_spcr(s);
 
 	(void)addr;
 	spi_clear_on_access(s);
-	if (!(cr & BIT(SPCR_SPE)) || !(cr & BIT(SPCR_MSTR))) {
+	if (!spi_master_on(s)) {
 		s->rx = v;		/* slave mode is not modelled */
 		return;
 	}

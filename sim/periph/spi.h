@@ -42,6 +42,7 @@ typedef struct spi_dev_t {
 	int mode;			/* SPI mode 0..3 the device speaks */
 	int lsb_first;			/* its bit order */
 	signal_t *cs;			/* chip select pin, active low */
+	struct spi_t *bus;		/* the bus it is on (spi_attach) */
 	int selected;
 	int out;			/* the MISO level it drives */
 	uint32_t txn;			/* counts selections */
@@ -72,8 +73,11 @@ typedef struct spi_log_t {
 	uint8_t mosi, miso;
 } spi_log_t;
 
-/* The board model shows SCK and MOSI on the pins: PIN 0 = SCK, 1 = MOSI;
- * ACTIVE 0 gives the pin back to PORT. */
+/* The board model shows the bus on the pins: PIN 0 = SCK, 1 = MOSI (the
+ * master's), 2 = MISO (the selected device's level; 1, nobody driving,
+ * while the master is on); ACTIVE 0 gives the pin back to PORT. */
+enum { SPI_PIN_SCK, SPI_PIN_MOSI, SPI_PIN_MISO, SPI_PINS };
+
 typedef void (*spi_drive_t)(void *param, int pin, int active, int level, uint64_t cycle);
 
 typedef struct spi_t {
@@ -95,9 +99,11 @@ typedef struct spi_t {
 	const char *pending_cs;
 	uint32_t pending_txn;
 	int mosi_level;
-	/* SCK/MOSI edges of the byte on the wire, shown when it ends */
-	uint64_t edge_cycle[32];
-	uint8_t edge_pin[32], edge_level[32];
+	int miso_level;			/* what the MISO pin shows */
+	/* SCK/MOSI/MISO edges of the byte on the wire, shown when it ends:
+	 * 16 SCK edges, up to 8 MOSI and 9 MISO changes */
+	uint64_t edge_cycle[48];
+	uint8_t edge_pin[48], edge_level[48];
 	int nedges;
 
 	spi_dev_t *dev[SPI_MAX_DEVICES];

@@ -80,6 +80,27 @@ static uint8_t usart_ucsra(const usart_t *u)
  * change, on enable bit changes and on RETI, a vector is raised again while
  * its flag and enable bit are both set, and withdrawn when its flag drops.
  */
+/* simavr 1.6's avr_clear_interrupt leaves the vector's entry in its queue
+ * of pending interrupts. A firmware that empties UDR with the receive
+ * interrupt masked (the M32-D's servo interrupt polls it) would add an
+ * entry at every character while the queue serves one per interrupt taken:
+ * the 64-entry queue fills, a later raise finds no room, and the vector
+ * stays flagged pending without ever being taken. Its entries go too. */
+static void usart_withdraw(avr_t *avr, avr_int_vector_t *v)
+{
+	avr_int_pending_t *q = &avr->interrupts.pending;
+	unsigned keep = q->read;
+
+	avr_clear_interrupt(avr, v);
+	for (unsigned i = q->read; i != q->write; i = (i + 1) & (avr_int_pending_fifo_size - 1)) {
+		if (q->buffer[i] != v) {
+			q->buffer[keep] = q->buffer[i];
+			keep = (keep + 1) & (avr_int_pending_fifo_size - 1);
+		}
+	}
+	q->write = keep;
+}
+
 static void usart_sync_vector(usart_t *u, avr_int_vector_t *v, int flag)
 {
 	avr_t *avr = u->avr;
@@ -89,7 +110,7 @@ static void usart_sync_vector(usart_t *u, avr_int_vector_t *v, int flag)
 			avr_raise_interrupt(avr, v);
 		}
 	} else if (v->pending) {
-		avr_clear_interrupt(avr, v);
+		usart_withdraw(avr, v);
 	}
 }
 
@@ -112,11 +133,25 @@ static void usart_rx_flush(usart_t *u)
 	u->rx_dor = 0;
 }
 
+/* A start bit on the wire. Silicon overruns here, not when the frame
+ * ends: with two frames unread in UDR and a third complete in the shift
+ * register, the new frame shifts in over that third (DOR). */
+static void usart_rx_start_bit(usart_t *u, avr_cycle_count_t start)
+{
+	if (u->rx_fifo_len == 2 && u->rx_shift_full) {
+		trace_event(u->trace, start, "uart overrun %02X", u->rx_shift_byte);
+		u->rx_shift_full = 0;
+		u->rx_dor = 1;
+		u->rx_lost++;
+	}
+}
+
 static void usart_rx_deliver(usart_t *u, uint8_t byte, int fe)
 {
 	if (u->rx_fifo_len < 2) {
 		u->rx_fifo[u->rx_fifo_len].data = byte;
-		u->rx_fifo[u->rx_fifo_len].dor = 0;
+		u->rx_fifo[u->rx_fifo_len].dor = (uint8_t)u->rx_dor;
+		u->rx_dor = 0;
 		u->rx_fifo[u->rx_fifo_len].fe = (uint8_t)fe;
 		u->rx_fifo_len++;
 	} else if (!u->rx_shift_full) {
@@ -127,6 +162,7 @@ static void usart_rx_deliver(usart_t *u, uint8_t byte, int fe)
 		/* Overrun: the frame waiting in the shifter is overwritten.
 		 * The next frame to enter the FIFO carries DOR ("frames lost
 		 * between the last frame read and the next one"). */
+		trace_event(u->trace, u->avr->cycle, "uart overrun %02X", u->rx_shift_byte);
 		u->rx_shift_byte = byte;
 		u->rx_shift_fe = (uint8_t)fe;
 		u->rx_dor = 1;
@@ -244,6 +280,9 @@ static avr_cycle_count_t usart_rx_dec_timer(avr_t *avr, avr_cycle_count_t when,
 static void usart_rx_begin(usart_t *u, uint8_t byte, avr_cycle_count_t start,
 			   avr_cycle_count_t end)
 {
+	if (usart_rxen(u)) {
+		usart_rx_start_bit(u, start);
+	}
 	u->rx_wire_byte = byte;
 	u->rx_wire_busy = 1;
 	u->rx_wire_end = end;

@@ -52,6 +52,18 @@ def test_baud_that_is_not_a_line_rate_stops_the_build(baud, tmp_path):
 
 
 @pytest.mark.parametrize("board", ["m32d", "m128s"])
+def test_921600_is_refused_with_its_reason(board, tmp_path):
+    """docs/protocol.md, "The line": 921600 divides the crystal but the
+    firmware does not keep up; make says so in one line and builds nothing."""
+    r = make("BOARD=" + board, "MODE=gate", "BAUD=921600", tmp_path=tmp_path)
+    assert r.returncode != 0
+    refusal = [l for l in r.stderr.splitlines() if "BAUD=921600" in l]
+    assert len(refusal) == 1 and "refused" in refusal[0] and "80 cycles" in refusal[0] \
+        and "460800" in refusal[0], r.stderr
+    assert "avr-gcc" not in r.stdout
+
+
+@pytest.mark.parametrize("board", ["m32d", "m128s"])
 def test_auto_baud_links_the_autobaud_module_only(board, tmp_path):
     r = make("BOARD=" + board, "MODE=gate", "BAUD=auto", tmp_path=tmp_path)
     assert r.returncode == 0, r.stderr

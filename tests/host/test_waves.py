@@ -11,6 +11,8 @@ from orfa import boardmap, plot, vcd, waves
 from orfa.cli import main
 from orfa.cli import plot as cli_plot
 
+import wavegen
+
 F = boardmap.F_CPU
 PS = 1e12 / F
 #: The simulator's timescale at 7.3728 MHz: 100 ns, the longest power of
@@ -328,3 +330,152 @@ def test_command_errors_are_one_line(tmp_path, capsys, argv, message):
     err = capsys.readouterr().err
     assert err.startswith(message.format(**fill)) and err.count("\n") == 1
     assert not (tmp_path / "x.png").exists()
+
+
+# --- decoded rows: the serial line's bytes, the I2C bus's frames ---------------
+
+BIT = F // 115200                                  # the gateway's default rate: 64 cycles
+
+
+def serial_vcd(tmp_path, request=b"S A0 10 41 P\r", reply=b"SWAAAP\r\n"):
+    """The PC's request on RXD (D0) and the board's reply on TXD (D1); the
+    file goes on a while after them (B0 moves), as the simulator's does."""
+    rx, _ = wavegen.serial(request, BIT, t=10000)
+    tx, _ = wavegen.serial(reply, BIT, t=10000 + (len(request) + 20) * 10 * BIT)
+    src = tmp_path / "serial.vcd"
+    src.write_text(make_vcd({"D0": [(500, 1)] + rx, "D1": [(500, 1)] + tx,
+                             "B0": [(tx[-1][0] + 5000, 1)]}))
+    return src
+
+
+def in_order(wanted, texts):
+    """Whether WANTED appear in TEXTS in this order (others between them)."""
+    it = iter(texts)
+    return all(any(t == w for t in it) for w in wanted)
+
+
+def test_serial_rows_carry_their_decoded_bytes(tmp_path, capsys):
+    """Both directions, each byte written over its frame as the character
+    it is (CR, LF, SP named); -v prints them instead of the bits' widths."""
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "serial.svg"
+    assert main(["plot", str(serial_vcd(tmp_path)), "--signals", "D0", "D1", "-o", str(out),
+                 "-v"]) == 0
+    got = {}
+    for ln in capsys.readouterr().out.splitlines():
+        name, _, text = ln.partition(" ")
+        got.setdefault(name, []).append(text.strip())
+    request = ["S", "SP", "A", "0", "SP", "1", "0", "SP", "4", "1", "SP", "P", "CR"]
+    reply = ["S", "W", "A", "A", "A", "P", "CR", "LF"]
+    assert got["D0"][:-1] == request and got["D1"][:-1] == reply
+    texts = svg_texts(out)
+    drawn = [plot.GLYPHS.get(t, t) for t in request]      # a space drawn as one glyph
+    assert in_order(drawn, texts) and in_order(reply, texts)
+
+
+def test_serial_rows_are_decoded_at_the_given_rate(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    rx, _ = wavegen.serial(b"V\r", F // 9600, t=10000)
+    src = tmp_path / "slow.vcd"
+    src.write_text(make_vcd({"D0": [(500, 1)] + rx, "B0": [(rx[-1][0] + 5000, 1)]}))
+    assert main(["--baud", "9600", "plot", str(src), "--signals", "D0", "-v",
+                 "-o", str(tmp_path / "slow.png")]) == 0
+    assert capsys.readouterr().out.splitlines()[:2] == ["D0         V", "D0         CR"]
+
+
+def test_decoded_frames_are_read_whole_when_the_window_cuts_them():
+    """A window that starts inside a frame: the frames inside it are read
+    from the whole line (not from a falling edge inside the cut one), and
+    the cut one is not written."""
+    rx, starts = wavegen.serial(b"\x00\x41\x42", BIT, t=1000)
+    whole = waves.window("D0", 1, rx, 0, 10 ** 6)
+    frames = cli_plot.decoded(cli_plot.Namer(list(M32D_PINS)), {"D0": whole}, ["D0"], F, 115200)
+    row = plot.Row(waves.clip(whole, starts[0] + 5 * BIT, 10 ** 6), "D0", False, frames["D0"])
+    assert [a.text for a in plot.annotations([row], F) if a.kind == "decoded"] == ["A", "B"]
+
+
+def i2c_vcd(tmp_path):
+    """The bus's own wires `sda` and `scl` (the simulator's bit-level bus):
+    an EEPROM's random read with a repeated START and the master's NACK, a
+    slave that stretches the clock, an absent address."""
+    bus = wavegen.Bus(t=5000)
+    bus.start()
+    for b in (0xA0, 0x10):
+        bus.byte(b, True)
+    bus.restart()
+    bus.byte(0xA1, True)
+    bus.byte(0x41, True)
+    bus.byte(0x42, False)
+    bus.stop()
+    bus.t += 500
+    bus.start()
+    bus.byte(0x10, True)
+    bus.byte(0x05, True, stretch=400)              # the slave holds SCL low
+    bus.stop()
+    bus.t += 500
+    bus.start()
+    bus.byte(0xE0, False)
+    bus.stop()
+    src = tmp_path / "bus.vcd"
+    idle = {n: [(100, 1)] + es for n, es in bus.edges.items()}     # high from power-up
+    src.write_text(make_vcd(idle, names=M32D_PINS + ("i2c", "sda", "scl")))
+    return src
+
+
+I2C_TEXTS = ["S", "A0 W", "A", "10", "A", "Sr", "A1 R", "A", "41", "A", "42", "N", "P",
+             "S", "10 W", "A", "05", "A", "P", "S", "E0 W", "N", "P"]
+
+
+def test_sda_row_carries_the_decoded_i2c(tmp_path, capsys):
+    """With wires `sda` and `scl` in the capture, the default rows are the
+    bus's (labelled as the I2C bus), and SDA's has START, address + R/W,
+    data, ACK/NACK, repeated START and STOP written on it."""
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "bus.svg"
+    assert main(["plot", str(i2c_vcd(tmp_path)), "-o", str(out), "-v"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [ln.split()[0] for ln in lines] == ["sda"] * (len(I2C_TEXTS) + 1) + ["scl"]
+    assert [ln[11:] for ln in lines[:len(I2C_TEXTS)]] == I2C_TEXTS
+    texts = svg_texts(out)
+    assert "sda" in texts and "I2C bus" in texts
+    assert in_order(I2C_TEXTS, texts)
+
+
+def test_with_the_bus_wires_the_twi_pins_are_no_default_rows():
+    """The TWI pins (C0/C1 on the M32-D, a slave's 10/D0) carry the bus's
+    lines: with the wires sda and scl in the capture, those are the rows."""
+    names = list(M32D_PINS) + ["i2c", "sda", "scl", "10/C0"]
+    namer = cli_plot.Namer(names, {"": "m32d", "10": "m32d"})
+    assert [namer.rank(n) for n in ("sda", "scl", "C0", "C1", "10/C0", "i2c")] == \
+        [3, 3, None, None, None, 3]
+    assert namer.label("sda") == "sda\nI2C bus" and namer.periodic("scl") is False
+    without = cli_plot.Namer(list(M32D_PINS), {"": "m32d"})
+    assert without.rank("C0") == 3
+
+
+def test_without_scl_sda_is_not_decoded(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    bus = wavegen.Bus(t=5000)
+    bus.start()
+    bus.byte(0xA0, True)
+    bus.stop()
+    src = tmp_path / "sda.vcd"
+    src.write_text(make_vcd({"sda": [(100, 1)] + bus.edges["sda"]}, names=M32D_PINS + ("sda",)))
+    assert main(["plot", str(src), "-o", str(tmp_path / "sda.png"), "-v"]) == 0
+    assert "A0 W" not in capsys.readouterr().out
+
+
+def test_decoded_texts_that_would_cover_each_other_are_not_drawn(tmp_path, capsys):
+    """Forty bytes in a window of 200 ms: each byte's frame is far narrower
+    than its text, so none is written (a few would read as a wrong word);
+    -v still prints every one."""
+    pytest.importorskip("matplotlib")
+    rx, _ = wavegen.serial(b"QZ" * 20, BIT, t=10000)
+    src = tmp_path / "dense.vcd"
+    src.write_text(make_vcd({"D0": [(500, 1)] + rx, "B0": [(F // 5, 1)]}))
+    out = tmp_path / "dense.svg"
+    assert main(["plot", str(src), "--signals", "D0", "--from", "0", "--to", "200ms", "-v",
+                 "-o", str(out)]) == 0
+    assert capsys.readouterr().out.splitlines()[:40] == ["D0         Q", "D0         Z"] * 20
+    texts = svg_texts(out)
+    assert "Q" not in texts and "Z" not in texts

@@ -273,6 +273,8 @@ def board(bench):
 F_CPU = boardmap.F_CPU
 #: One servo frame: 20 ms.
 SERVO_FRAME = F_CPU * 20 // 1000
+#: docs/registers.md "Servos": widths within 1.1 us = 8 cycles of the command.
+WIDTH_TOL = 8
 
 def _layout(board: str) -> dict:
     """Registers and pins of a board with all its drivers, from its map

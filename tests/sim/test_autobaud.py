@@ -55,6 +55,8 @@ def noise(rng, n, avoid=b"\r"):
 @pytest.mark.parametrize("board,noise_rate,rate", [
     ("m32d", 9600, 115200), ("m32d", 115200, 2400), ("m32d", 2400, 38400),
     ("m128s", 57600, 14400), ("m128s", 4800, 76800), ("m128s", 115200, 9600),
+    ("m32d", 460800, 230400), ("m32d", 230400, 460800), ("m32d", 2400, 460800),
+    ("m128s", 460800, 230400), ("m128s", 230400, 460800), ("m128s", 460800, 2400),
 ])
 def test_noise_first_then_the_preamble(board, noise_rate, rate):
     """Random bytes at another rate, then bytes at the right rate that are
@@ -72,6 +74,8 @@ def test_noise_first_then_the_preamble(board, noise_rate, rate):
 
 @pytest.mark.parametrize("board,wrong,rate", [
     ("m32d", 9600, 115200), ("m128s", 115200, 9600), ("m32d", 2400, 57600),
+    ("m32d", 460800, 2400), ("m128s", 460800, 2400), ("m32d", 2400, 460800),
+    ("m128s", 230400, 460800),
 ])
 def test_a_preamble_at_a_wrong_rate_first_is_not_kept(board, wrong, rate):
     """0x0Ds at another rate, then quiet, look like a preamble and lock that

@@ -32,15 +32,13 @@ WARMUP = 5
 TRIES = 3
 TARGET = 95.0
 
-M32D_DOR = pytest.mark.xfail(reason="issue 20: the M32-D's servo interrupt holds interrupts "
-                             "off longer than two frames above 115200 (characters lost: DOR)")
 FIRMWARE_TIME = pytest.mark.xfail(reason="issue 20: the firmware's time per step is longer "
                                   "than the step's wire time (its servo write, per character "
                                   "and per request costs)")
 
-CORRECT = {("m32d", 230400): M32D_DOR, ("m32d", 460800): M32D_DOR}
-AT_TARGET = {("m32d", 115200): FIRMWARE_TIME, ("m32d", 230400): M32D_DOR,
-             ("m32d", 460800): M32D_DOR, ("m128s", 230400): FIRMWARE_TIME,
+CORRECT = {}
+AT_TARGET = {("m32d", 115200): FIRMWARE_TIME, ("m32d", 230400): FIRMWARE_TIME,
+             ("m32d", 460800): FIRMWARE_TIME, ("m128s", 230400): FIRMWARE_TIME,
              ("m128s", 460800): FIRMWARE_TIME}
 
 

@@ -8,9 +8,8 @@ must be within 1.1 us = 8 cycles of the commanded width, the period 20 ms
 
 import pytest
 
-from conftest import F_CPU, SERVO_FRAME, us_to_cycles
+from conftest import F_CPU, SERVO_FRAME, WIDTH_TOL, us_to_cycles
 
-WIDTH_TOL = 8                       # cycles: 1.1 us at 7.3728 MHz
 PERIOD_TOL = SERVO_FRAME // 1000    # 0.1 %: 147 cycles
 BAD_LENGTH, BAD_VALUE, PIN_BUSY = 0x01, 0x02, 0x03
 #: docs: an off channel on a counter with pulsing channels: a pulse of 1-30 us.

@@ -4,10 +4,7 @@ gateway's RXD and TXD wires, decodes exactly the bytes the host sent and
 received, each frame starting at the cycle the trace gives; and it reads a
 capture of one simulated second in under 10 s."""
 
-import json
 import shutil
-import subprocess
-import time
 
 import pytest
 import serial
@@ -15,42 +12,25 @@ import serial
 from conftest import REPLY_TIMEOUT, require_builds
 from orfa.protocol import F_CPU
 from orfa.sim import BOARDS, SimBoard
+from sigrok import TIMESCALE, decode as sigrok_decode, needs_sigrok, sample_cycle
 
 #: The gateway's serial pins, as the VCD names its wires (the board files'
 #: UART_RX and UART_TX: USART1's RXD1/TXD1 on the M128-S).
 WIRES = {"m32d": ("D0", "D1"), "m128s": ("D2", "D3")}
 BIT = F_CPU // 115200                          # 64 cycles a bit on both sides
-#: The VCD's timescale at 7.3728 MHz, and so sigrok's sample rate (10 MHz).
-TIMESCALE, UNIT_S = "100ns", 1e-7
 REQUESTS = ["V", "S A0 10 48 69 P", "S A0 10 S A1 02 P", "S AA 00 00 S AB 01 P", "V"]
 
-pytestmark = pytest.mark.skipif(shutil.which("sigrok-cli") is None,
-                                reason="needs sigrok-cli (tools/setup.sh installs it)")
-
-
-def sample_cycle(sample):
-    """A sample of the capture (one timescale unit) as the nearest cycle:
-    the simulator wrote each edge at its cycle's time rounded to the unit."""
-    return (2 * sample * F_CPU + 10 ** 7) // (2 * 10 ** 7)
+pytestmark = needs_sigrok
 
 
 def decode(path, board):
     """sigrok-cli's uart decoder on the board's RXD (rx) and TXD (tx) wires:
     {"RX": [(start cycle, byte)], "TX": [...]}, and the seconds it took."""
     rx, tx = WIRES[board]
-    cmd = ["sigrok-cli", "-i", str(path), "-I", "vcd",
-           "-P", "uart:rx=%s:tx=%s:baudrate=115200" % (rx, tx),
-           "-A", "uart=rx-data:tx-data", "--protocol-decoder-jsontrace"]
-    t0 = time.monotonic()
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
-    took = time.monotonic() - t0
-    assert r.returncode == 0, r.stderr
-    out = {"RX": [], "TX": []}
-    for ev in json.loads(r.stdout)["traceEvents"]:
-        if ev["ph"] == "B":                    # "ts": microseconds, 0.1 a sample
-            sample = round(ev["ts"] * 1e-6 / UNIT_S)
-            out[ev["tid"]].append((sample_cycle(sample), int(ev["name"], 16)))
-    return out, took
+    rows, took = sigrok_decode(path, "uart:rx=%s:tx=%s:baudrate=115200" % (rx, tx),
+                               "uart=rx-data:tx-data")
+    return {k: [(begin, int(text, 16)) for begin, _, text in rows.get(k, [])]
+            for k in ("RX", "TX")}, took
 
 
 def run_gateway(board, seconds=1.0):

@@ -1,7 +1,8 @@
 """`orfa plot`: draw servo pulses, motor PWM, chip selects and bus activity
 with matplotlib, from the simulator's VCD (`orfa plot TRACE.vcd`) or from a
 live simulated board through its control socket (`orfa plot --sim BOARD`,
-`orfa plot --control PATH`). docs/plot.md."""
+`orfa plot --control PATH`), with the serial lines' bytes and the I2C
+bus's frames (wires `sda` and `scl`) decoded on them. docs/plot.md."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import shlex
 import sys
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
-from .. import boardmap, vcd, waves
+from .. import boardmap, decode, vcd, waves
 from .. import plot as drawing
 from ..sim import SimError
 from ..simctl import SimControl, SimControlError, parse_edges
@@ -31,6 +32,8 @@ _HIDDEN = {"SERVO_CLK", "SERVO_RST"}   # the M128-S's counter lines: its servoN 
 #: a byte): their rows give widths and a count, no period or duty.
 _NOT_PERIODIC = {"I2C_BUSY", "TWI_SCL", "TWI_SDA", "UART_RX", "UART_TX", "SPI_SS", "SPI_SCK",
                  "SPI_MOSI", "SPI_MISO"}
+#: The I2C bus's own wires in a capture (the lines every board's TWI is on).
+BUS_WIRES = {"sda": "TWI_SDA", "scl": "TWI_SCL"}
 
 
 def parse_time(text: str) -> float:
@@ -56,6 +59,8 @@ class Namer:
         boards = boards or {}
         self.maps = {prefix: boardmap.load(boards[prefix]) if prefix in boards else _guess(group)
                      for prefix, group in groups.items()}
+        #: the capture has the bus's own wires: the TWI pins carry the same lines
+        self.bus_wires = all(wire in names for wire in BUS_WIRES)
 
     def _split(self, name: str) -> Tuple[str, str]:
         prefix, _, local = name.rpartition("/")
@@ -68,6 +73,8 @@ class Namer:
             return [("SERVO_SIGNAL", int(local[5:]))]
         if local == "i2c":
             return [("I2C_BUSY", 0)]
+        if not prefix and local in BUS_WIRES:
+            return [(BUS_WIRES[local], 0)]
         return [(p.function, p.index) for p in (m.pins if m else ()) if p.signal == local]
 
     def label(self, name: str) -> str:
@@ -76,6 +83,9 @@ class Namer:
         for function, index in self.functions(name):
             if function == "I2C_BUSY":
                 uses.append("bus busy")
+                continue
+            if not prefix and local in BUS_WIRES:
+                uses.append("I2C bus")
                 continue
             if function == "SERVO_SIGNAL":
                 pin = self._servo_pin(prefix, index)
@@ -114,6 +124,9 @@ class Namer:
             return None if local.startswith("cnt") else 5
         if all(f in _HIDDEN for f, _ in uses):
             return None
+        if self.bus_wires and local not in BUS_WIRES and \
+                all(f in BUS_WIRES.values() for f, _ in uses):
+            return None                      # a TWI pin: the rows sda and scl show its line
         return min(_RANK.get(f, 5) for f, _ in uses)
 
 
@@ -165,7 +178,12 @@ def _windows(trace: vcd.Trace, start: int, end: int) -> Dict[str, waves.Wave]:
             for n in trace.names()}
 
 
-def _from_file(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]:
+Waves = Dict[str, waves.Wave]
+
+
+def _from_file(args) -> Tuple[Waves, Waves, List[str], Namer, int, str]:
+    """The window's waves, the whole file's (to decode), names, namer,
+    clock and the title."""
     try:
         trace = vcd.load(args.trace)
     except OSError as exc:
@@ -178,11 +196,12 @@ def _from_file(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str]
     if end <= start:
         raise UsageError("--to must be after --from")
     names = trace.names()
-    found = _windows(trace, start, end)
+    whole = _windows(trace, 0, max(trace.end + 1, end))
+    found = {n: waves.clip(w, start, end) for n, w in whole.items()}
     boards = trace.board_of()
     if args.board:
         boards[""] = args.board
-    return found, names, Namer(names, boards), f, os.path.basename(args.trace)
+    return found, whole, names, Namer(names, boards), f, os.path.basename(args.trace)
 
 
 def _run_commands(port: str, args) -> None:
@@ -326,8 +345,37 @@ def _activity(found: Dict[str, waves.Wave], names: Sequence[str], f_cpu: int
     return max(w0.start, min(times) - pad), min(w0.end, max(times) + pad + 1)
 
 
+def _frames_whole(window: Tuple[int, int], frames: Dict[str, List[decode.Frame]],
+                  w0: waves.Wave) -> Tuple[int, int]:
+    """The window widened to hold whole every decoded frame it cuts (a
+    serial byte's stop bit after the line's last edge), within w0's."""
+    start, end = window
+    for f in (f for fs in frames.values() for f in fs):
+        if f.start < start < f.end:
+            start = f.start
+        if f.start < end < f.end:
+            end = f.end + 1
+    return max(w0.start, start), min(w0.end, end)
+
+
 def _clip_all(found: Dict[str, waves.Wave], window: Tuple[int, int]) -> Dict[str, waves.Wave]:
     return {n: waves.clip(w, *window) for n, w in found.items()}
+
+
+def decoded(namer: Namer, whole: Waves, chosen: Sequence[str], f_cpu: int, baud: int
+            ) -> Dict[str, List[decode.Frame]]:
+    """What orfa.decode reads on the chosen rows, from their whole waves (a
+    frame the window cuts is read right): a board's serial lines (UART_RX,
+    UART_TX) at BAUD, and on the `sda` row the I2C bus when the capture has
+    both `sda` and `scl`."""
+    out = {}
+    for n in chosen:
+        uses = {f for f, _ in namer.functions(n)}
+        if uses & {"UART_RX", "UART_TX"}:
+            out[n] = decode.uart(whole[n], f_cpu / baud)
+        elif n == "sda" and "scl" in whole:
+            out[n] = decode.i2c(whole["sda"], whole["scl"])
+    return out
 
 
 def cmd_plot(args) -> int:
@@ -354,10 +402,10 @@ def cmd_plot(args) -> int:
     if args.do and not live:
         raise UsageError("--do runs commands on a live board: give --sim or --control")
     if live:
-        found, names, namer, f_cpu, source, zero = _from_sim(args)
-        found = _narrow(found, args, f_cpu, zero)
+        whole, names, namer, f_cpu, source, zero = _from_sim(args)
+        found = _narrow(whole, args, f_cpu, zero)
     else:
-        found, names, namer, f_cpu, source = _from_file(args)
+        found, whole, names, namer, f_cpu, source = _from_file(args)
     patterns = [p for item in (args.signals or ()) for p in item.split(",") if p]
 
     def changing():
@@ -369,13 +417,17 @@ def cmd_plot(args) -> int:
         # the default rows those that change in it
         window = _activity(found, chosen, f_cpu)
         if window is not None:
+            window = _frames_whole(window, decoded(namer, whole, chosen, f_cpu, args.baud),
+                                   found[chosen[0]])
             found = _clip_all(found, window)
             if not patterns:
                 chosen, more = select(namer, names, changing(), patterns)
     if not chosen:
         # nothing moved: the servo rows, flat, rather than an empty picture
         chosen = [n for n in names if namer.rank(n) == 0][:4] or names[:4]
-    rows = [drawing.Row(found[n], namer.label(n), namer.periodic(n)) for n in chosen]
+    frames = decoded(namer, whole, chosen, f_cpu, args.baud)
+    rows = [drawing.Row(found[n], namer.label(n), namer.periodic(n), frames.get(n, ()))
+            for n in chosen]
     try:
         notes = drawing.render(rows, f_cpu, args.output, title=source)
     except drawing.PlotUnavailable as exc:
