@@ -223,10 +223,12 @@ AVR_LIBC_INCLUDE ?= $(abspath $(dir $(shell avr-gcc -print-file-name=libc.a))../
 SIM_CFLAGS := -std=gnu99 -O2 -g -Wall -Wextra -Werror -I. -Isim -I/usr/include/simavr -idirafter $(AVR_LIBC_INCLUDE)
 SIM_LIBS := -lsimavr -lelf -lutil -lpthread -lm
 
-sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf build/sim-fw/twi_slave_echo_m128.elf
+sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf build/sim-fw/twi_slave_echo_m128.elf \
+	build/sim-fw/twi_arb_master.elf
 
 # Test firmware for the simulator's bus tests (tests/sim/fw), not ORFA: the
-# echo slave on an ATmega32 at 0x20 and on an ATmega128 at 0x22.
+# echo slave on an ATmega32 at 0x20 and on an ATmega128 at 0x22, a master
+# that loses arbitration (ATmega32).
 # Each runs on a board's MCU at its clock (board.h).
 SIM_FW_CFLAGS := -std=gnu99 -Os -Wall -Wextra -Werror
 build/sim-fw/%_m128.elf: tests/sim/fw/%.c

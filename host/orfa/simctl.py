@@ -281,6 +281,31 @@ class SimControl(Closing):
         """A device on the I2C bus holds SCL low (on) or lets it go."""
         self.request("i2c hold-scl %s" % ("on" if on else "off"))
 
+    def i2c_arb(self, byte: int, bit: int) -> None:
+        """A device pulls SDA low for bit `bit` (0..7 MSB first, 8 the
+        acknowledge) of byte `byte` (0: the address after the next START;
+        every address and data byte after it counts) of the next
+        transaction: where the master sends a 1 it loses arbitration
+        (0x38). Fires once."""
+        self.request("i2c arb %d %d" % (byte, bit))
+
+    def i2c_glitch(self, cond: str, byte: int, bit: int) -> None:
+        """A START (`cond` "start") or STOP ("stop") condition in bit `bit`
+        (1..8) of byte `byte` of the next transaction, as i2c_arb counts
+        them: a bus error (0x00) for the master and the addressed slave.
+        Fires once."""
+        self.request("i2c glitch %s %d %d" % (cond, byte, bit))
+
+    def i2c_disarm(self) -> None:
+        """Forget an i2c_arb or i2c_glitch that has not fired."""
+        self.request("i2c disarm")
+
+    def i2c_armed(self) -> str:
+        """The fault armed for the next transaction: "arb BYTE BIT",
+        "glitch start|stop BYTE BIT", or "none" once it fired."""
+        w = self.request("i2c").split()
+        return " ".join(w[w.index("fault") + 1:])
+
     def i2c(self) -> Dict[str, int]:
         """The bus lines: {"sda", "scl" (levels), "stuck" (pulses the stuck
         device still waits for), "hold_scl" (0/1)}."""

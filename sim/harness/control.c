@@ -637,6 +637,48 @@ static int req_reset(control_req_ctx_t *q)
 	return 0;
 }
 
+#define I2C_ARGS "stuck N | hold-scl on|off | arb BYTE BIT | glitch start|stop BYTE BIT | disarm"
+
+/* `i2c arb BYTE BIT`, `i2c glitch start|stop BYTE BIT`, `i2c disarm`: a
+ * fault in the middle of a byte of the next transaction (twi_fault.h). */
+static int req_i2c_fault(control_req_ctx_t *q, twi_bus_t *bus)
+{
+	char **argv = q->argv;
+	twi_fault_kind_t kind = TWI_FAULT_ARB;
+	uint64_t byte, bit;
+	int at = 2;
+
+	if (!strcasecmp(argv[1], "disarm") && q->argc == 2) {
+		twi_fault_arm(&bus->fault, TWI_FAULT_NONE, 0, 0);
+		reply_printf(q->r, "OK");
+		return 0;
+	}
+	if (!strcasecmp(argv[1], "glitch")) {
+		if (q->argc != 5 || (strcasecmp(argv[2], "start") && strcasecmp(argv[2], "stop"))) {
+			reply_printf(q->r, "ERR i2c glitch start|stop BYTE BIT");
+			return 0;
+		}
+		kind = !strcasecmp(argv[2], "start") ? TWI_FAULT_START : TWI_FAULT_STOP;
+		at = 3;
+	} else if (strcasecmp(argv[1], "arb") || q->argc != 4) {
+		reply_printf(q->r, "ERR i2c [" I2C_ARGS "]");
+		return 0;
+	}
+	if (parse_u64(argv[at], &byte) < 0 || parse_u64(argv[at + 1], &bit) < 0 ||
+	    twi_fault_arm(&bus->fault, kind, byte > 255 ? 256 : (unsigned)byte,
+			  bit > 8 ? 9 : (unsigned)bit) < 0) {
+		reply_printf(q->r, kind == TWI_FAULT_ARB ?
+			     "ERR i2c arb BYTE BIT: BYTE 0..255 from the next START (0: its address),"
+			     " BIT 0..7 MSB first or 8 the acknowledge" :
+			     "ERR i2c glitch start|stop BYTE BIT: BYTE 0..255 from the next START"
+			     " (0: its address), BIT 1..8 (8: the acknowledge; bit 0 is where a"
+			     " legal START or STOP goes)");
+		return 0;
+	}
+	reply_printf(q->r, "OK");
+	return 0;
+}
+
 static int req_i2c(control_req_ctx_t *q)
 {
 	twi_bus_t *bus = q->c->bus;
@@ -657,11 +699,17 @@ static int req_i2c(control_req_ctx_t *q)
 		   (!strcasecmp(argv[2], "on") || !strcasecmp(argv[2], "off"))) {
 		twi_bus_hold_scl(bus, !strcasecmp(argv[2], "on"), now);
 		reply_printf(q->r, "OK");
+	} else if (q->argc >= 2 && (!strcasecmp(argv[1], "arb") || !strcasecmp(argv[1], "glitch") ||
+				    !strcasecmp(argv[1], "disarm"))) {
+		return req_i2c_fault(q, bus);
 	} else if (q->argc == 1) {
-		reply_printf(q->r, "sda %d scl %d stuck %" PRIu32 " hold-scl %s", bus->sda, bus->scl,
-			     bus->stuck, bus->hold_scl ? "on" : "off");
+		char fault[40];
+
+		reply_printf(q->r, "sda %d scl %d stuck %" PRIu32 " hold-scl %s fault %s", bus->sda,
+			     bus->scl, bus->stuck, bus->hold_scl ? "on" : "off",
+			     twi_fault_describe(&bus->fault, fault, sizeof(fault)));
 	} else {
-		reply_printf(q->r, "ERR i2c [stuck N | hold-scl on|off]");
+		reply_printf(q->r, "ERR i2c [" I2C_ARGS "]");
 	}
 	return 0;
 }
@@ -766,7 +814,7 @@ static const control_req_t control_reqs[] = {
 	{ "rx", "CYCLE HEX...", 0, CONTROL_MAX_ARGS, CONTROL_GATEWAY, req_rx },
 	{ "line", "", 1, 1, CONTROL_GATEWAY, req_line },
 	{ "signals", "", 1, 1, CONTROL_ANY_BOARD, req_signals },
-	{ "i2c", "[stuck N | hold-scl on|off]", 0, 3, CONTROL_ANY_BOARD, req_i2c },
+	{ "i2c", "[" I2C_ARGS "]", 0, 5, CONTROL_ANY_BOARD, req_i2c },
 	{ "fault", "hang", 2, 2, CONTROL_ANY_BOARD, req_fault },
 	{ "reset", "external|power|brownout", 2, 2, CONTROL_ANY_BOARD, req_reset },
 	{ "sense", "@ADDR QUANTITY V...", 3, CONTROL_MAX_ARGS, CONTROL_PART, req_sense },

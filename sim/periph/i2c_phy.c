@@ -52,7 +52,12 @@ void i2c_phy_condition(twi_bus_t *bus, twi_dev_t *d, int start)
 	 * SCL pulse after an acknowledge); later in a byte it is a bus error. */
 	int illegal = d->phy != TWI_PHY_IDLE && (d->nbits > 1 || bus->abort);
 
-	/* SDA moved, so this device does not pull it; a byte under way ends */
+	/* SDA moved, so this device does not pull it (a glitch moves no line,
+	 * twi_bus_glitch: then it lets SDA go, its front starting over); a
+	 * byte under way ends */
+	if (d->drv.sda_low) {
+		phy_sda(bus, d, 0, bus->cycle);
+	}
 	d->nbits = 0;
 	d->shift = 0;
 	d->waiting = 0;

@@ -81,7 +81,7 @@ static void twi_done(sim_twi_t *t, uint8_t status)
  * from the release); a START waits for a free bus (SDA and SCL high).
  */
 
-enum { M_LOW = 1, M_RISE, M_MID, M_FALL };
+enum { M_LOW = 1, M_RISE, M_MID, M_FALL, M_GLITCH };
 
 static void twi_drive(sim_twi_t *t, int sda_low, int scl_low, avr_cycle_count_t cycle)
 {
@@ -118,8 +118,15 @@ static int twi_low_sda(const sim_twi_t *t)
 	case TWI_OP_RX:
 		return t->bit == 8 && t->op_ack;
 	default:
-		return t->bit < 8 && !(t->byte & (0x80 >> t->bit));
+		/* after a lost bit the master sends nothing (1s) */
+		return !t->lost && t->bit < 8 && !(t->byte & (0x80 >> t->bit));
 	}
+}
+
+/* The rival (`i2c arb`, twi_fault.h) acts in the bit under way. */
+static int twi_rival_bit(const sim_twi_t *t)
+{
+	return t->fault == TWI_FAULT_ARB && t->bit == t->fault_bit;
 }
 
 /* A bit's SCL low half began at cycle B: SDA changes a quarter period on
@@ -128,7 +135,7 @@ static int twi_low_sda(const sim_twi_t *t)
 static void twi_low_half(sim_twi_t *t, avr_cycle_count_t b)
 {
 	t->bit_at = b;
-	if (twi_low_sda(t) != t->drv.sda_low) {
+	if (twi_low_sda(t) != t->drv.sda_low || twi_rival_bit(t)) {
 		twi_at(t, b + t->half / 2, M_LOW);
 	} else {
 		twi_at(t, b + t->half, M_RISE);
@@ -151,6 +158,12 @@ static void twi_go(sim_twi_t *t, avr_cycle_count_t b)
 		t->byte = *twi_reg(t, t->regs->twdr);
 	}
 	if (t->op == TWI_OP_SLA || t->op == TWI_OP_TX || t->op == TWI_OP_RX) {
+		unsigned bit = 0;
+
+		t->lost = 0;
+		t->fault = (uint8_t)twi_fault_here(&t->bus->fault, &bit);
+		t->fault_bit = (uint8_t)bit;
+		t->bus->in_byte = &t->master;
 		twi_bus_byte(t->bus, b, b + 18 * t->half);
 	}
 	twi_low_half(t, b);
@@ -196,6 +209,12 @@ static void twi_high(sim_twi_t *t, avr_cycle_count_t h)
 {
 	int sda = t->bus->sda;
 
+	if ((t->fault == TWI_FAULT_START || t->fault == TWI_FAULT_STOP) &&
+	    t->bit == t->fault_bit) {
+		/* a glitch armed for this bit: in SCL's high half */
+		twi_at(t, h + t->half / 2, M_GLITCH);
+		return;
+	}
 	switch (t->op) {
 	case TWI_OP_START:
 		t->fall_at = h + t->half;
@@ -208,17 +227,105 @@ static void twi_high(sim_twi_t *t, avr_cycle_count_t h)
 	case TWI_OP_RX:
 		if (t->bit < 8) {
 			t->byte = (uint8_t)(t->byte << 1 | sda);
+		} else if (!t->op_ack && !sda) {
+			t->lost = 1;	/* its NACK read low: arbitration lost */
 		}
 		break;
 	default:
 		if (t->bit == 8) {
 			t->line_ack = (uint8_t)!sda;
+		} else {
+			t->line_byte = (uint8_t)(t->line_byte << 1 | sda);
+			if (!t->drv.sda_low && !sda) {
+				/* a bit sent high reads low: arbitration lost;
+				 * SDA let go for the rest of the byte, which it
+				 * clocks to its end */
+				t->lost = 1;
+			}
 		}
-		/* A bit sent high that reads low is arbitration lost (not
-		 * modelled yet: one master per bus). */
 		break;
 	}
 	twi_at(t, h + t->half, M_FALL);
+}
+
+/* The rival (`i2c arb`, twi_fault.h) pulls SDA low for the bit that begins
+ * at WHEN (ON), or lets it go when it ends. */
+static void twi_rival(sim_twi_t *t, int on, avr_cycle_count_t when)
+{
+	if (twi_rival_bit(t)) {
+		twi_bus_drive(t->bus, &t->bus->rival_drv, on, 0, when);
+	}
+}
+
+/* The master lost arbitration in the byte that ended at WHEN (SCL fell
+ * after its acknowledge): it is not the master any more. Addressed by the
+ * address the devices read (its TWAR, TWEA set: its own front acknowledged
+ * it, twi_dev_start) it is a slave from here, 0x68 (written to), 0x78 (the
+ * general call, with TWGCE) or 0xB0 (read from); else 0x38, holding SCL
+ * until TWINT is cleared. */
+static void twi_arb_lost(sim_twi_t *t, avr_cycle_count_t when)
+{
+	t->owner = 0;
+	t->bus->clocked = 0;
+	if (t->addressed) {
+		trace_event(t->bus->trace, when, "twi arb-lost %02X", t->sl_addr);
+		twi_drive(t, 0, 0, when);	/* its slave side holds SCL */
+		t->op = TWI_OP_NONE;
+		if (t->addressed == TWI_SLAVE_TX) {
+			t->status = TW_ST_ARB_LOST_SLA_ACK;
+		} else {
+			t->status = t->sl_gcall ? TW_SR_ARB_LOST_GCALL_ACK : TW_SR_ARB_LOST_SLA_ACK;
+		}
+		t->sl_status = t->status;
+		twi_sync(t);
+		return;
+	}
+	trace_event(t->bus->trace, when, "twi arb-lost");
+	twi_drive(t, 0, 1, when);
+	twi_done(t, TW_MT_ARB_LOST);
+}
+
+/* This master's byte is over (done, cut): the lines' conditions are no
+ * longer its bus error. */
+static void twi_byte_over(sim_twi_t *t)
+{
+	if (t->bus->in_byte == &t->master) {
+		t->bus->in_byte = NULL;
+	}
+}
+
+/* A bus error at WHEN in the byte under way: the TWI lets the lines go
+ * and sets TWINT with 0x00 (TWSTO or TWEN off recovers). */
+static void twi_bus_error(sim_twi_t *t, avr_cycle_count_t when)
+{
+	trace_event(t->bus->trace, when, "twi bus-error");
+	t->owner = 0;
+	t->bus->clocked = 0;
+	twi_drive(t, 0, 0, when);
+	twi_done(t, TW_BUS_ERROR);
+}
+
+/* A glitch in the bit under way, at WHEN: the condition to every device,
+ * and this TWI's bus error. */
+static void twi_glitch(sim_twi_t *t, avr_cycle_count_t when)
+{
+	twi_byte_over(t);
+	twi_bus_glitch(t->bus, when, t->fault == TWI_FAULT_START);
+	twi_bus_error(t, when);
+}
+
+/* A START or STOP on the lines at CYCLE while this master clocks a byte
+ * (another driver moved SDA with SCL high): its bus error, as the
+ * datasheet's TWI detects it. */
+static void twi_master_condition(twi_bus_master_t *m, uint64_t cycle)
+{
+	sim_twi_t *t = (sim_twi_t *)((char *)m - offsetof(sim_twi_t, master));
+
+	avr_cycle_timer_cancel(t->avr, twi_timer, t);
+	twi_bus_cancel(t->bus, &t->master);
+	t->waiting = TWI_WAIT_NONE;
+	twi_bus_drive(t->bus, &t->bus->rival_drv, 0, 0, cycle);
+	twi_bus_error(t, cycle);
 }
 
 static void twi_master_resume(twi_bus_master_t *m, uint64_t cycle)
@@ -242,25 +349,36 @@ static void twi_byte_done(sim_twi_t *t, avr_cycle_count_t when)
 {
 	uint8_t *twdr = twi_reg(t, t->regs->twdr);
 
+	twi_byte_over(t);
 	switch (t->op) {
 	case TWI_OP_SLA:
-		twi_bus_note_addr(t->bus, when, t->byte, t->line_ack);
-		if (t->byte & 1) {
+		twi_bus_note_addr(t->bus, when, t->line_byte, t->line_ack);
+		if (t->lost) {
+			twi_arb_lost(t, when);
+		} else if (t->byte & 1) {
 			twi_done(t, t->line_ack ? TW_MR_SLA_ACK : TW_MR_SLA_NACK);
 		} else {
 			twi_done(t, t->line_ack ? TW_MT_SLA_ACK : TW_MT_SLA_NACK);
 		}
 		break;
 	case TWI_OP_TX:
-		twi_bus_note_write(t->bus, when, t->byte, t->line_ack);
-		twi_done(t, t->line_ack ? TW_MT_DATA_ACK : TW_MT_DATA_NACK);
+		twi_bus_note_write(t->bus, when, t->line_byte, t->line_ack);
+		if (t->lost) {
+			twi_arb_lost(t, when);
+		} else {
+			twi_done(t, t->line_ack ? TW_MT_DATA_ACK : TW_MT_DATA_NACK);
+		}
 		break;
 	default:
 		/* its acknowledge given, the master lets SDA go */
 		twi_drive(t, 0, 1, when);
 		*twdr = t->byte;
-		twi_bus_note_read(t->bus, when, t->byte, t->op_ack);
-		twi_done(t, t->op_ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK);
+		twi_bus_note_read(t->bus, when, t->byte, t->op_ack || t->lost);
+		if (t->lost) {
+			twi_arb_lost(t, when);
+		} else {
+			twi_done(t, t->op_ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK);
+		}
 		break;
 	}
 }
@@ -291,6 +409,7 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 	switch (t->step) {
 	case M_LOW:
 		twi_drive(t, twi_low_sda(t), 1, when);
+		twi_rival(t, 1, when);
 		twi_at(t, t->bit_at + t->half, M_RISE);
 		break;
 	case M_RISE:
@@ -315,6 +434,7 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 		break;
 	case M_FALL:
 		twi_drive(t, t->drv.sda_low, 1, when);
+		twi_rival(t, 0, when);
 		if (t->op == TWI_OP_START) {
 			twi_bus_note_start(t->bus, when);
 			twi_done(t, t->owner ? TW_REP_START : TW_START);
@@ -324,6 +444,9 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 		} else {
 			twi_byte_done(t, when);
 		}
+		break;
+	case M_GLITCH:
+		twi_glitch(t, when);
 		break;
 	default:
 		break;
@@ -343,9 +466,12 @@ static void twi_master_off(sim_twi_t *t)
 	avr_cycle_timer_cancel(t->avr, twi_timer, t);
 	twi_bus_cancel(t->bus, &t->master);
 	t->waiting = TWI_WAIT_NONE;
+	twi_byte_over(t);
 	t->bus->abort = in_byte;
 	twi_drive(t, 0, t->drv.scl_low, t->avr->cycle);
 	twi_drive(t, 0, 0, t->avr->cycle);
+	/* the rival's bit ends with the clock that made it */
+	twi_bus_drive(t->bus, &t->bus->rival_drv, 0, 0, t->avr->cycle);
 	t->bus->abort = 0;
 	if (t->owner) {
 		t->bus->clocked = 0;
@@ -431,13 +557,19 @@ static int twi_dev_start(twi_dev_t *dev, uint8_t addr8)
 	uint8_t cr = *twi_reg(t, t->regs->twcr);
 	uint8_t twar = *twi_reg(t, t->regs->twar);
 
-	/* A master never answers its own address; a slave answers only while
-	 * enabled with TWEA and idle (the bus waits for a TWINT it holds). */
-	if (t->owner || t->op != TWI_OP_NONE || t->sl_pending || dev->hold ||
+	/* the general call: address 0, a write, with TWGCE (TWAR bit 0) */
+	int gcall = addr8 == 0x00 && (twar & 1);
+
+	/* A master never answers its own address (but one that lost
+	 * arbitration in it may be the winner's slave); a slave answers only
+	 * while enabled with TWEA and idle (the bus waits for a TWINT it
+	 * holds). */
+	if (((t->owner || t->op != TWI_OP_NONE) && !t->lost) || t->sl_pending || dev->hold ||
 	    !(cr & BIT(TWCR_TWEN)) || !(cr & BIT(TWCR_TWEA)) || (cr & BIT(TWCR_TWINT)) ||
-	    (addr8 & 0xfe) != (twar & 0xfe)) {
+	    ((addr8 & 0xfe) != (twar & 0xfe) && !gcall)) {
 		return 0;
 	}
+	t->sl_gcall = gcall;
 	t->sl_addr = addr8 & 0xfe;
 	t->addressed = addr8 & 1 ? TWI_SLAVE_TX : TWI_SLAVE_RX;
 	t->sl_got_addr = 1;
@@ -469,15 +601,24 @@ static int twi_dev_ack_end(twi_dev_t *dev, int ack)
 
 	if (t->sl_got_addr) {
 		t->sl_got_addr = 0;
-		twi_slave_deliver(t, t->addressed == TWI_SLAVE_TX ? TW_ST_SLA_ACK : TW_SR_SLA_ACK,
-				  0, 0);
+		if (t->addressed == TWI_SLAVE_TX) {
+			status = TW_ST_SLA_ACK;
+		} else {
+			status = t->sl_gcall ? TW_SR_GCALL_ACK : TW_SR_SLA_ACK;
+		}
+		twi_slave_deliver(t, status, 0, 0);
 		return 1;
 	}
 	if (t->addressed == TWI_SLAVE_RX) {
 		if (!ack) {
 			t->addressed = 0;	/* NACKed: not addressed until the next START */
 		}
-		twi_slave_deliver(t, ack ? TW_SR_DATA_ACK : TW_SR_DATA_NACK, 1, t->sl_rx);
+		if (t->sl_gcall) {
+			status = ack ? TW_SR_GCALL_DATA_ACK : TW_SR_GCALL_DATA_NACK;
+		} else {
+			status = ack ? TW_SR_DATA_ACK : TW_SR_DATA_NACK;
+		}
+		twi_slave_deliver(t, status, 1, t->sl_rx);
 		return 1;
 	}
 	if (t->addressed != TWI_SLAVE_TX) {
@@ -523,6 +664,7 @@ static void twi_dev_bus_error(twi_dev_t *dev)
 	if (!t->addressed) {
 		return;
 	}
+	trace_event(t->bus->trace, t->bus->cycle, "twi bus-error %02X", t->sl_addr);
 	t->addressed = 0;
 	t->sl_got_addr = 0;
 	twi_slave_deliver(t, TW_BUS_ERROR, 0, 0);
@@ -595,6 +737,11 @@ static void twi_action(sim_twi_t *t, uint8_t cr)
 	int sta = !!(cr & BIT(TWCR_TWSTA));
 	int sto = !!(cr & BIT(TWCR_TWSTO));
 
+	if (t->status == TW_MT_ARB_LOST) {
+		/* the bus released, not addressed slave mode (or a START
+		 * once the bus is free) */
+		twi_drive(t, 0, 0, t->avr->cycle);
+	}
 	if (sto) {
 		if (t->owner) {
 			twi_begin(t, sta ? TWI_OP_STOP_START : TWI_OP_STOP);
@@ -736,6 +883,7 @@ void sim_twi_init(sim_twi_t *t, avr_t *avr, const sim_mcu_twi_t *regs, twi_bus_t
 	t->io.kind = "orfa-twi";
 	t->io.reset = twi_reset;
 	t->master.resume = twi_master_resume;
+	t->master.condition = twi_master_condition;
 	t->dev.ops = &twi_dev_ops;
 	t->dev.name = "avr-twi";
 	twi_bus_attach(bus, &t->dev);

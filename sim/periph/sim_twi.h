@@ -72,6 +72,9 @@ typedef struct sim_twi_t {
 	uint8_t bit;			/* 0..8 in a byte (8: the acknowledge) */
 	uint8_t byte;			/* the byte going out or coming in */
 	uint8_t line_ack;		/* SLA/TX: the acknowledge on SDA */
+	uint8_t line_byte;		/* SLA/TX: the byte as SDA carried it */
+	uint8_t lost;			/* it lost arbitration in this byte */
+	uint8_t fault, fault_bit;	/* twi_fault_kind_t armed for this byte, its bit */
 
 	/* slave mode */
 	twi_dev_t dev;			/* this TWI as a device on the bus */
@@ -85,7 +88,8 @@ typedef struct sim_twi_t {
 	int sl_has_data;		/* ... and this received byte */
 	uint8_t sl_data;
 	avr_cycle_count_t sl_at;	/* ... at this cycle */
-	uint8_t sl_addr;		/* TWAR address it answered (trace) */
+	uint8_t sl_addr;		/* TWAR address it answered (trace), 00: the general call */
+	int sl_gcall;			/* addressed by the general call (TWGCE) */
 
 	/* SCL/SDA as port pins while TWEN is off (sim_twi_wire_pins) */
 	twi_drv_t pins;

@@ -14,7 +14,7 @@ void twi_bus_init(twi_bus_t *bus, trace_t *trace)
 	*bus = (twi_bus_t) {
 		.trace = trace,
 		.sda = 1, .scl = 1, .sda_ext = 1, .scl_ext = 1,
-		.stuck_drv = { .ext = 1 }, .hold_drv = { .ext = 1 },
+		.stuck_drv = { .ext = 1 }, .hold_drv = { .ext = 1 }, .rival_drv = { .ext = 1 },
 	};
 }
 
@@ -86,8 +86,14 @@ static void twi_bus_edge(twi_bus_t *bus, int scl_line, uint64_t cycle)
 	}
 	if (!scl_line && bus->scl) {
 		/* SDA changed with SCL high: START (falling) or STOP (rising) */
+		twi_bus_master_t *m = bus->in_byte;
+
 		for (twi_dev_t *d = bus->devs; d; d = d->next) {
 			i2c_phy_condition(bus, d, !bus->sda);
+		}
+		if (m) {
+			bus->in_byte = NULL;
+			m->condition(m, cycle);
 		}
 	} else if (bus->nactive) {
 		for (twi_dev_t *d = bus->devs; d; d = d->next) {
@@ -193,6 +199,7 @@ void twi_bus_note_start(twi_bus_t *bus, uint64_t cycle)
 	bus->clocked = 1;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi start");
+	twi_fault_on_start(&bus->fault);
 	if (bus->busy_signal) {
 		signal_set(bus->busy_signal, cycle, 1);
 	}
@@ -202,18 +209,21 @@ void twi_bus_note_addr(twi_bus_t *bus, uint64_t cycle, uint8_t addr8, int ack)
 {
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi addr %02X %s", addr8, ack ? "ack" : "nack");
+	twi_fault_byte_done(&bus->fault);
 }
 
 void twi_bus_note_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte, int ack)
 {
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi write %02X %s", byte, ack ? "ack" : "nack");
+	twi_fault_byte_done(&bus->fault);
 }
 
 void twi_bus_note_read(twi_bus_t *bus, uint64_t cycle, uint8_t byte, int master_acks)
 {
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi read %02X %s", byte, master_acks ? "ack" : "nack");
+	twi_fault_byte_done(&bus->fault);
 }
 
 void twi_bus_note_stop(twi_bus_t *bus, uint64_t cycle)
@@ -221,9 +231,28 @@ void twi_bus_note_stop(twi_bus_t *bus, uint64_t cycle)
 	bus->clocked = 0;
 	bus->activity++;
 	trace_event(bus->trace, cycle, "twi stop");
+	if (twi_fault_on_stop(&bus->fault)) {
+		trace_event(bus->trace, cycle, "twi fault missed");
+	}
 	if (bus->busy_signal) {
 		signal_set(bus->busy_signal, cycle, 0);
 	}
+}
+
+void twi_bus_glitch(twi_bus_t *bus, uint64_t cycle, int start)
+{
+	bus->cycle = cycle;
+	bus->activity++;
+	trace_event(bus->trace, cycle, "twi glitch %s", start ? "start" : "stop");
+	twi_fault_byte_done(&bus->fault);
+	/* every device hears the condition first; what their fronts let go
+	 * of then is told after */
+	bus->telling = 1;
+	for (twi_dev_t *d = bus->devs; d; d = d->next) {
+		i2c_phy_condition(bus, d, start);
+	}
+	bus->telling = 0;
+	twi_bus_lines(bus, cycle);
 }
 
 /* --- devices' holds ------------------------------------------------------------ */

@@ -29,6 +29,7 @@
 
 #include "harness/signals.h"
 #include "harness/trace.h"
+#include "periph/twi_fault.h"
 
 typedef struct twi_dev_t twi_dev_t;
 
@@ -105,6 +106,9 @@ struct twi_dev_t {
  * (twi_bus_wait) came, with the cycle it came at. */
 typedef struct twi_bus_master_t {
 	void (*resume)(struct twi_bus_master_t *m, uint64_t cycle);
+	/* A START or STOP the lines carried at CYCLE while it clocked a byte
+	 * (twi_bus_t.in_byte): its bus error. */
+	void (*condition)(struct twi_bus_master_t *m, uint64_t cycle);
 } twi_bus_master_t;
 
 /* What a master waits for. */
@@ -153,6 +157,13 @@ typedef struct twi_bus_t {
 	twi_drv_t stuck_drv, hold_drv;
 	uint32_t stuck;		/* SCL pulses the stuck device still waits for (0: off) */
 	int hold_scl;		/* the SCL-holding device holds SCL low */
+	/* a fault armed for the middle of a byte (`i2c arb`, `i2c glitch`),
+	 * and the rival's pull on SDA (twi_fault.h) */
+	twi_fault_t fault;
+	twi_drv_t rival_drv;
+	/* the master clocking an address or data byte (NULL: none), told of
+	 * a START or STOP the lines carry meanwhile */
+	twi_bus_master_t *in_byte;
 
 	twi_line_fn listener[TWI_BUS_LISTENERS];
 	void *listener_param[TWI_BUS_LISTENERS];
@@ -194,12 +205,19 @@ void twi_bus_cancel(twi_bus_t *bus, twi_bus_master_t *m);
 void twi_bus_byte(twi_bus_t *bus, uint64_t begin, uint64_t end);
 
 /* The master's account of its operations: trace lines and the busy signal,
- * at the CYCLE each completes. */
+ * at the CYCLE each completes; they also count the bytes for the fault
+ * armed (twi_fault.h). */
 void twi_bus_note_start(twi_bus_t *bus, uint64_t cycle);
 void twi_bus_note_addr(twi_bus_t *bus, uint64_t cycle, uint8_t addr8, int ack);
 void twi_bus_note_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte, int ack);
 void twi_bus_note_read(twi_bus_t *bus, uint64_t cycle, uint8_t byte, int master_acks);
 void twi_bus_note_stop(twi_bus_t *bus, uint64_t cycle);
+
+/* A START (START 1) or STOP condition at CYCLE in the middle of the byte
+ * the master clocks (`i2c glitch`, told to the devices without moving the
+ * lines): a bus error for a device taking part in it (i2c_phy.c); the
+ * fault is spent. */
+void twi_bus_glitch(twi_bus_t *bus, uint64_t cycle, int start);
 
 /* DEV holds SCL low: now (TWI_HOLD_ALL) or from SCL's next falling edge. */
 void twi_bus_hold(twi_bus_t *bus, twi_dev_t *dev, twi_hold_t how);

@@ -117,6 +117,23 @@ def sigrok_view(path):
     return out
 
 
+def run_capture(sim, talk):
+    """Starts `sim` (made with vcd=True, trace=True, control=True), calls
+    talk(port) with its serial port open, lets 20000 cycles pass and stops
+    it, keeping its directory (the VCD, the trace) for the caller to
+    remove."""
+    sim.start()
+    try:
+        with serial.Serial(sim.port, 115200, timeout=REPLY_TIMEOUT) as port:
+            talk(port)
+        sim.control.wait(20000)
+    except BaseException:
+        sim.stop()
+        raise
+    sim.stop(keep_dir=True)
+    return sim
+
+
 @pytest.fixture(scope="module", params=BOARDS)
 def capture(request):
     """A gateway with the EEPROM and the M128-S slave, --vcd and --trace;
@@ -124,21 +141,17 @@ def capture(request):
     trace's, sigrok's, and the sim (its trace)."""
     board = request.param
     require_builds([board])
-    sim = SimBoard(board, eeproms=(0xA0,), slaves=[("m128s", SLAVE, require_slave("m128s", SLAVE))],
-                   control=True, vcd=True, trace=True).start()
     host = []
-    try:
-        with serial.Serial(sim.port, 115200, timeout=REPLY_TIMEOUT) as port:
-            for req, want in REQUESTS:
-                port.write(req.encode() + b"\r")
-                reply = port.readline().decode().strip()
-                assert reply == want, (req, reply)
-                host += host_view(req, reply)
-            sim.control.wait(20000)
-    except BaseException:
-        sim.stop()
-        raise
-    sim.stop(keep_dir=True)
+
+    def talk(port):
+        for req, want in REQUESTS:
+            port.write(req.encode() + b"\r")
+            reply = port.readline().decode().strip()
+            assert reply == want, (req, reply)
+            host.extend(host_view(req, reply))
+
+    sim = run_capture(SimBoard(board, eeproms=(0xA0,), control=True, vcd=True, trace=True,
+                               slaves=[("m128s", SLAVE, require_slave("m128s", SLAVE))]), talk)
     try:
         yield host, trace_view(sim.trace_events(kinds=["twi"])), sigrok_view(sim.vcd_path), sim
     finally:

@@ -357,9 +357,62 @@ static void test_aborted_frames(void)
 	CHECK_EQ(regmap_status(), REG_NO_REGISTER);
 }
 
+/* Bus faults in the middle of a byte (docs/protocol.md, the bus-fault
+ * table): the slave's TWI gives 0x00 wherever the illegal START or STOP
+ * falls, and the frame is dropped whole; a slave addressed by a master that
+ * won arbitration against this TWI (0x68, 0xB0) serves the frame as
+ * after 0x60, 0xA8. */
+static void test_faults_mid_byte(void)
+{
+	uint8_t b;
+
+	boot();
+	slave_fsm_init();
+	uint8_t sp = B.servo_sp;
+	/* in the register byte: nothing had arrived, the status stands */
+	CHECK_EQ(xact_model_twi_event(TW_SR_SLA_ACK, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
+	CHECK(!slave_fsm_in_frame());
+	CHECK_EQ(regmap_status(), REG_OK);
+	/* in the middle of a read: the frame ends, nothing else changes */
+	SLAVE_WRITE(sp, 0x00, 0x05, 0xDC);
+	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	SLAVE_WRITE(sp);
+	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(xact_model_twi_event(TW_ST_SLA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(b, 0x05);
+	CHECK(slave_fsm_in_frame());
+	CHECK_EQ(xact_model_twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
+	CHECK(!slave_fsm_in_frame());
+	CHECK_EQ(regmap_status(), REG_OK);
+	/* after the last data byte, before the STOP: dropped, not applied */
+	SLAVE_WRITE(sp, 0x00, 0x07, 0xD0);
+	CHECK_EQ(xact_model_twi_event(TW_BUS_ERROR, &b), SLAVE_RECOVER);
+	CHECK_EQ(regmap_status(), REG_DROPPED);
+	READ(sp, 2, "05 DC");
+	/* the arbitration-lost entries: a write applied at its STOP ... */
+	CHECK_EQ(xact_model_twi_event(TW_SR_ARB_LOST_SLA_ACK, &b), SLAVE_ACK);
+	CHECK(slave_fsm_in_frame());
+	const uint8_t data[] = { sp, 0x00, 0x06, 0x40 };
+	for (unsigned i = 0; i < sizeof data; i++) {
+		b = data[i];
+		CHECK_EQ(xact_model_twi_event(TW_SR_DATA_ACK, &b), SLAVE_ACK);
+	}
+	CHECK_EQ(xact_model_twi_event(TW_SR_STOP, &b), SLAVE_ACK);
+	CHECK_EQ(regmap_status(), REG_OK);
+	/* ... and a read served from the selected register */
+	CHECK_EQ(xact_model_twi_event(TW_ST_ARB_LOST_SLA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(b, 0x06);
+	CHECK_EQ(xact_model_twi_event(TW_ST_DATA_ACK, &b), SLAVE_SEND);
+	CHECK_EQ(b, 0x40);
+	CHECK_EQ(xact_model_twi_event(TW_ST_DATA_NACK, &b), SLAVE_ACK);
+	CHECK(!slave_fsm_in_frame());
+}
+
 void xact_tests(void)
 {
 	test_aborted_frames();
+	test_faults_mid_byte();
 	test_check_agrees_with_write();
 	test_refusals();
 	test_intro_cursor();
