@@ -94,11 +94,8 @@ static struct {
  * can come back to back (four counters, and the frame start): above 115200
  * baud that is longer than the USART holds received characters (two: 320
  * cycles at 460800). Each ends letting a waiting character's interrupt in:
- * every width is the hardware's, and the next rise is programmed already. */
-static inline __attribute__((always_inline)) void rx_poll_after_rise(void)
-{
-	front_rx_poll(FRONT_HOLD_ALL);
-}
+ * every width is the hardware's, and the next rise is programmed already:
+ * front_rx_poll(FRONT_HOLD_ALL) at the end of each below. */
 
 /*
  * Counter c's compare unit made a rising edge: the counter moved on. Bring
@@ -132,7 +129,7 @@ servo_rise(uint8_t c, volatile uint16_t *ocr, volatile uint16_t *tcnt, volatile 
 	}
 	if (steps & SERVO_REST) {
 		*tccr &= (uint8_t)~(3u << com0);
-		rx_poll_after_rise();
+		front_rx_poll(FRONT_HOLD_ALL);
 		return;
 	}
 	*tccr ^= flip;          /* clear -> set: the next rise */
@@ -142,7 +139,7 @@ servo_rise(uint8_t c, volatile uint16_t *ocr, volatile uint16_t *tcnt, volatile 
 		at = now + SERVO_AHEAD;
 	}
 	*ocr = at;
-	rx_poll_after_rise();
+	front_rx_poll(FRONT_HOLD_ALL);
 }
 
 ISR(TIMER3_COMPA_vect) { servo_rise(0, &OCR3A, &TCNT3, &TCCR3A, COM3A0, &TCCR3C, _BV(FOC3A)); }
@@ -166,7 +163,7 @@ ISR(TIMER1_COMPC_vect) { servo_rise(3, &OCR1C, &TCNT1, &TCCR1A, COM1C0, &TCCR1C,
  * after OCR1A's match, on which the plan's times are based. */
 ISR(TIMER1_COMPA_vect)
 {
-	rx_poll_after_rise();
+	front_rx_poll(FRONT_HOLD_ALL);
 	uint16_t f = OCR1A;
 	if (pulses.pending) {
 		pulses.cur ^= 1;
@@ -201,7 +198,7 @@ ISR(TIMER1_COMPA_vect)
 	}
 	*pulses.rst_port &= (uint8_t)~pulses.rst_mask;
 	OCR1A = f + s->frame;
-	rx_poll_after_rise();
+	front_rx_poll(FRONT_HOLD_ALL);
 }
 
 void servo_hw_init(void)

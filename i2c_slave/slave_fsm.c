@@ -22,14 +22,20 @@ static struct {
 	uint8_t next;
 } slave;
 
+/* No read frame open, nothing taken ahead. */
+static inline __attribute__((always_inline)) void slave_no_read(void)
+{
+	slave.reading = 0;
+	slave.next_ok = 0;
+}
+
 /* No frame open, nothing taken ahead. */
 static void slave_idle(void)
 {
 	slave.work = WORK_NONE;
 	slave.in_write = 0;
 	slave.in_frame = 0;
-	slave.reading = 0;
-	slave.next_ok = 0;
+	slave_no_read();
 }
 
 void slave_fsm_init(void)
@@ -72,8 +78,7 @@ static slave_action_t slave_end_write(void)
  * bus goes on before its end is booked. */
 static slave_action_t slave_end_read(void)
 {
-	slave.reading = 0;
-	slave.next_ok = 0;
+	slave_no_read();
 	slave.work = WORK_FRAME_END;
 	return SLAVE_DEFER_ACK;
 }
@@ -102,8 +107,7 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 	case TW_SR_ARB_LOST_SLA_ACK:
 		/* acknowledged whatever comes: the frame is opened after */
 		slave.in_write = 1;
-		slave.reading = 0;
-		slave.next_ok = 0;
+		slave_no_read();
 		slave.work = WORK_WRITE_START;
 		return SLAVE_DEFER_ACK;
 	case TW_ST_DATA_ACK:
