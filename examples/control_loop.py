@@ -37,7 +37,6 @@ for wrong arguments.
 
 import argparse
 import importlib.util
-import math
 import sys
 import time
 from collections import deque

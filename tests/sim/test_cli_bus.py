@@ -5,7 +5,6 @@ against one simulated robot (M32-D gateway, EEPROM 0xA0, an M128-S slave at
 import pytest
 
 from conftest import cli_runner, require_builds
-from orfa import cli
 from orfa.sim import SimRobot
 
 EEPROM = 0xA0

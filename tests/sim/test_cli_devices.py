@@ -7,7 +7,7 @@ socket, in simulated time."""
 import pytest
 
 from conftest import SERVO_FRAME, cli_runner, require_builds, us_to_cycles
-from orfa import boardmap, cli
+from orfa import boardmap
 from orfa.sim import SimRobot
 
 WIDTH_TOL = 8                    # cycles: 1.1 us, as tests/sim/test_drv_servo.py

@@ -39,7 +39,7 @@ def test_the_master_bits_at_their_points(board):
     require_builds([board])
     with running(SimBoard(board, eeproms=(0xA0,), control=True, trace=True)) as b:
         ctl = b.sim.control
-        p, h = scl_period(ctl, board), scl_period(ctl, board) // 2
+        h = scl_period(ctl, board) // 2
         since = ctl.time()
         assert b.ask("S A0 10 5A P") == b"SWAAP\r\n"
         ev = merged(ctl, since)
