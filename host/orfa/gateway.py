@@ -521,6 +521,13 @@ class Gateway(Closing):
         except p.ProtocolError as e:
             return "<noise: %s>" % e
 
+    def reset_input_buffer(self) -> None:
+        """Drop every byte received and not yet read as a reply: the
+        port's (pyserial's reset_input_buffer) and what a read took past a
+        line's end and kept for the next line."""
+        self._rx.clear()
+        self.serial.reset_input_buffer()
+
     def _waiting(self) -> int:
         """Bytes received that no line has taken yet."""
         return len(self._rx) + self._port_waiting()

@@ -233,7 +233,7 @@ def for_each_test(bench, prepare=None, tidy=None, settle=False):
     putting back what the module changes, restore() the board's defaults;
     the MCU must not have reset meanwhile."""
     assert bench.sim.running, "the simulator died: %s" % bench.sim.stderr
-    bench.gw.serial.reset_input_buffer()
+    bench.gw.reset_input_buffer()
     mark = bench.mark()
     if prepare:
         prepare(bench)

@@ -43,7 +43,7 @@ def robot(request):
 @pytest.fixture
 def rb(robot):
     assert robot.sim.running, robot.sim.stderr
-    robot.gw.serial.reset_input_buffer()
+    robot.gw.reset_input_buffer()
     for addr in SLAVES:
         clear(robot, addr)
     yield robot

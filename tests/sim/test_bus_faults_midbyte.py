@@ -33,7 +33,7 @@ LEAD = 2000          # cycles from the batch to the request's first bit
 @pytest.fixture
 def rb(robot):  # noqa: F811
     assert robot.sim.running, robot.sim.stderr
-    robot.gw.serial.reset_input_buffer()
+    robot.gw.reset_input_buffer()
     robot.sim.control.i2c_disarm()
     for addr in SLAVES:
         clear(robot, addr)

@@ -263,7 +263,7 @@ def test_slave_left_mid_frame_lets_go(robot, addr):
     so it never holds the bus for good; then it answers as before."""
     b = robot
     ctl = b.sim.control
-    b.gw.serial.reset_input_buffer()
+    b.gw.reset_input_buffer()
     mark = b.mark()
     rs = DRV_LAYOUT["m128s" if addr == 0x10 else "m32d"]["servo"]   # takes anything
     try:

@@ -24,7 +24,7 @@ def drv(drv_sim):
     """The board as reset left it: no driver state to put back afterwards
     (the tests only read and make refused writes)."""
     assert drv_sim.sim.running, drv_sim.sim.stderr
-    drv_sim.gw.serial.reset_input_buffer()
+    drv_sim.gw.reset_input_buffer()
     mark = drv_sim.mark()
     yield drv_sim
     drv_sim.restore()

@@ -35,7 +35,7 @@ def robot():
 def rb(robot):
     gw, boards = robot
     assert gw.sim.running, gw.sim.stderr
-    gw.gw.serial.reset_input_buffer()
+    gw.gw.reset_input_buffer()
     mark = gw.mark()
     yield gw, boards
     gw.restore()
