@@ -292,10 +292,7 @@ void twi_bus_release(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle, uint8_t add
 
 void twi_bus_forget(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle)
 {
-	if (dev->phy != TWI_PHY_IDLE) {
-		bus->nactive--;
-	}
-	dev->phy = TWI_PHY_IDLE;
+	i2c_phy_state(bus, dev, TWI_PHY_IDLE);
 	dev->hold = TWI_HOLD_NONE;
 	dev->waiting = 0;
 	dev->load = 0;
