@@ -353,6 +353,19 @@ static void park_seek(const park_t *p, uint64_t cyc, uint64_t *start, int *j)
 	*j = k;
 }
 
+/* The board put at boundary P->j of the turn at P->start: its state, its
+ * cycle, and the watchdog timer where the loop's WDR left it. */
+static void park_put(const park_t *p, avr_t *avr)
+{
+	const park_point_t *pt = &p->pt[p->j];
+
+	park_load(pt, avr);
+	avr->cycle = p->start + pt->off;
+	if (p->wdr >= 0) {
+		park_wd(p, avr);
+	}
+}
+
 /* A timer falls due at boundary J of the turn at START: the board is put
  * there as the instruction ending there left it, and what avr_run() does
  * after an instruction is done. 1 when it stays parked: no interrupt, the
@@ -363,11 +376,7 @@ static int park_fire(park_t *p, avr_t *avr, uint64_t start, int j)
 
 	p->start = start;
 	p->j = j;
-	park_load(pt, avr);
-	avr->cycle = start + pt->off;
-	if (p->wdr >= 0) {
-		park_wd(p, avr);
-	}
+	park_put(p, avr);
 	avr->pc = p->pt[j ? j - 1 : p->n - 1].pc;	/* as avr_run_one() left it */
 	avr_step_after(avr, pt->pc);
 	if (avr->state != cpu_Running || avr->interrupt_state || avr->pc != pt->pc ||
@@ -421,15 +430,8 @@ int park_advance(park_t *p, avr_t *avr, uint64_t end)
 
 void park_leave(park_t *p, avr_t *avr)
 {
-	const park_point_t *pt;
-
 	park_where(p, avr);
-	pt = &p->pt[p->j];
-	park_load(pt, avr);
-	avr->cycle = p->start + pt->off;
-	if (p->wdr >= 0) {
-		park_wd(p, avr);
-	}
+	park_put(p, avr);
 	p->parked = 0;
 	p->retry_at = 0;
 }

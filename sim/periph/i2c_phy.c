@@ -3,7 +3,7 @@
  */
 #include "periph/i2c_phy.h"
 
-static void phy_state(twi_bus_t *bus, twi_dev_t *d, twi_phy_state_t state)
+void i2c_phy_state(twi_bus_t *bus, twi_dev_t *d, twi_phy_state_t state)
 {
 	if ((d->phy != TWI_PHY_IDLE) != (state != TWI_PHY_IDLE)) {
 		bus->nactive += state != TWI_PHY_IDLE ? 1 : -1;
@@ -64,15 +64,15 @@ void i2c_phy_condition(twi_bus_t *bus, twi_dev_t *d, int start)
 	d->load = 0;
 	if (illegal && d->ops->bus_error) {
 		d->ops->bus_error(d);
-		phy_state(bus, d, TWI_PHY_IDLE);
+		i2c_phy_state(bus, d, TWI_PHY_IDLE);
 	} else if (start) {
 		if (d->ops->bus_start) {
 			d->ops->bus_start(d);
 		}
-		phy_state(bus, d, TWI_PHY_ADDR);
+		i2c_phy_state(bus, d, TWI_PHY_ADDR);
 	} else {
 		d->ops->stop(d);
-		phy_state(bus, d, TWI_PHY_IDLE);
+		i2c_phy_state(bus, d, TWI_PHY_IDLE);
 	}
 }
 
@@ -84,7 +84,7 @@ static void phy_byte_end(twi_bus_t *bus, twi_dev_t *d)
 	case TWI_PHY_ADDR:
 		d->ack = (uint8_t)!!PHY_OP(bus, d->ops->start(d, d->shift));
 		if (!d->ack) {
-			phy_state(bus, d, TWI_PHY_IDLE);	/* deaf until the next START */
+			i2c_phy_state(bus, d, TWI_PHY_IDLE);	/* deaf until the next START */
 			return;
 		}
 		break;
@@ -116,7 +116,7 @@ static void phy_ack_end(twi_bus_t *bus, twi_dev_t *d)
 	}
 	d->nbits = 0;
 	d->shift = 0;
-	phy_state(bus, d, next);
+	i2c_phy_state(bus, d, next);
 	if (d->ops->ack_end && d->ops->ack_end(d, ack)) {
 		d->hold = TWI_HOLD_ALL;
 		d->waiting = 1;

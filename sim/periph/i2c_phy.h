@@ -29,4 +29,8 @@ void i2c_phy_released(twi_bus_t *bus, twi_dev_t *d, uint64_t cycle);
  * its first bit goes on SDA at CYCLE. */
 void i2c_phy_load(twi_bus_t *bus, twi_dev_t *d, uint64_t cycle);
 
+/* D's front goes to STATE, the bus's count of active fronts (nactive)
+ * kept with it. */
+void i2c_phy_state(twi_bus_t *bus, twi_dev_t *d, twi_phy_state_t state);
+
 #endif

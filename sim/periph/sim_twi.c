@@ -348,38 +348,34 @@ static void twi_master_resume(twi_bus_master_t *m, uint64_t cycle)
 static void twi_byte_done(sim_twi_t *t, avr_cycle_count_t when)
 {
 	uint8_t *twdr = twi_reg(t, t->regs->twdr);
+	uint8_t status;
 
 	twi_byte_over(t);
 	switch (t->op) {
 	case TWI_OP_SLA:
 		twi_bus_note_addr(t->bus, when, t->line_byte, t->line_ack);
-		if (t->lost) {
-			twi_arb_lost(t, when);
-		} else if (t->byte & 1) {
-			twi_done(t, t->line_ack ? TW_MR_SLA_ACK : TW_MR_SLA_NACK);
+		if (t->byte & 1) {
+			status = t->line_ack ? TW_MR_SLA_ACK : TW_MR_SLA_NACK;
 		} else {
-			twi_done(t, t->line_ack ? TW_MT_SLA_ACK : TW_MT_SLA_NACK);
+			status = t->line_ack ? TW_MT_SLA_ACK : TW_MT_SLA_NACK;
 		}
 		break;
 	case TWI_OP_TX:
 		twi_bus_note_write(t->bus, when, t->line_byte, t->line_ack);
-		if (t->lost) {
-			twi_arb_lost(t, when);
-		} else {
-			twi_done(t, t->line_ack ? TW_MT_DATA_ACK : TW_MT_DATA_NACK);
-		}
+		status = t->line_ack ? TW_MT_DATA_ACK : TW_MT_DATA_NACK;
 		break;
 	default:
 		/* its acknowledge given, the master lets SDA go */
 		twi_drive(t, 0, 1, when);
 		*twdr = t->byte;
 		twi_bus_note_read(t->bus, when, t->byte, t->op_ack || t->lost);
-		if (t->lost) {
-			twi_arb_lost(t, when);
-		} else {
-			twi_done(t, t->op_ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK);
-		}
+		status = t->op_ack ? TW_MR_DATA_ACK : TW_MR_DATA_NACK;
 		break;
+	}
+	if (t->lost) {
+		twi_arb_lost(t, when);
+	} else {
+		twi_done(t, status);
 	}
 }
 

@@ -127,11 +127,12 @@ static int spi_master_on(const spi_t *s)
  * port's own. A byte on the wire shows its edges when it ends. */
 static void spi_miso_show(spi_t *s, uint64_t cycle)
 {
-	spi_dev_t *d = spi_selected(s);
+	spi_dev_t *d;
 
 	if (!s->drive || s->busy) {
 		return;
 	}
+	d = spi_selected(s);
 	s->miso_level = d ? d->out : 1;
 	s->drive(s->drive_param, SPI_PIN_MISO, d || spi_master_on(s), s->miso_level, cycle);
 }

@@ -205,25 +205,28 @@ void twi_bus_note_start(twi_bus_t *bus, uint64_t cycle)
 	}
 }
 
-void twi_bus_note_addr(twi_bus_t *bus, uint64_t cycle, uint8_t addr8, int ack)
+/* One byte's trace line; the fault counts it. */
+static void twi_bus_note_byte(twi_bus_t *bus, uint64_t cycle, const char *what, uint8_t byte,
+			      int ack)
 {
 	bus->activity++;
-	trace_event(bus->trace, cycle, "twi addr %02X %s", addr8, ack ? "ack" : "nack");
+	trace_event(bus->trace, cycle, "twi %s %02X %s", what, byte, ack ? "ack" : "nack");
 	twi_fault_byte_done(&bus->fault);
+}
+
+void twi_bus_note_addr(twi_bus_t *bus, uint64_t cycle, uint8_t addr8, int ack)
+{
+	twi_bus_note_byte(bus, cycle, "addr", addr8, ack);
 }
 
 void twi_bus_note_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte, int ack)
 {
-	bus->activity++;
-	trace_event(bus->trace, cycle, "twi write %02X %s", byte, ack ? "ack" : "nack");
-	twi_fault_byte_done(&bus->fault);
+	twi_bus_note_byte(bus, cycle, "write", byte, ack);
 }
 
 void twi_bus_note_read(twi_bus_t *bus, uint64_t cycle, uint8_t byte, int master_acks)
 {
-	bus->activity++;
-	trace_event(bus->trace, cycle, "twi read %02X %s", byte, master_acks ? "ack" : "nack");
-	twi_fault_byte_done(&bus->fault);
+	twi_bus_note_byte(bus, cycle, "read", byte, master_acks);
 }
 
 void twi_bus_note_stop(twi_bus_t *bus, uint64_t cycle)
@@ -289,10 +292,7 @@ void twi_bus_release(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle, uint8_t add
 
 void twi_bus_forget(twi_bus_t *bus, twi_dev_t *dev, uint64_t cycle)
 {
-	if (dev->phy != TWI_PHY_IDLE) {
-		bus->nactive--;
-	}
-	dev->phy = TWI_PHY_IDLE;
+	i2c_phy_state(bus, dev, TWI_PHY_IDLE);
 	dev->hold = TWI_HOLD_NONE;
 	dev->waiting = 0;
 	dev->load = 0;

@@ -52,8 +52,7 @@ void twi_fault_byte_done(twi_fault_t *f)
 		return;
 	}
 	if (f->seen == f->byte) {
-		f->kind = TWI_FAULT_NONE;
-		f->counting = 0;
+		twi_fault_arm(f, TWI_FAULT_NONE, 0, 0);	/* the fault's byte: done */
 		return;
 	}
 	f->seen++;
