@@ -66,7 +66,7 @@ _Static_assert(SERVO_LEAD >= SERVO_RX_ISR + SERVO_ENTRY, "the lead allows a rece
  * returns, within the next wake-up's lead. Every Timer2 wrap wakes it while
  * servos run (0.28 ms), so nothing stays held longer than that.
  */
-#define SERVO_HOLD_TICKS 6  /* a turn may hold the two characters UDR keeps: ~45 cycles */
+#define SERVO_HOLD_TICKS 3
 
 static struct {
 	servo_sched_t sched[2];
