@@ -151,11 +151,16 @@ static bool servo_arm(void)
 }
 
 /* Lets the receive interrupt hand on what the hold keeps: all of it when
- * the next edge is SERVO_FAR away, else what the next wake-up's lead
- * allows for. */
+ * the next edge is SERVO_FAR away, BOARD_RX_BURST characters when it is
+ * SERVO_NEAR away, nothing closer (the caller then waits for the edge in
+ * place, holding). */
 static void servo_rx_release(void)
 {
-	front_rx_poll(servo_ticks_left() > SERVO_FAR / 8 ? FRONT_HOLD_ALL : BOARD_RX_BURST);
+	int16_t left = servo_ticks_left();
+
+	if (left > SERVO_NEAR / 8) {
+		front_rx_poll(left > SERVO_FAR / 8 ? FRONT_HOLD_ALL : BOARD_RX_BURST);
+	}
 }
 
 ISR(TIMER2_COMP_vect)
@@ -218,10 +223,15 @@ ISR(TIMER2_COMP_vect)
 			}
 			edge = pulses.sched[pulses.active].edge;
 		}
+		/* The release before the wake-up is armed, not after: its
+		 * burst (~320 cycles) after an arm at SERVO_NEAR ran past the
+		 * wake-up, and the interrupt came back late for the edge (8-11
+		 * cycles late at 460800). An edge the release brought closer
+		 * than SERVO_NEAR is waited for in place. */
 		servo_aim(edge);
+		front_rx_hold();
+		servo_rx_release();
 		if (servo_arm()) {
-			front_rx_hold();
-			servo_rx_release();
 			return;
 		}
 	}
