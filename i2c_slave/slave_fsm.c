@@ -83,12 +83,34 @@ static slave_action_t slave_end_read(void)
 	return SLAVE_DEFER_ACK;
 }
 
+bool slave_fsm_acks(uint8_t status)
+{
+	/* the sending statuses are TW_ST_SLA_ACK, TW_ST_ARB_LOST_SLA_ACK
+	 * and TW_ST_DATA_ACK, in a row */
+	return status != TW_SR_DATA_ACK && status != TW_BUS_ERROR &&
+	       (uint8_t)(status - TW_ST_SLA_ACK) > TW_ST_DATA_ACK - TW_ST_SLA_ACK;
+}
+
+bool slave_fsm_ahead(uint8_t *byte)
+{
+	if (!slave.next_ok) {
+		return false;
+	}
+	slave.next_ok = 0;
+	*byte = slave.next;
+	return true;
+}
+
+bool slave_fsm_received(uint8_t byte)
+{
+	slave.in_frame = 1;
+	return xact_write_received(byte);
+}
+
 slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 {
 	/* The byte taken ahead first: the master waits for it, SCL held. */
-	if (status == TW_ST_DATA_ACK && slave.next_ok) {
-		slave.next_ok = 0;
-		*byte = slave.next;
+	if (status == TW_ST_DATA_ACK && slave_fsm_ahead(byte)) {
 		return SLAVE_SEND;
 	}
 	/* addressed until a frame's end: STOP or repeated START, a refused
@@ -100,7 +122,7 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 		return slave_defer(WORK_READ_START);
 	}
 	if (status == TW_SR_DATA_ACK) {
-		return xact_write_received(*byte) ? SLAVE_ACK : SLAVE_NACK;
+		return slave_fsm_received(*byte) ? SLAVE_ACK : SLAVE_NACK;
 	}
 	switch (status) {
 	case TW_SR_SLA_ACK:

@@ -55,6 +55,23 @@ void slave_fsm_init(void);
  * error's doing. */
 void slave_fsm_drop(void);
 
+/* True when the answer to an event with this status is SLAVE_ACK or
+ * SLAVE_DEFER_ACK whatever came before (a frame's end, its own write
+ * address, what is never ours): the TWI layer may let the bus go on
+ * first and call slave_fsm_event() after. False for a byte received (its
+ * value decides), the statuses that send and a bus error. */
+bool slave_fsm_acks(uint8_t status);
+
+/* A byte of a write frame received (a TW_SR_DATA_ACK event, as
+ * slave_fsm_event() takes it): true to acknowledge the next one
+ * (SLAVE_ACK), false to refuse it (SLAVE_NACK). */
+bool slave_fsm_received(uint8_t byte);
+
+/* The byte the master reads next (a TW_ST_DATA_ACK event), if
+ * slave_fsm_after() took it ahead: true and *byte, to send at once; the
+ * event is then answered (slave_fsm_event() would say SLAVE_SEND). */
+bool slave_fsm_ahead(uint8_t *byte);
+
 /* A TWI event: `status` is TW_STATUS; `*byte` holds TWDR for received
  * data and receives the byte to send for SLAVE_SEND. */
 slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte);
