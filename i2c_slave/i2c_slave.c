@@ -85,6 +85,12 @@ static void slave_event(void)
 		/* a byte received: its value decides the next one's
 		 * acknowledge */
 		TWCR = slave_fsm_received(TWDR) ? SLAVE_GO_ON : SLAVE_REFUSE_NEXT;
+	} else if (status == TW_ST_SLA_ACK || status == TW_ST_ARB_LOST_SLA_ACK) {
+		/* a read frame: its first byte is the driver's, the master
+		 * waits for it (SCL held) */
+		slave_fsm_read_start(&byte);
+		TWDR = byte;
+		TWCR = SLAVE_GO_ON;
 	} else {
 		/* acknowledged whatever the state: the bus goes on first, the
 		 * next event waits in TWINT until this one's work is done */

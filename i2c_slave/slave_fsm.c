@@ -118,7 +118,6 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 	slave.in_frame = 1;
 	/* Then the two the master waits on longest, tested first. */
 	if (status == TW_ST_SLA_ACK || status == TW_ST_ARB_LOST_SLA_ACK) {
-		slave.next_ok = 0;
 		return slave_defer(WORK_READ_START);
 	}
 	if (status == TW_SR_DATA_ACK) {
@@ -164,6 +163,15 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 	}
 }
 
+void slave_fsm_read_start(uint8_t *byte)
+{
+	slave.in_frame = 1;
+	slave.next_ok = 0;
+	xact_read_requested(slave.buf, sizeof slave.buf);
+	slave.reading = 1;
+	xact_read_processed(byte);
+}
+
 slave_action_t slave_fsm_work(uint8_t *byte)
 {
 	slave_work_t work = (slave_work_t)slave.work;
@@ -171,9 +179,7 @@ slave_action_t slave_fsm_work(uint8_t *byte)
 	slave.work = WORK_NONE;
 	if (work == WORK_READ_START) {
 		/* first: the master waits for its byte, SCL held */
-		xact_read_requested(slave.buf, sizeof slave.buf);
-		slave.reading = 1;
-		xact_read_processed(byte);
+		slave_fsm_read_start(byte);
 		return SLAVE_SEND;
 	}
 	switch (work) {

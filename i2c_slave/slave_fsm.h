@@ -67,6 +67,12 @@ bool slave_fsm_acks(uint8_t status);
  * (SLAVE_ACK), false to refuse it (SLAVE_NACK). */
 bool slave_fsm_received(uint8_t byte);
 
+/* A read frame begins (TW_ST_SLA_ACK, TW_ST_ARB_LOST_SLA_ACK): the
+ * driver's answer asked for at once, its first byte in *byte to send (as
+ * slave_fsm_event()'s SLAVE_DEFER and slave_fsm_work()'s SLAVE_SEND give
+ * it, for a layer that need not defer). */
+void slave_fsm_read_start(uint8_t *byte);
+
 /* The byte the master reads next (a TW_ST_DATA_ACK event), if
  * slave_fsm_after() took it ahead: true and *byte, to send at once; the
  * event is then answered (slave_fsm_event() would say SLAVE_SEND). */
