@@ -75,13 +75,17 @@ static void slave_apply(slave_action_t act, uint8_t byte)
 static void slave_event(void)
 {
 	uint8_t status = TW_STATUS;
-	uint8_t byte;
+	uint8_t byte, next;
 
-	if (status == TW_ST_DATA_ACK && slave_fsm_ahead(&byte)) {
+	if (status == TW_ST_DATA_ACK && slave_fsm_ahead(&next)) {
 		/* the common read byte, taken ahead: sent at once */
-		TWDR = byte;
+		TWDR = next;
 		TWCR = SLAVE_GO_ON;
-	} else if (status == TW_SR_DATA_ACK) {
+		slave_seen = clock_now8();
+		slave_fsm_after();
+		return;
+	}
+	if (status == TW_SR_DATA_ACK) {
 		/* a byte received: its value decides the next one's
 		 * acknowledge */
 		TWCR = slave_fsm_received(TWDR) ? SLAVE_GO_ON : SLAVE_REFUSE_NEXT;

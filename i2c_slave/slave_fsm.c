@@ -167,9 +167,11 @@ void slave_fsm_read_start(uint8_t *byte)
 {
 	slave.in_frame = 1;
 	slave.next_ok = 0;
-	xact_read_requested(slave.buf, sizeof slave.buf);
 	slave.reading = 1;
-	xact_read_processed(byte);
+	/* the driver's answer goes to the buffer's start: its first byte
+	 * taken where it is */
+	*byte = xact_read_requested(slave.buf, sizeof slave.buf) && xact_read_take(1) ?
+		slave.buf[0] : 0xFF;
 }
 
 slave_action_t slave_fsm_work(uint8_t *byte)
