@@ -96,8 +96,11 @@ static void slave_event(void)
 		TWDR = byte;
 		TWCR = SLAVE_GO_ON;
 	} else {
-		/* acknowledged whatever the state: the bus goes on first, the
-		 * next event waits in TWINT until this one's work is done */
+		/* A frame's end, the own write address, a read byte not taken
+		 * ahead, a bus error. Where the status alone decides the
+		 * answer (acknowledged whatever the state) the bus goes on
+		 * first: the next event waits in TWINT until this one's work
+		 * is done. */
 		bool first = slave_fsm_acks(status);
 		if (first) {
 			TWCR = SLAVE_GO_ON;

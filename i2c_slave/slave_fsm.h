@@ -1,8 +1,9 @@
 /*
  * The TWI slave's decisions (docs/registers.md, "On a slave board"), free of
  * hardware: one call per TWI event with its status code (avr-libc's TW_*
- * names), one action back for the thin interrupt layer in i2c_slave.c to put into TWCR/TWDR. Host
- * unit tests drive it with status sequences as the AVR TWI produces them.
+ * names), one action back for the thin layer in i2c_slave.c to put into
+ * TWCR/TWDR. Host unit tests drive it with status sequences as the AVR TWI
+ * produces them.
  *
  * What the hardware decides first, and what follows here:
  *  - a received byte is acknowledged before its value is seen, so a refusal
@@ -23,6 +24,13 @@
  * go on (the next address is acknowledged by the TWI alone) and holds the
  * next event until the write is applied. Everything else is a few byte
  * moves, with the bookkeeping after the answer (slave_fsm_after()).
+ *
+ * The polled layer (i2c_slave.c) takes the shortest way to each answer,
+ * the master waiting with SCL held: the byte taken ahead
+ * (slave_fsm_ahead()), a received byte's decision (slave_fsm_received()),
+ * a read frame's first byte without the deferral (slave_fsm_read_start()),
+ * and the answer first wherever the status alone decides it
+ * (slave_fsm_acks()); each gives what slave_fsm_event() would.
  */
 #ifndef SLAVE_FSM_H
 #define SLAVE_FSM_H
