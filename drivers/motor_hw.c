@@ -15,7 +15,9 @@
 
 void motor_hw_init(void)
 {
-	static const uint8_t zero[MOTOR_COUNT] = { 0, 0 };
+	/* Zeroed at start-up, not const: a const array is .data, which links
+	 * avr-libc's copy loop for its 2 bytes (24 bytes of flash). */
+	static uint8_t zero[MOTOR_COUNT];
 	ICR1 = MOTOR_TOP;
 	TCCR1A = _BV(WGM11);
 	TCCR1B = _BV(WGM13) | _BV(WGM12) | _BV(CS10);
