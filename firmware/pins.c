@@ -12,10 +12,10 @@ void pins_init(void)
 		owner[i] = PIN_FREE;
 	}
 	/* UART and TWI pins never change hands. */
-	owner[board_pin(BF_UART_RX, 0)] = PIN_UART;
-	owner[board_pin(BF_UART_TX, 0)] = PIN_UART;
-	owner[board_pin(BF_TWI_SCL, 0)] = PIN_TWI;
-	owner[board_pin(BF_TWI_SDA, 0)] = PIN_TWI;
+	owner[board_pin_at(BF_UART_RX, 0)] = PIN_UART;
+	owner[board_pin_at(BF_UART_TX, 0)] = PIN_UART;
+	owner[board_pin_at(BF_TWI_SCL, 0)] = PIN_TWI;
+	owner[board_pin_at(BF_TWI_SDA, 0)] = PIN_TWI;
 }
 
 bool pins_can_claim(uint8_t pin, pin_owner_t who)
