@@ -32,7 +32,18 @@ static inline __attribute__((always_inline)) uint8_t board_pin_at(board_fn_t fn,
 	return BOARD_PIN_NONE;
 }
 
-/* Whether `pin` has function `fn` (any index) in the map. */
-uint8_t board_pin_has(uint8_t pin, board_fn_t fn);
+/* Whether `pin` has function `fn` (any index) in the map, `fn` a constant:
+ * folded as board_pin_at() is, to a test of the pin against the few pins
+ * with that function (none: false, no code). */
+static inline __attribute__((always_inline)) uint8_t board_pin_has(uint8_t pin, board_fn_t fn)
+{
+#define BOARD_PIN_HAS_IF(port, line, function, idx) \
+	if (fn == BF_##function && pin == PIN_ID(port, line)) { \
+		return 1; \
+	}
+	BOARD_PINS(BOARD_PIN_HAS_IF)
+#undef BOARD_PIN_HAS_IF
+	return 0;
+}
 
 #endif
