@@ -72,9 +72,12 @@ pin_owner_t pins_owner(uint8_t pin)
 uint8_t pins_gpio_mask(uint8_t port)
 {
 	uint8_t mask = 0;
-	for (uint8_t line = 0; line < 8; line++) {
-		if (owner[port * 8 + line] == PIN_FREE) {
-			mask |= (uint8_t)(1u << line);
+	const uint8_t *o = &owner[port * 8];
+	/* the line's bit walked along (a shift by the line's number is a loop
+	 * on the AVR) */
+	for (uint8_t bit = 1; bit; bit = (uint8_t)(bit << 1)) {
+		if (*o++ == PIN_FREE) {
+			mask |= bit;
 		}
 	}
 	return mask;
