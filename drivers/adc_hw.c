@@ -13,21 +13,11 @@
 
 static struct {
 	volatile uint16_t value[8];
-	uint8_t mask;
 	uint8_t refs;
 	uint8_t ch;        /* channel being converted */
 	uint8_t next[8];   /* the enabled channel after channel n */
 	uint8_t discard;   /* conversions to drop after a reference change */
 } adc;
-
-/* The enabled channel after `ch`, round the 8 (mask not 0). */
-static uint8_t adc_after(uint8_t mask, uint8_t ch)
-{
-	do {
-		ch = (uint8_t)((ch + 1) & 7);
-	} while (!(mask & (1u << ch)));
-	return ch;
-}
 
 static void adc_start(uint8_t ch)
 {
@@ -56,18 +46,31 @@ void adc_hw_config(uint8_t refs, uint8_t mask)
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 		ADCSRA = 0;  /* stop; a conversion under way is dropped */
 	}
-	for (uint8_t ch = 0; ch < 8; ch++) {
-		if (!(mask & (1u << ch))) {
+	/* (masks walked a bit at a time: a shift by a channel's number is a
+	 * loop on the AVR) */
+	uint8_t off = (uint8_t)~mask;
+	for (uint8_t ch = 0; off; ch++, off >>= 1) {
+		if (off & 1) {
 			adc.value[ch] = 0;
 		}
 	}
 	/* The reference needs a moment after a change: one conversion. */
 	adc.discard = (refs != adc.refs) ? 1 : 0;
 	adc.refs = refs;
-	adc.mask = mask;
 	if (mask) {
-		for (uint8_t ch = 0; ch < 8; ch++) {
-			adc.next[ch] = adc_after(mask, ch);
+		/* Each channel's enabled one after it, round the 8: the channels
+		 * walked down twice round (the mask's bits from the top), the
+		 * last enabled one seen is the next one up (itself when alone). */
+		uint16_t bits = (uint16_t)(mask << 8 | mask);
+		uint8_t next = 0;
+		for (uint8_t i = 16; i--; bits <<= 1) {
+			uint8_t ch = i & 7;
+			if (i < 8) {
+				adc.next[ch] = next;
+			}
+			if (bits & 0x8000) {
+				next = ch;
+			}
 		}
 		ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 			adc_start(adc.next[7]);

@@ -8,6 +8,7 @@
 #define ADC_REG_RC 0
 #define ADC_REG_RD 1
 #define ADC_PORT ((uint8_t)(BOARD_ADC_PORT - 'A'))
+#define ADC_PIN0 PIN_ID(BOARD_ADC_PORT, 0)  /* channel 0's pin; channel n is line n */
 
 static struct {
 	uint8_t settings;
@@ -41,18 +42,22 @@ reg_status_t drv_adc_write(uint8_t reg, const uint8_t *data, uint8_t len)
 	}
 	uint8_t taking = mask & (uint8_t)~adc_cfg.mask;
 	/* Check every line before taking any: giving a taken line back would
-	 * reset it to an input, though it may have been a GPIO output. */
-	for (uint8_t ch = 0; ch < 8; ch++) {
-		if ((taking & (1u << ch)) && !pins_can_claim((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC)) {
+	 * reset it to an input, though it may have been a GPIO output. (The
+	 * masks are walked a bit at a time: a shift by the channel's number
+	 * is a loop on the AVR.) */
+	uint8_t lines = taking;
+	for (uint8_t pin = ADC_PIN0; lines; pin++, lines >>= 1) {
+		if ((lines & 1) && !pins_can_claim(pin, PIN_ADC)) {
 			return REG_PIN_BUSY;
 		}
 	}
 	uint8_t giving = adc_cfg.mask & (uint8_t)~mask;
-	for (uint8_t ch = 0; ch < 8; ch++) {
-		if (taking & (1u << ch)) {
-			pins_claim((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC);
-		} else if (giving & (1u << ch)) {
-			pins_release((uint8_t)(ADC_PORT * 8 + ch), PIN_ADC);
+	lines = taking;
+	for (uint8_t pin = ADC_PIN0; lines | giving; pin++, lines >>= 1, giving >>= 1) {
+		if (lines & 1) {
+			pins_claim(pin, PIN_ADC);
+		} else if (giving & 1) {
+			pins_release(pin, PIN_ADC);
 		}
 	}
 	port_io_dir(ADC_PORT, taking, 0);

@@ -40,11 +40,9 @@ reg_status_t drv_gpio_write(uint8_t reg, const uint8_t *data, uint8_t len)
 uint8_t drv_gpio_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
 	(void)max;
-	if (reg >= GPIO_NPORTS) {
-		dst[0] = port_io_dirs(gpio_ports[reg - GPIO_NPORTS]);
-	} else {
-		dst[0] = port_io_pins(gpio_ports[reg]);
-	}
+	uint8_t is_mode = reg >= GPIO_NPORTS;
+	uint8_t port = gpio_ports[is_mode ? reg - GPIO_NPORTS : reg];
+	dst[0] = is_mode ? port_io_dirs(port) : port_io_pins(port);
 	return 1;
 }
 

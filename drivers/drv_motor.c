@@ -17,8 +17,8 @@ void drv_motor_init(void)
 	/* Direction lines are the motors' for good; a stopped motor's PWM line
 	 * (low) may be lent to servo channels 14/15. */
 	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
-		pins_claim(board_pin(BF_MOTOR_DIR, m), PIN_MOTOR);
-		pins_claim(board_pin(BF_MOTOR_PWM, m), PIN_MOTOR_IDLE);
+		pins_claim(MOTOR_PIN(BF_MOTOR_DIR, m), PIN_MOTOR);
+		pins_claim(MOTOR_PIN(BF_MOTOR_PWM, m), PIN_MOTOR_IDLE);
 	}
 	motor_hw_init();
 }
@@ -53,14 +53,14 @@ reg_status_t drv_motor_write(uint8_t reg, const uint8_t *data, uint8_t len)
 	}
 	/* A running motor needs its PWM line: a servo may hold it. */
 	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
-		uint8_t pin = board_pin(BF_MOTOR_PWM, m);
+		uint8_t pin = MOTOR_PIN(BF_MOTOR_PWM, m);
 		if (next[m] && pins_owner(pin) != PIN_MOTOR && pins_owner(pin) != PIN_MOTOR_IDLE) {
 			return REG_PIN_BUSY;
 		}
 	}
 	uint8_t lines = 0;
 	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
-		if (pins_claim(board_pin(BF_MOTOR_PWM, m), next[m] ? PIN_MOTOR : PIN_MOTOR_IDLE)) {
+		if (pins_claim(MOTOR_PIN(BF_MOTOR_PWM, m), next[m] ? PIN_MOTOR : PIN_MOTOR_IDLE)) {
 			lines |= (uint8_t)(1u << m);
 		}
 	}

@@ -38,10 +38,10 @@ void drv_spi_init(void)
 	}
 	spi.rx_len = 0;
 	spi.settings = SPI_SET_DEFAULT;
-	pins_claim(board_pin(BF_SPI_SS, 0), PIN_SPI);
-	pins_claim(board_pin(BF_SPI_SCK, 0), PIN_SPI);
-	pins_claim(board_pin(BF_SPI_MOSI, 0), PIN_SPI);
-	pins_claim(board_pin(BF_SPI_MISO, 0), PIN_SPI);
+	pins_claim(board_pin_at(BF_SPI_SS, 0), PIN_SPI);
+	pins_claim(board_pin_at(BF_SPI_SCK, 0), PIN_SPI);
+	pins_claim(board_pin_at(BF_SPI_MOSI, 0), PIN_SPI);
+	pins_claim(board_pin_at(BF_SPI_MISO, 0), PIN_SPI);
 	spi_hw_init();
 	spi_apply(spi.settings);
 }

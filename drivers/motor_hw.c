@@ -15,7 +15,9 @@
 
 void motor_hw_init(void)
 {
-	static const uint8_t zero[MOTOR_COUNT] = { 0, 0 };
+	/* Zeroed at start-up, not const: a const array is .data, which links
+	 * avr-libc's copy loop for its 2 bytes (24 bytes of flash). */
+	static uint8_t zero[MOTOR_COUNT];
 	ICR1 = MOTOR_TOP;
 	TCCR1A = _BV(WGM11);
 	TCCR1B = _BV(WGM13) | _BV(WGM12) | _BV(CS10);
@@ -61,14 +63,14 @@ void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
 		TCCR1A = (uint8_t)((TCCR1A & ~com_off) | com_on);
 	}
 	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
-		uint8_t d = board_pin(BF_MOTOR_DIR, m);
+		uint8_t d = MOTOR_PIN(BF_MOTOR_DIR, m);
 		pins_drive(d, dir[m]);
 		if (lines & (1u << m)) {
 			/* 0 and 255 are steady levels from the port with the compare
 			 * output disconnected: at OCR 0 the output would still spike
 			 * once a period, and OCR = TOP relies on compare and overflow
 			 * meeting in the same cycle. */
-			uint8_t p = board_pin(BF_MOTOR_PWM, m);
+			uint8_t p = MOTOR_PIN(BF_MOTOR_PWM, m);
 			pins_drive(p, pwm[m] == 255);
 		}
 	}

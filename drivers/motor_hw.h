@@ -4,7 +4,13 @@
 
 #include <stdint.h>
 
+#include "firmware/board_pins.h"
+
 #define MOTOR_COUNT 2
+
+/* Motor m's pin of function `fn` (BF_MOTOR_PWM, BF_MOTOR_DIR): one of two
+ * constants, not a search of the pin map. */
+#define MOTOR_PIN(fn, m) ((m) ? board_pin_at(fn, 1) : board_pin_at(fn, 0))
 
 /* Timer1 fast PWM; outputs low. */
 void motor_hw_init(void);

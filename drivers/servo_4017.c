@@ -213,7 +213,7 @@ void servo_hw_init(void)
 		pins_claim(pin, PIN_SERVO_CLK);
 		pins_drive(pin, false);
 	}
-	uint8_t rst = board_pin(BF_SERVO_RST, 0);
+	uint8_t rst = board_pin_at(BF_SERVO_RST, 0);
 	pins_claim(rst, PIN_SERVO_CLK);
 	pulses.rst_port = mcu_port(PIN_PORT(rst)).port;
 	pulses.rst_mask = PIN_MASK(rst);

@@ -3,23 +3,36 @@
 #include <avr/io.h>
 
 #include "firmware/board_pins.h"
+#include "firmware/mcu.h"
 #include "firmware/pins.h"
-#include "firmware/port_io.h"
 
-static void spi_pin(board_fn_t fn, uint8_t output, uint8_t level)
+/* The SPI pins are the MCU's own (port B on both boards), known when
+ * compiling: each step is one sbi/cbi on the port's register, which no
+ * interrupt can come between (the servo interrupt drives other lines of
+ * the port), as port_io's read-modify-writes with interrupts off. */
+static inline __attribute__((always_inline)) void spi_pin(uint8_t pin, uint8_t output, uint8_t level)
 {
-	uint8_t pin = board_pin(fn, 0);
-	pins_level(pin, level);
-	port_io_dir(PIN_PORT(pin), PIN_MASK(pin), output ? 0xFF : 0);
+	mcu_port_t p = mcu_port_at(PIN_PORT(pin));
+	uint8_t mask = PIN_MASK(pin);
+	if (level) {
+		*p.port |= mask;
+	} else {
+		*p.port &= (uint8_t)~mask;
+	}
+	if (output) {
+		*p.ddr |= mask;
+	} else {
+		*p.ddr &= (uint8_t)~mask;
+	}
 }
 
+/* The settings (and SCK's idle level) are the driver's first
+ * spi_hw_config(), right after. */
 void spi_hw_init(void)
 {
-	spi_pin(BF_SPI_SS, 1, 1);
-	spi_pin(BF_SPI_MOSI, 1, 0);
-	spi_pin(BF_SPI_SCK, 1, 0);
-	spi_pin(BF_SPI_MISO, 0, 0);
-	spi_hw_config(2, 0, 0);
+	spi_pin(board_pin_at(BF_SPI_SS, 0), 1, 1);
+	spi_pin(board_pin_at(BF_SPI_MOSI, 0), 1, 0);
+	spi_pin(board_pin_at(BF_SPI_MISO, 0), 0, 0);
 }
 
 void spi_hw_config(uint8_t divider, uint8_t mode, uint8_t lsb_first)
@@ -41,7 +54,7 @@ void spi_hw_config(uint8_t divider, uint8_t mode, uint8_t lsb_first)
 	SPCR = spcr;
 	SPSR = (!(divider & 1) && divider < 6) ? _BV(SPI2X) : 0;
 	/* SCK idles at CPOL: give the pin that level while SPI is off too. */
-	spi_pin(BF_SPI_SCK, 1, (uint8_t)(mode & 2));
+	spi_pin(board_pin_at(BF_SPI_SCK, 0), 1, (uint8_t)(mode & 2));
 }
 
 void spi_hw_exchange(uint8_t *buf, uint8_t n)

@@ -4,7 +4,8 @@
 
 #include <stdint.h>
 
-/* SCK, MOSI, SS outputs (SS high: master mode stays on), MISO input. */
+/* MOSI, SS outputs (SS high: master mode stays on), MISO input; SCK
+ * with the first spi_hw_config(). */
 void spi_hw_init(void);
 
 /* divider: 0..6 for F_CPU/2, 4, 8, 16, 32, 64, 128; mode 0-3 (CPOL, CPHA);

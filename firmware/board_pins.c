@@ -26,13 +26,3 @@ uint8_t board_pin(board_fn_t fn, uint8_t index)
 	}
 	return BOARD_PIN_NONE;
 }
-
-uint8_t board_pin_has(uint8_t pin, board_fn_t fn)
-{
-	for (uint8_t i = 0; i < BOARD_NPINS; i++) {
-		if (board_pins[i].fn == fn && board_pins[i].pin == pin) {
-			return 1;
-		}
-	}
-	return 0;
-}

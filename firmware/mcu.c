@@ -7,15 +7,10 @@
  * Addresses rather than pointers in flash: avr-gcc 5.4 at -O2 miscompiled
  * reads of pointers through __flash. */
 static const __flash uint8_t port_regs[][3] = {
-	{ _SFR_MEM_ADDR(PINA), _SFR_MEM_ADDR(DDRA), _SFR_MEM_ADDR(PORTA) },
-	{ _SFR_MEM_ADDR(PINB), _SFR_MEM_ADDR(DDRB), _SFR_MEM_ADDR(PORTB) },
-	{ _SFR_MEM_ADDR(PINC), _SFR_MEM_ADDR(DDRC), _SFR_MEM_ADDR(PORTC) },
-	{ _SFR_MEM_ADDR(PIND), _SFR_MEM_ADDR(DDRD), _SFR_MEM_ADDR(PORTD) },
-#if defined(__AVR_ATmega128__)
-	{ _SFR_MEM_ADDR(PINE), _SFR_MEM_ADDR(DDRE), _SFR_MEM_ADDR(PORTE) },
-	{ _SFR_MEM_ADDR(PINF), _SFR_MEM_ADDR(DDRF), _SFR_MEM_ADDR(PORTF) },
-	{ _SFR_MEM_ADDR(PING), _SFR_MEM_ADDR(DDRG), _SFR_MEM_ADDR(PORTG) },
-#endif
+#define MCU_PORT_ROW(letter) \
+	{ _SFR_MEM_ADDR(PIN##letter), _SFR_MEM_ADDR(DDR##letter), _SFR_MEM_ADDR(PORT##letter) },
+	MCU_PORT_LETTERS(MCU_PORT_ROW)
+#undef MCU_PORT_ROW
 };
 
 mcu_port_t mcu_port(uint8_t index)

@@ -43,6 +43,13 @@
 #error "ORFA supports ATmega32 and ATmega128"
 #endif
 
+/* The MCU's I/O ports in letter order from A, X(letter). */
+#if defined(__AVR_ATmega128__)
+#define MCU_PORT_LETTERS(X) X(A) X(B) X(C) X(D) X(E) X(F) X(G)
+#else
+#define MCU_PORT_LETTERS(X) X(A) X(B) X(C) X(D)
+#endif
+
 /* The three registers of one I/O port. */
 typedef struct {
 	volatile uint8_t *pin;
@@ -53,6 +60,20 @@ typedef struct {
 /* The registers of port `index` (0 = port A). The MCU's ports only: the
  * board files name nothing else. */
 mcu_port_t mcu_port(uint8_t index);
+
+/* The same for an `index` known when compiling: the compiler folds it to
+ * the registers themselves (a bit of them is one sbi/cbi), no table read.
+ * A variable index would inline every test: use mcu_port() then. */
+static inline __attribute__((always_inline)) mcu_port_t mcu_port_at(uint8_t index)
+{
+#define MCU_PORT_IF(letter) \
+	if (index == (uint8_t)(*#letter - 'A')) { \
+		return (mcu_port_t){ &PIN##letter, &DDR##letter, &PORT##letter }; \
+	}
+	MCU_PORT_LETTERS(MCU_PORT_IF)
+#undef MCU_PORT_IF
+	return (mcu_port_t){ 0, 0, 0 };
+}
 
 /* Watchdog on (250 ms), reset flags cleared (simavr re-arms a fired
  * watchdog until WDRF is cleared; harmless on silicon). Returns the reset

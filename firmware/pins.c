@@ -12,10 +12,10 @@ void pins_init(void)
 		owner[i] = PIN_FREE;
 	}
 	/* UART and TWI pins never change hands. */
-	owner[board_pin(BF_UART_RX, 0)] = PIN_UART;
-	owner[board_pin(BF_UART_TX, 0)] = PIN_UART;
-	owner[board_pin(BF_TWI_SCL, 0)] = PIN_TWI;
-	owner[board_pin(BF_TWI_SDA, 0)] = PIN_TWI;
+	owner[board_pin_at(BF_UART_RX, 0)] = PIN_UART;
+	owner[board_pin_at(BF_UART_TX, 0)] = PIN_UART;
+	owner[board_pin_at(BF_TWI_SCL, 0)] = PIN_TWI;
+	owner[board_pin_at(BF_TWI_SDA, 0)] = PIN_TWI;
 }
 
 bool pins_can_claim(uint8_t pin, pin_owner_t who)
@@ -72,9 +72,12 @@ pin_owner_t pins_owner(uint8_t pin)
 uint8_t pins_gpio_mask(uint8_t port)
 {
 	uint8_t mask = 0;
-	for (uint8_t line = 0; line < 8; line++) {
-		if (owner[port * 8 + line] == PIN_FREE) {
-			mask |= (uint8_t)(1u << line);
+	const uint8_t *o = &owner[port * 8];
+	/* the line's bit walked along (a shift by the line's number is a loop
+	 * on the AVR) */
+	for (uint8_t bit = 1; bit; bit = (uint8_t)(bit << 1)) {
+		if (*o++ == PIN_FREE) {
+			mask |= bit;
 		}
 	}
 	return mask;

@@ -212,14 +212,15 @@ bool twi_stop(void)
 	return twi_wait_for(_BV(TWSTO), 0);
 }
 
-/* Open-drain lines by hand: low = output 0, released = input with pull-up. */
-static void line_low(const mcu_port_t *p, uint8_t bit)
+/* Open-drain lines by hand: low = output 0, released = input with pull-up.
+ * Inlined on the TWI port known when compiling: a bit is one sbi/cbi. */
+static inline __attribute__((always_inline)) void line_low(const mcu_port_t *p, uint8_t bit)
 {
 	*p->port &= (uint8_t)~bit;
 	*p->ddr |= bit;
 }
 
-static void line_release(const mcu_port_t *p, uint8_t bit)
+static inline __attribute__((always_inline)) void line_release(const mcu_port_t *p, uint8_t bit)
 {
 	*p->ddr &= (uint8_t)~bit;
 	*p->port |= bit;
@@ -227,7 +228,7 @@ static void line_release(const mcu_port_t *p, uint8_t bit)
 
 bool twi_clear_bus(void)
 {
-	mcu_port_t port = mcu_port(BOARD_TWI_PORT - 'A');
+	const mcu_port_t port = mcu_port_at(BOARD_TWI_PORT - 'A');
 	const mcu_port_t *p = &port;
 	const uint8_t scl = _BV(BOARD_TWI_SCL);
 	const uint8_t sda = _BV(BOARD_TWI_SDA);

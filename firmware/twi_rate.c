@@ -2,7 +2,7 @@
 
 twi_rate_t twi_rate_for_khz(uint32_t f_cpu, uint16_t khz)
 {
-	twi_rate_t r = { .twbr = 255, .twps = 3 };
+	twi_rate_t r;
 
 	/* The shortest SCL period not faster than asked, then the smallest
 	 * prescaler whose TWBR reaches it: TWBR = ceil((period - 16) / 2·4^ps)
@@ -14,16 +14,20 @@ twi_rate_t twi_rate_for_khz(uint32_t f_cpu, uint16_t khz)
 	uint16_t period = (uint16_t)((uint16_t)(fk_up - 1) / (khz ? khz : 1) + 1);
 	uint16_t extra = period > 16 ? (uint16_t)(period - 16) : 0;
 
-	for (uint8_t ps = 0; ps < 4; ps++) {
-		uint8_t shift = (uint8_t)(1 + 2 * ps);
-		uint16_t need = (uint16_t)((extra + (1u << shift) - 1) >> shift);
-		if (need <= 255) {
-			r.twbr = (uint8_t)need;
-			r.twps = ps;
-			break;
-		}
+	/* ceil(extra / 2·4^ps) a prescaler step at a time: ceil(ceil(x / a)
+	 * / b) = ceil(x / ab), so each step divides the last one's by 4. */
+	uint16_t need = (uint16_t)((extra + 1) >> 1);
+	uint16_t unit = 2;  /* 2·4^ps */
+	uint8_t ps = 0;
+	while (need > 255 && ps < 3) {
+		need = (uint16_t)((need + 3) >> 2);
+		unit = (uint16_t)(unit << 2);
+		ps++;
 	}
-	period = (uint16_t)(16u + ((uint16_t)r.twbr << (1 + 2 * r.twps)));
+	/* the slowest rate when even the largest prescaler falls short */
+	r.twbr = need > 255 ? 255 : (uint8_t)need;
+	r.twps = ps;
+	period = (uint16_t)(16u + r.twbr * unit);
 	r.period = period;
 	r.khz = (uint16_t)((uint16_t)(f_cpu / 1000UL) / period);
 	return r;
