@@ -2,39 +2,12 @@
 
 #include <stdbool.h>
 
-enum {
-	ST_BEGIN,    /* first character of a line */
-	ST_LEAD,     /* only spaces so far */
-	ST_COMMENT,  /* a '#' line */
-	ST_ARGS,     /* L / C: optional bytes */
-	ST_ADDR,     /* I2C: a frame's address byte expected */
-	ST_WDATA,    /* I2C write frame: data bytes, S or P */
-	ST_RCOUNT,   /* I2C read frame: the count byte expected */
-	ST_RDONE,    /* I2C read frame complete: S or P */
-	ST_DONE,     /* complete command: only spaces may follow */
-	ST_ERROR,    /* discard the rest of the line */
-};
-
-#define NO_DIGIT 0xFF
-
-static uint8_t hex_value(uint8_t c)
-{
-	if (c >= '0' && c <= '9') {
-		return (uint8_t)(c - '0');
-	}
-	c |= 0x20;  /* lower case */
-	if (c >= 'a' && c <= 'f') {
-		return (uint8_t)(c - 'a' + 10);
-	}
-	return NO_DIGIT;
-}
-
 static __attribute__((noinline)) sg_event_t fail(sg_parser_t *p, uint8_t err)
 {
 	if (p->err == SG_OK) {
 		p->err = err;
 	}
-	p->state = ST_ERROR;
+	p->state = SG_ST_ERROR;
 	return SG_MORE;
 }
 
@@ -50,35 +23,34 @@ static sg_event_t start_frame(sg_parser_t *p)
 	}
 	p->frame = p->nbytes;
 	p->reply_len = (uint8_t)(p->reply_len + 2);  /* "SW" or "SR" */
-	p->state = ST_ADDR;
+	p->state = SG_ST_ADDR;
 	return SG_MORE;
 }
 
-/* A complete byte in a state that takes one. */
-static sg_event_t take_byte(sg_parser_t *p, uint8_t b)
+sg_event_t sg_parse_byte(sg_parser_t *p, uint8_t b)
 {
 	switch (p->state) {
-	case ST_ARGS:
+	case SG_ST_ARGS:
 		p->buf[p->nbytes++] = b;
 		if (p->cmd == SG_CMD_LOCAL) {
 			if ((b & 0xFE) == 0) {
 				return fail(p, SG_ERR_DATA);
 			}
-			p->state = ST_DONE;
+			p->state = SG_ST_DONE;
 		} else if (p->nbytes == 2) {
 			if (p->buf[0] == 0 && p->buf[1] == 0) {
 				return fail(p, SG_ERR_DATA);
 			}
-			p->state = ST_DONE;
+			p->state = SG_ST_DONE;
 		}
 		return SG_MORE;
-	case ST_ADDR:
+	case SG_ST_ADDR:
 		p->buf[p->frame] = b;
 		p->buf[p->frame + 1] = 0;
 		p->nbytes = (uint8_t)(p->frame + 2);
-		p->state = (b & 1) ? ST_RCOUNT : ST_WDATA;
+		p->state = (b & 1) ? SG_ST_RCOUNT : SG_ST_WDATA;
 		return SG_MORE;
-	case ST_WDATA:
+	case SG_ST_WDATA:
 		if (!room(p, 1, 1)) {
 			return fail(p, SG_ERR_DATA);
 		}
@@ -86,14 +58,14 @@ static sg_event_t take_byte(sg_parser_t *p, uint8_t b)
 		p->buf[p->frame + 1]++;
 		p->reply_len++;
 		return SG_MORE;
-	case ST_RCOUNT:
+	case SG_ST_RCOUNT:
 		if (b == 0 || !room(p, b, 2u * b)) {
 			return fail(p, SG_ERR_DATA);
 		}
 		p->buf[p->frame + 1] = b;
 		p->nbytes = (uint8_t)(p->nbytes + b);
 		p->reply_len = (uint8_t)(p->reply_len + 2u * b);
-		p->state = ST_RDONE;
+		p->state = SG_ST_RDONE;
 		return SG_MORE;
 	default:
 		return fail(p, SG_ERR_INTERNAL);
@@ -103,26 +75,21 @@ static sg_event_t take_byte(sg_parser_t *p, uint8_t b)
 /* A hex digit, in any state after the command letter. */
 static sg_event_t take_digit(sg_parser_t *p, uint8_t d)
 {
-	switch (p->state) {
-	case ST_ARGS:
-	case ST_ADDR:
-	case ST_WDATA:
-	case ST_RCOUNT:
-		break;
-	default:  /* ST_DONE, ST_RDONE: a byte where none may stand */
+	if ((uint8_t)(p->state - SG_ST_ARGS) > SG_ST_RCOUNT - SG_ST_ARGS) {
+		/* SG_ST_DONE, SG_ST_RDONE: a byte where none may stand */
 		return fail(p, SG_ERR_DATA);
 	}
-	if (p->hi == NO_DIGIT) {
+	if (p->hi == SG_NO_DIGIT) {
 		p->hi = d;
 		return SG_MORE;
 	}
 	uint8_t b = (uint8_t)(p->hi << 4 | d);
-	p->hi = NO_DIGIT;
-	return take_byte(p, b);
+	p->hi = SG_NO_DIGIT;
+	return sg_parse_byte(p, b);
 }
 
-/* A one-letter command: V and X take nothing more (ST_DONE), L and C
- * optional bytes (ST_ARGS). */
+/* A one-letter command: V and X take nothing more (SG_ST_DONE), L and C
+ * optional bytes (SG_ST_ARGS). */
 static sg_event_t begin_line_command(sg_parser_t *p, uint8_t cmd, uint8_t state)
 {
 	p->cmd = cmd;
@@ -134,13 +101,13 @@ static sg_event_t begin_command(sg_parser_t *p, uint8_t c)
 {
 	switch (c | 0x20) {
 	case 'v':
-		return begin_line_command(p, SG_CMD_VERSION, ST_DONE);
+		return begin_line_command(p, SG_CMD_VERSION, SG_ST_DONE);
 	case 'x':
-		return begin_line_command(p, SG_CMD_CLEAR, ST_DONE);
+		return begin_line_command(p, SG_CMD_CLEAR, SG_ST_DONE);
 	case 'l':
-		return begin_line_command(p, SG_CMD_LOCAL, ST_ARGS);
+		return begin_line_command(p, SG_CMD_LOCAL, SG_ST_ARGS);
 	case 'c':
-		return begin_line_command(p, SG_CMD_CLOCK, ST_ARGS);
+		return begin_line_command(p, SG_CMD_CLOCK, SG_ST_ARGS);
 	case 's':
 		p->cmd = SG_CMD_I2C;
 		p->reply_len = 1;  /* the closing "P" */
@@ -153,24 +120,24 @@ static sg_event_t begin_command(sg_parser_t *p, uint8_t c)
 static sg_event_t end_line(sg_parser_t *p)
 {
 	uint8_t state = p->state;
-	p->state = ST_BEGIN;
+	p->state = SG_ST_BEGIN;
 	switch (state) {
-	case ST_BEGIN:
-	case ST_LEAD:
-	case ST_COMMENT:
+	case SG_ST_BEGIN:
+	case SG_ST_LEAD:
+	case SG_ST_COMMENT:
 		return SG_IGNORED;
-	case ST_ERROR:
-	case ST_DONE:
+	case SG_ST_ERROR:
+	case SG_ST_DONE:
 		break;
-	case ST_ARGS:
-		if (p->hi != NO_DIGIT) {
+	case SG_ST_ARGS:
+		if (p->hi != SG_NO_DIGIT) {
 			p->err = SG_ERR_HEX;
 		} else if (p->cmd == SG_CMD_CLOCK && p->nbytes == 1) {
 			p->err = SG_ERR_DATA;
 		}
 		break;
 	default:  /* inside an I2C request */
-		p->err = (p->hi != NO_DIGIT) ? SG_ERR_HEX : SG_ERR_NO_P;
+		p->err = (p->hi != SG_NO_DIGIT) ? SG_ERR_HEX : SG_ERR_NO_P;
 		break;
 	}
 	return SG_REQUEST;
@@ -193,28 +160,21 @@ static sg_event_t lost_run(sg_parser_t *p, uint8_t c)
 
 void sg_parse_init(sg_parser_t *p)
 {
-	p->state = ST_BEGIN;
+	p->state = SG_ST_BEGIN;
 	p->err = SG_OK;
 	p->cmd = SG_CMD_NONE;
 	p->len = 0;
-	p->hi = NO_DIGIT;
+	p->hi = SG_NO_DIGIT;
 	p->nbytes = 0;
 	p->frame = 0;
 	p->reply_len = 0;
 	p->lost_info = 0;
 }
 
-sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
+sg_event_t sg_parse_slow(sg_parser_t *p, uint8_t c)
 {
 	if (p->lost_info) {
 		return lost_run(p, c);
-	}
-	/* The common space first: between bytes, inside a request, the line
-	 * short (what the whole path below does with it, in fewer cycles). */
-	if (c == ' ' && (uint8_t)(p->state - ST_ARGS) <= ST_DONE - ST_ARGS && p->hi == NO_DIGIT &&
-	    p->len < SG_LINE_MAX) {
-		p->len++;
-		return SG_MORE;
 	}
 	if (c == '\r' || c == '\n') {
 		return end_line(p);
@@ -226,64 +186,64 @@ sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 	if (c == SG_CHAR_END_LOST || c == SG_CHAR_END_EMPTY) {
 		/* the end of a line that lost characters: the receive ring knew
 		 * what the parser cannot (the lost part), so it decides */
-		p->state = ST_BEGIN;
+		p->state = SG_ST_BEGIN;
 		if (c == SG_CHAR_END_EMPTY) {
 			return SG_IGNORED;
 		}
 		p->err = SG_ERR_DATA;
 		return SG_REQUEST;
 	}
-	if (p->state == ST_BEGIN) {
+	if (p->state == SG_ST_BEGIN) {
 		sg_parse_init(p);
 	}
-	if (p->state == ST_COMMENT || p->state == ST_ERROR) {
+	if (p->state == SG_ST_COMMENT || p->state == SG_ST_ERROR) {
 		return SG_MORE;
 	}
 	if (p->len <= SG_LINE_MAX) {
 		p->len++;  /* stops at one over the limit */
 	}
-	bool blank = c == ' ' && (p->state == ST_BEGIN || p->state == ST_LEAD);
+	bool blank = c == ' ' && (p->state == SG_ST_BEGIN || p->state == SG_ST_LEAD);
 	if (p->len > SG_LINE_MAX && !blank) {
 		/* over the limit; a line of nothing but spaces is empty, however
 		 * long (no reply) */
 		return fail(p, SG_ERR_DATA);
 	}
-	uint8_t d = hex_value(c);
-	if (p->hi != NO_DIGIT && d == NO_DIGIT) {
+	uint8_t d = sg_hex_value(c);
+	if (p->hi != SG_NO_DIGIT && d == SG_NO_DIGIT) {
 		return fail(p, SG_ERR_HEX);  /* a byte with one digit */
 	}
 	if (c == ' ') {
-		if (p->state == ST_BEGIN) {
-			p->state = ST_LEAD;
+		if (p->state == SG_ST_BEGIN) {
+			p->state = SG_ST_LEAD;
 		}
 		return SG_MORE;
 	}
 	switch (p->state) {
-	case ST_BEGIN:
+	case SG_ST_BEGIN:
 		if (c == '#') {
-			p->state = ST_COMMENT;
+			p->state = SG_ST_COMMENT;
 			return SG_MORE;
 		}
 		return begin_command(p, c);
-	case ST_LEAD:
+	case SG_ST_LEAD:
 		return begin_command(p, c);
-	case ST_DONE:
+	case SG_ST_DONE:
 		return fail(p, SG_ERR_DATA);
 	default:
 		break;
 	}
-	if (d != NO_DIGIT) {
+	if (d != SG_NO_DIGIT) {
 		return take_digit(p, d);
 	}
 	uint8_t lc = c | 0x20;
-	if (lc == 's' && (p->state == ST_WDATA || p->state == ST_RDONE)) {
+	if (lc == 's' && (p->state == SG_ST_WDATA || p->state == SG_ST_RDONE)) {
 		return start_frame(p);
 	}
-	if (lc == 'p' && (p->state == ST_WDATA || p->state == ST_RDONE)) {
-		p->state = ST_DONE;
+	if (lc == 'p' && (p->state == SG_ST_WDATA || p->state == SG_ST_RDONE)) {
+		p->state = SG_ST_DONE;
 		return SG_MORE;
 	}
-	if ((lc == 's' || lc == 'p') && p->state == ST_RCOUNT) {
+	if ((lc == 's' || lc == 'p') && p->state == SG_ST_RCOUNT) {
 		return fail(p, SG_ERR_DATA);  /* a read frame without its count */
 	}
 	return fail(p, SG_ERR_HEX);  /* not a hex digit where a byte is expected */

@@ -78,9 +78,66 @@ typedef struct {
 
 void sg_parse_init(sg_parser_t *p);
 
+/* The parser's states (`state`; sg_parse.c's, here for sg_parse_char()). */
+enum {
+	SG_ST_BEGIN,    /* first character of a line */
+	SG_ST_LEAD,     /* only spaces so far */
+	SG_ST_COMMENT,  /* a '#' line */
+	SG_ST_ARGS,     /* L / C: optional bytes */
+	SG_ST_ADDR,     /* I2C: a frame's address byte expected */
+	SG_ST_WDATA,    /* I2C write frame: data bytes, S or P */
+	SG_ST_RCOUNT,   /* I2C read frame: the count byte expected */
+	SG_ST_RDONE,    /* I2C read frame complete: S or P */
+	SG_ST_DONE,     /* complete command: only spaces may follow */
+	SG_ST_ERROR,    /* discard the rest of the line */
+};
+
+#define SG_NO_DIGIT 0xFF  /* `hi` between bytes; sg_hex_value() of a non-digit */
+
+static inline uint8_t sg_hex_value(uint8_t c)
+{
+	if ((uint8_t)(c - '0') <= 9) {
+		return (uint8_t)(c - '0');
+	}
+	c = (uint8_t)((c | 0x20) - 'a');  /* lower case */
+	return c <= 5 ? (uint8_t)(c + 10) : SG_NO_DIGIT;
+}
+
+/* Feeds one character, the whole rule. */
+sg_event_t sg_parse_slow(sg_parser_t *p, uint8_t c);
+
+/* A byte complete in a state that takes one (SG_ST_ARGS to SG_ST_RCOUNT). */
+sg_event_t sg_parse_byte(sg_parser_t *p, uint8_t b);
+
 /* Feeds one character. After SG_REQUEST, `err` holds the error to reply (or
  * SG_OK), `cmd`, `nbytes` and `buf` the request; the parser is ready for the
- * next line. */
-sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c);
+ * next line. The common characters inside a request, the line short (a
+ * space between bytes, a byte's digit), are taken here in a few cycles,
+ * without sg_parse_slow()'s call: what it does with them
+ * (tests/unit's test_parse_fast_path checks both agree). At 460800 baud
+ * the parser has a share of the 160 cycles a character lasts. */
+static inline sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
+{
+	if ((uint8_t)(p->state - SG_ST_ARGS) <= SG_ST_DONE - SG_ST_ARGS && p->len < SG_LINE_MAX &&
+	    !p->lost_info) {
+		uint8_t hi = p->hi;
+
+		if (c == ' ' && hi == SG_NO_DIGIT) {
+			p->len++;
+			return SG_MORE;
+		}
+		uint8_t d = sg_hex_value(c);
+		if (d != SG_NO_DIGIT && p->state <= SG_ST_RCOUNT) {
+			p->len++;
+			if (hi == SG_NO_DIGIT) {
+				p->hi = d;
+				return SG_MORE;
+			}
+			p->hi = SG_NO_DIGIT;
+			return sg_parse_byte(p, (uint8_t)(hi << 4 | d));
+		}
+	}
+	return sg_parse_slow(p, c);
+}
 
 #endif
