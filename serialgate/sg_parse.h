@@ -118,8 +118,9 @@ sg_event_t sg_parse_byte(sg_parser_t *p, uint8_t b);
  * the parser has a share of the 160 cycles a character lasts. */
 static inline sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 {
-	if ((uint8_t)(p->state - SG_ST_ARGS) <= SG_ST_DONE - SG_ST_ARGS && p->len < SG_LINE_MAX &&
-	    !p->lost_info) {
+	/* c >= ' ' first: a line's end (the latency's character) is out at once */
+	if (c >= ' ' && (uint8_t)(p->state - SG_ST_ARGS) <= SG_ST_DONE - SG_ST_ARGS &&
+	    p->len < SG_LINE_MAX && !p->lost_info) {
 		uint8_t hi = p->hi;
 
 		if (c == ' ' && hi == SG_NO_DIGIT) {
