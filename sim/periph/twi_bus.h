@@ -164,6 +164,9 @@ typedef struct twi_bus_t {
 	/* the master clocking an address or data byte (NULL: none), told of
 	 * a START or STOP the lines carry meanwhile */
 	twi_bus_master_t *in_byte;
+	/* the bytes the masters have clocked since the simulator started
+	 * (their addr, write and read notes; `wait i2c` counts them) */
+	uint64_t bytes;
 
 	twi_line_fn listener[TWI_BUS_LISTENERS];
 	void *listener_param[TWI_BUS_LISTENERS];
@@ -205,8 +208,8 @@ void twi_bus_cancel(twi_bus_t *bus, twi_bus_master_t *m);
 void twi_bus_byte(twi_bus_t *bus, uint64_t begin, uint64_t end);
 
 /* The master's account of its operations: trace lines and the busy signal,
- * at the CYCLE each completes; they also count the bytes for the fault
- * armed (twi_fault.h). */
+ * at the CYCLE each completes; they also count the bytes (bus->bytes, and
+ * for the fault armed, twi_fault.h). */
 void twi_bus_note_start(twi_bus_t *bus, uint64_t cycle);
 void twi_bus_note_addr(twi_bus_t *bus, uint64_t cycle, uint8_t addr8, int ack);
 void twi_bus_note_write(twi_bus_t *bus, uint64_t cycle, uint8_t byte, int ack);
