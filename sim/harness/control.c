@@ -19,7 +19,6 @@
 #include "harness/control.h"
 #include "harness/fault.h"
 #include "harness/isr_watch.h"
-#include "harness/world.h"
 #include "boards/sram.h"
 #include "parts/part.h"
 
@@ -1203,17 +1202,25 @@ uint64_t control_deadline(const control_t *c)
 	for (int i = 0; i < CONTROL_CLIENTS; i++) {
 		const control_client_t *cl = &c->client[i];
 
-		if (cl->fd < 0 || !cl->waiting) {
-			continue;
-		}
-		if (cl->wait.until < d) {
+		if (cl->fd >= 0 && cl->waiting && cl->wait.until < d) {
 			d = cl->wait.until;
-		}
-		if (cl->wait.bytes && c->avr->cycle + WORLD_QUANTUM < d) {
-			d = c->avr->cycle + WORLD_QUANTUM;
 		}
 	}
 	return d;
+}
+
+uint64_t control_bytes_due(const control_t *c)
+{
+	uint64_t n = UINT64_MAX;
+
+	for (int i = 0; i < CONTROL_CLIENTS; i++) {
+		const control_client_t *cl = &c->client[i];
+
+		if (cl->fd >= 0 && cl->waiting && cl->wait.bytes && cl->wait.bytes < n) {
+			n = cl->wait.bytes;
+		}
+	}
+	return n;
 }
 
 int control_pollfds(const control_t *c, struct pollfd *pfd, int max)

@@ -79,10 +79,14 @@ void control_poll(control_t *c);
 /* True while some client waits for simulated time or bus bytes. */
 int control_waiting(const control_t *c);
 
-/* The earliest cycle a waiting client wants (UINT64_MAX when none); while
- * one waits for bus bytes, the next world quantum's end, so the batch that
- * carries the byte stops within a quantum of it. */
+/* The earliest cycle a waiting client wants (UINT64_MAX when none): a
+ * `wait`'s, or a `wait i2c`'s bound. */
 uint64_t control_deadline(const control_t *c);
+
+/* The lowest count of the bus's bytes (twi_bus_t.bytes) a waiting client
+ * wants (`wait i2c`), UINT64_MAX when none: the run should stop at the
+ * quantum it is reached in. */
+uint64_t control_bytes_due(const control_t *c);
 
 /* Add the socket's descriptors to PFD (room for MAX); returns how many. */
 int control_pollfds(const control_t *c, struct pollfd *pfd, int max);
