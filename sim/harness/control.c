@@ -395,8 +395,8 @@ static int req_wait_i2c(control_req_ctx_t *q)
 		reply_printf(q->r, "ERR wait i2c: no I2C bus");
 		return 0;
 	}
-	*q->wait = (control_wait_t) { .until = q->c->avr->cycle + within, .bytes = bus->bytes + n,
-				      .n = n };
+	*q->wait = (control_wait_t) { .until = q->c->avr->cycle + within,
+				      .bytes = bus->bytes + (uint32_t)n, .n = (uint32_t)n };
 	return 1;
 }
 
@@ -1094,22 +1094,36 @@ static void client_process(control_t *c, control_client_t *cl)
 	}
 }
 
+/* The bytes CL's `wait i2c` still waits for: 0 once they came, or for a
+ * wait for a cycle. The count wraps at 2^32; a wait spans far fewer. */
+static uint32_t client_bytes_due(const control_t *c, const control_client_t *cl)
+{
+	int32_t due;
+
+	if (!cl->wait.n) {
+		return 0;
+	}
+	due = (int32_t)(cl->wait.bytes - c->bus->bytes);
+	return due > 0 ? (uint32_t)due : 0;
+}
+
 /* Answer CL's wait if it is over: the cycle it ended at, or the error of a
  * `wait i2c` whose bound passed before its bytes came. */
 static void client_wait_over(control_t *c, control_client_t *cl)
 {
 	reply_t r = { &cl->out, &cl->out_len, &cl->out_cap };
-	const control_wait_t *w = &cl->wait;
+	uint32_t due = client_bytes_due(c, cl);
 	uint64_t now = c->avr->cycle;
-	int bytes_in = w->bytes && c->bus->bytes >= w->bytes;
 
-	if (!bytes_in && now < w->until) {
+	/* the bytes came: answered whatever the bound (the boards ran a
+	 * quantum at a time, sim_main.c) */
+	if ((!cl->wait.n || due) && now < cl->wait.until) {
 		return;
 	}
 	cl->waiting = 0;
-	if (w->bytes && !bytes_in) {
-		reply_printf(&r, "ERR wait i2c: %" PRIu64 " of %" PRIu64 " bytes by cycle %" PRIu64
-			     "\n", w->n - (w->bytes - c->bus->bytes), w->n, w->until);
+	if (due) {
+		reply_printf(&r, "ERR wait i2c: %" PRIu32 " of %" PRIu32 " bytes by cycle %" PRIu64
+			     "\n", cl->wait.n - due, cl->wait.n, cl->wait.until);
 		return;
 	}
 	reply_printf(&r, "%" PRIu64 "\n", now);
@@ -1209,18 +1223,19 @@ uint64_t control_deadline(const control_t *c)
 	return d;
 }
 
-uint64_t control_bytes_due(const control_t *c)
+uint32_t control_bytes_due(const control_t *c)
 {
-	uint64_t n = UINT64_MAX;
+	uint32_t fewest = 0;
 
 	for (int i = 0; i < CONTROL_CLIENTS; i++) {
 		const control_client_t *cl = &c->client[i];
+		uint32_t due = cl->fd >= 0 && cl->waiting ? client_bytes_due(c, cl) : 0;
 
-		if (cl->fd >= 0 && cl->waiting && cl->wait.bytes && cl->wait.bytes < n) {
-			n = cl->wait.bytes;
+		if (due && (!fewest || due < fewest)) {
+			fewest = due;
 		}
 	}
-	return n;
+	return fewest;
 }
 
 int control_pollfds(const control_t *c, struct pollfd *pfd, int max)

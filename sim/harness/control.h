@@ -25,8 +25,8 @@
  * count (`wait i2c N WITHIN`), with the cycle as its bound. */
 typedef struct control_wait_t {
 	uint64_t until;		/* the cycle it ends at, or the bound's */
-	uint64_t bytes;		/* twi_bus_t.bytes that ends it (0: a cycle's wait) */
-	uint64_t n;		/* the bytes waited for (the bound's error) */
+	uint32_t bytes;		/* twi_bus_t.bytes that ends it (modulo 2^32) */
+	uint32_t n;		/* the bytes waited for (0: a cycle's wait) */
 } control_wait_t;
 
 typedef struct control_client_t {
@@ -83,10 +83,9 @@ int control_waiting(const control_t *c);
  * `wait`'s, or a `wait i2c`'s bound. */
 uint64_t control_deadline(const control_t *c);
 
-/* The lowest count of the bus's bytes (twi_bus_t.bytes) a waiting client
- * wants (`wait i2c`), UINT64_MAX when none: the run should stop at the
- * quantum it is reached in. */
-uint64_t control_bytes_due(const control_t *c);
+/* The fewest bus bytes a client's `wait i2c` still waits for, 0 when none
+ * does: the run should stop after the quantum that many came in. */
+uint32_t control_bytes_due(const control_t *c);
 
 /* Add the socket's descriptors to PFD (room for MAX); returns how many. */
 int control_pollfds(const control_t *c, struct pollfd *pfd, int max);

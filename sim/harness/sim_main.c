@@ -167,14 +167,16 @@ static int sim_parse_addr(const char *s, uint8_t *out)
 }
 
 /* Run the world to TARGET, or stop after the quantum in which the bus's
- * byte count reaches BYTES (a control client's `wait i2c`): a quantum at a
- * time then, so that wait ends within a quantum of its byte; a run that no
- * client waits on bytes for goes on unchecked. As world_run(). */
-static int sim_run_to_bytes(world_t *w, uint64_t target, uint64_t bytes)
+ * master has clocked DUE more bytes (a control client's `wait i2c`): a
+ * quantum at a time then, so that wait ends within a quantum of its byte;
+ * a run that no client waits on bytes for goes on unchecked. As
+ * world_run(). */
+static int sim_run_to_bytes(world_t *w, uint64_t target, uint32_t due)
 {
+	uint32_t from = w->bus.bytes;
 	int rc = 0;
 
-	while (!rc && w->now < target && w->bus.bytes < bytes) {
+	while (!rc && w->now < target && w->bus.bytes - from < due) {
 		uint64_t end = w->now + WORLD_QUANTUM;
 
 		rc = world_run(w, end < target ? end : target);
@@ -189,14 +191,14 @@ static int sim_batch(sim_t *sim)
 	world_t *w = &sim->world;
 	uint64_t target = world_cycle(w) + SIM_BATCH_CYCLES;
 	uint64_t deadline = control_deadline(&sim->control);
-	uint64_t bytes = control_bytes_due(&sim->control);
+	uint32_t due = control_bytes_due(&sim->control);
 	int rc;
 
 	/* a control client's `wait` ends near its cycle, not a batch later */
 	if (deadline < target) {
 		target = deadline;
 	}
-	rc = bytes == UINT64_MAX ? world_run(w, target) : sim_run_to_bytes(w, target, bytes);
+	rc = due ? sim_run_to_bytes(w, target, due) : world_run(w, target);
 	pty_flush(&sim->pty);
 	sim_check_twar(sim);
 	vcd_flush(&sim->vcd, world_cycle(w), 0);
