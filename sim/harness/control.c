@@ -1115,8 +1115,9 @@ static void client_wait_over(control_t *c, control_client_t *cl)
 	uint32_t due = client_bytes_due(c, cl);
 	uint64_t now = c->avr->cycle;
 
-	/* the bytes came: answered whatever the bound (the boards ran a
-	 * quantum at a time, sim_main.c) */
+	/* a `wait i2c` whose bytes came is answered even at its bound: they
+	 * came in the quantum that reached it (sim_main.c runs a quantum at a
+	 * time while bytes are due) */
 	if ((!cl->wait.n || due) && now < cl->wait.until) {
 		return;
 	}

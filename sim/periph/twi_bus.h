@@ -131,9 +131,9 @@ typedef struct twi_bus_t {
 	uint32_t activity;	/* bumps on every bus event */
 	/* the bytes the masters have clocked (their addr, write and read
 	 * notes; `wait i2c` counts them), modulo 2^32. In the padding after
-	 * activity: a 64-bit count at the end made the struct, and so the
-	 * world's parked-board state after it, move, and make bench's
-	 * simulator speed measured 1-2 % lower. */
+	 * activity: as a 64-bit count at the end it grew the struct, moving
+	 * all that follows it in world_t, and make bench's simulator speed
+	 * measured 1-2 % lower (layout); here the speed is as before. */
 	uint32_t bytes;
 	uint64_t cycle;		/* cycle of the edge being told (the devices' time) */
 
