@@ -78,6 +78,15 @@ class SimControl(Closing):
         """Returns the cycle at which the wait ended (>= now + cycles)."""
         return int(self.request("wait %d" % cycles))
 
+    def wait_i2c(self, count: int, within: int) -> int:
+        """Let simulated time pass until the bus's master has clocked `count`
+        more bytes (the trace's `twi addr|write|read`); the cycle the wait
+        ended at, at most a quantum (4 cycles) and an instruction after the
+        last byte's end. SimControlError when `within` cycles pass first. In
+        a batch (requests), "wait i2c N WITHIN" has the requests behind it
+        act at that byte."""
+        return int(self.request("wait i2c %d %d" % (count, within)))
+
     # --- which board ----------------------------------------------------------
     #: A slave board's view (SimControl.slave) prefixes names with "10/" and
     #: puts "@10" first in requests that name no signal; names that already

@@ -25,7 +25,9 @@
 #define CONTROL_OUT_MAX (4u << 20)
 #define CONTROL_MEASURE_DEFAULT 50
 #define CONTROL_MAX_ARGS 8
-#define CONTROL_RX_AHEAD (1ull << 40)	/* cycles, as for `wait` */
+#define CONTROL_WAIT_MAX (1ull << 40)	/* cycles a `wait` may span */
+#define CONTROL_RX_AHEAD CONTROL_WAIT_MAX	/* cycles, as for `wait` */
+#define CONTROL_WAIT_BYTES 1000000	/* bytes a `wait i2c` may wait for */
 
 /* --- reply buffer ---------------------------------------------------------- */
 
@@ -356,10 +358,10 @@ typedef struct control_req_ctx_t {
 	reply_t *r;
 	int argc;
 	char **argv;
-	uint64_t *wait_until;
+	control_wait_t *wait;
 } control_req_ctx_t;
 
-/* A handler: 0 (answered), 1 (the reply waits for *wait_until), or
+/* A handler: 0 (answered), 1 (the reply waits for *wait), or
  * CONTROL_WRONG (the arguments fit none of its forms). */
 #define CONTROL_WRONG (-1)
 typedef int (*control_req_fn)(control_req_ctx_t *q);
@@ -371,15 +373,45 @@ static int req_time(control_req_ctx_t *q)
 	return 0;
 }
 
+/* `wait i2c N WITHIN`: until the master has clocked N more bytes (the
+ * trace's `twi addr|write|read`), so a request behind it acts at a byte on
+ * the bus however the firmware's timing drifts; never longer than WITHIN
+ * cycles (then an error: the bytes did not come). */
+static int req_wait_i2c(control_req_ctx_t *q)
+{
+	twi_bus_t *bus = q->c->bus;
+	uint64_t n, within;
+
+	if (strcasecmp(q->argv[1], "i2c")) {
+		return CONTROL_WRONG;
+	}
+	if (q->argc != 4 || parse_u64(q->argv[2], &n) < 0 || n < 1 || n > CONTROL_WAIT_BYTES ||
+	    parse_u64(q->argv[3], &within) < 0 || within < 1 || within > CONTROL_WAIT_MAX) {
+		reply_printf(q->r, "ERR wait i2c N WITHIN: N bytes 1..%u, WITHIN cycles 1..%" PRIu64
+			     ", decimal", (unsigned)CONTROL_WAIT_BYTES, (uint64_t)CONTROL_WAIT_MAX);
+		return 0;
+	}
+	if (!bus) {
+		reply_printf(q->r, "ERR wait i2c: no I2C bus");
+		return 0;
+	}
+	*q->wait = (control_wait_t) { .until = q->c->avr->cycle + within,
+				      .bytes = bus->bytes + (uint32_t)n, .n = (uint32_t)n };
+	return 1;
+}
+
 static int req_wait(control_req_ctx_t *q)
 {
 	uint64_t u;
 
-	if (parse_u64(q->argv[1], &u) < 0 || u > (1ull << 40)) {
+	if (!strcasecmp(q->argv[1], "i2c")) {
+		return req_wait_i2c(q);		/* `wait i2c` short of its arguments */
+	}
+	if (parse_u64(q->argv[1], &u) < 0 || u > CONTROL_WAIT_MAX) {
 		reply_printf(q->r, "ERR wait N: N cycles, decimal");
 		return 0;
 	}
-	*q->wait_until = q->c->avr->cycle + u;
+	*q->wait = (control_wait_t) { .until = q->c->avr->cycle + u };
 	return 1;
 }
 
@@ -786,7 +818,9 @@ enum {
 };
 
 /* The requests: name, arguments (the help line), the argument counts it
- * takes (the name included), which boards, the handler. */
+ * takes (the name included), which boards, the handler. The forms of one
+ * request (`wait N`, `wait i2c N WITHIN`) are entries of one name, next to
+ * each other: the argument count picks the form. */
 typedef struct control_req_t {
 	const char *name;
 	const char *args;
@@ -798,6 +832,7 @@ typedef struct control_req_t {
 static const control_req_t control_reqs[] = {
 	{ "time", "", 1, 1, CONTROL_ANY_BOARD, req_time },
 	{ "wait", "N", 2, 2, CONTROL_ANY_BOARD, req_wait },
+	{ "wait", "i2c N WITHIN", 3, 4, CONTROL_ANY_BOARD, req_wait_i2c },
 	{ "pin", "P", 2, 2, CONTROL_NAMES_BOARD, req_pin },
 	{ "drive", "P 0|1|z", 3, 3, CONTROL_NAMES_BOARD, req_pin },
 	{ "adc", "CH [MV]", 2, 3, CONTROL_NAMES_BOARD, req_adc },
@@ -822,6 +857,19 @@ static const control_req_t control_reqs[] = {
 };
 
 #define CONTROL_NREQS ((int)(sizeof(control_reqs) / sizeof(control_reqs[0])))
+
+/* The form of request E (its first entry) that takes ARGC arguments, or E
+ * when none does. */
+static const control_req_t *control_req_form(const control_req_t *e, int argc)
+{
+	for (const control_req_t *f = e; f < control_reqs + CONTROL_NREQS &&
+	     !strcasecmp(f->name, e->name); f++) {
+		if (argc >= f->min_argc && argc <= f->max_argc) {
+			return f;
+		}
+	}
+	return e;
+}
 
 static void control_help(reply_t *r)
 {
@@ -864,13 +912,13 @@ static const part_request_t *control_part_request(const char *name)
 }
 
 int control_request(control_t *c, const char *line, char **out, size_t *len,
-		    size_t *cap, uint64_t *wait_until)
+		    size_t *cap, control_wait_t *wait)
 {
 	reply_t r = { out, len, cap };
 	char buf[CONTROL_LINE];
 	char *argv[CONTROL_MAX_ARGS + 1], *save = NULL, *tok;
 	int argc = 0;
-	control_req_ctx_t q = { .c = c, .cb = &c->board[0], .r = &r, .wait_until = wait_until };
+	control_req_ctx_t q = { .c = c, .cb = &c->board[0], .r = &r, .wait = wait };
 	const control_req_t *e = NULL;
 	const part_request_t *pr;
 	int rc;
@@ -920,6 +968,9 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 	}
 	q.argc = argc;
 	q.argv = argv;
+	if (e) {
+		e = control_req_form(e, argc);
+	}
 	if (e && argc >= e->min_argc && argc <= e->max_argc) {
 		if (e->boards == CONTROL_GATEWAY && q.cb != &c->board[0]) {
 			reply_printf(&r, "ERR %s: only the gateway's serial line reaches the PC",
@@ -1033,7 +1084,7 @@ static void client_process(control_t *c, control_client_t *cl)
 			client_reply_end(cl);
 			cl->overlong = 0;
 		} else if (control_request(c, cl->in, &cl->out, &cl->out_len, &cl->out_cap,
-					   &cl->wait_until)) {
+					   &cl->wait)) {
 			cl->waiting = 1;
 		} else {
 			client_reply_end(cl);
@@ -1041,6 +1092,42 @@ static void client_process(control_t *c, control_client_t *cl)
 		memmove(cl->in, cl->in + used, cl->in_len - used);
 		cl->in_len -= used;
 	}
+}
+
+/* The bytes CL's `wait i2c` still waits for: 0 once they came, or for a
+ * wait for a cycle. The count wraps at 2^32; a wait spans far fewer. */
+static uint32_t client_bytes_due(const control_t *c, const control_client_t *cl)
+{
+	int32_t due;
+
+	if (!cl->wait.n) {
+		return 0;
+	}
+	due = (int32_t)(cl->wait.bytes - c->bus->bytes);
+	return due > 0 ? (uint32_t)due : 0;
+}
+
+/* Answer CL's wait if it is over: the cycle it ended at, or the error of a
+ * `wait i2c` whose bound passed before its bytes came. */
+static void client_wait_over(control_t *c, control_client_t *cl)
+{
+	reply_t r = { &cl->out, &cl->out_len, &cl->out_cap };
+	uint32_t due = client_bytes_due(c, cl);
+	uint64_t now = c->avr->cycle;
+
+	/* a `wait i2c` whose bytes came is answered even at its bound: they
+	 * came in the quantum that reached it (sim_main.c runs a quantum at a
+	 * time while bytes are due) */
+	if ((!cl->wait.n || due) && now < cl->wait.until) {
+		return;
+	}
+	cl->waiting = 0;
+	if (due) {
+		reply_printf(&r, "ERR wait i2c: %" PRIu32 " of %" PRIu32 " bytes by cycle %" PRIu64
+			     "\n", cl->wait.n - due, cl->wait.n, cl->wait.until);
+		return;
+	}
+	reply_printf(&r, "%" PRIu64 "\n", now);
 }
 
 void control_poll(control_t *c)
@@ -1079,11 +1166,8 @@ void control_poll(control_t *c)
 		if (cl->fd < 0) {
 			continue;
 		}
-		if (cl->waiting && c->avr->cycle >= cl->wait_until) {
-			reply_t r = { &cl->out, &cl->out_len, &cl->out_cap };
-
-			cl->waiting = 0;
-			reply_printf(&r, "%" PRIu64 "\n", (uint64_t)c->avr->cycle);
+		if (cl->waiting) {
+			client_wait_over(c, cl);
 		}
 		if (cl->in_len < sizeof(cl->in)) {
 			ssize_t n = read(cl->fd, cl->in + cl->in_len, sizeof(cl->in) - cl->in_len);
@@ -1133,11 +1217,26 @@ uint64_t control_deadline(const control_t *c)
 	for (int i = 0; i < CONTROL_CLIENTS; i++) {
 		const control_client_t *cl = &c->client[i];
 
-		if (cl->fd >= 0 && cl->waiting && cl->wait_until < d) {
-			d = cl->wait_until;
+		if (cl->fd >= 0 && cl->waiting && cl->wait.until < d) {
+			d = cl->wait.until;
 		}
 	}
 	return d;
+}
+
+uint32_t control_bytes_due(const control_t *c)
+{
+	uint32_t fewest = 0;
+
+	for (int i = 0; i < CONTROL_CLIENTS; i++) {
+		const control_client_t *cl = &c->client[i];
+		uint32_t due = cl->fd >= 0 && cl->waiting ? client_bytes_due(c, cl) : 0;
+
+		if (due && (!fewest || due < fewest)) {
+			fewest = due;
+		}
+	}
+	return fewest;
 }
 
 int control_pollfds(const control_t *c, struct pollfd *pfd, int max)

@@ -21,6 +21,14 @@
 #define CONTROL_CLIENTS 8
 #define CONTROL_LINE 1024
 
+/* What a client's reply waits for: a cycle (`wait N`), or the bus's byte
+ * count (`wait i2c N WITHIN`), with the cycle as its bound. */
+typedef struct control_wait_t {
+	uint64_t until;		/* the cycle it ends at, or the bound's */
+	uint32_t bytes;		/* twi_bus_t.bytes that ends it (modulo 2^32) */
+	uint32_t n;		/* the bytes waited for (0: a cycle's wait) */
+} control_wait_t;
+
 typedef struct control_client_t {
 	int fd;				/* -1: free */
 	char in[CONTROL_LINE];
@@ -29,7 +37,7 @@ typedef struct control_client_t {
 	char *out;
 	size_t out_len, out_cap;
 	int waiting;
-	uint64_t wait_until;
+	control_wait_t wait;
 } control_client_t;
 
 #define CONTROL_MAX_BOARDS 16
@@ -68,11 +76,16 @@ int control_add_board(control_t *c, uint8_t addr, avr_t *avr, board_model_t *bm)
 /* Accept, read, answer, send: never blocks. */
 void control_poll(control_t *c);
 
-/* True while some client waits for simulated time. */
+/* True while some client waits for simulated time or bus bytes. */
 int control_waiting(const control_t *c);
 
-/* The earliest cycle a waiting client wants (UINT64_MAX when none). */
+/* The earliest cycle a waiting client wants (UINT64_MAX when none): a
+ * `wait`'s, or a `wait i2c`'s bound. */
 uint64_t control_deadline(const control_t *c);
+
+/* The fewest bus bytes a client's `wait i2c` still waits for, 0 when none
+ * does: the run should stop after the quantum that many came in. */
+uint32_t control_bytes_due(const control_t *c);
 
 /* Add the socket's descriptors to PFD (room for MAX); returns how many. */
 int control_pollfds(const control_t *c, struct pollfd *pfd, int max);
@@ -80,8 +93,8 @@ int control_pollfds(const control_t *c, struct pollfd *pfd, int max);
 void control_close(control_t *c);
 
 /* Answer one request LINE into OUT (no newline); exposed for tests. Returns
- * 1 when the reply must wait until *WAIT_UNTIL. */
+ * 1 when the reply must wait for *WAIT. */
 int control_request(control_t *c, const char *line, char **out, size_t *len,
-		    size_t *cap, uint64_t *wait_until);
+		    size_t *cap, control_wait_t *wait);
 
 #endif

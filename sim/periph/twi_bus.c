@@ -205,11 +205,12 @@ void twi_bus_note_start(twi_bus_t *bus, uint64_t cycle)
 	}
 }
 
-/* One byte's trace line; the fault counts it. */
+/* One byte's trace line; the bus and the fault count it. */
 static void twi_bus_note_byte(twi_bus_t *bus, uint64_t cycle, const char *what, uint8_t byte,
 			      int ack)
 {
 	bus->activity++;
+	bus->bytes++;
 	trace_event(bus->trace, cycle, "twi %s %02X %s", what, byte, ack ? "ack" : "nack");
 	twi_fault_byte_done(&bus->fault);
 }

@@ -9,14 +9,14 @@ resets there. The next request comes right after, to the same slave or to the
 other one. Nothing of the cut write is applied (registers read back, and the
 servo pins stay quiet), the slave's status register says `09` once data had
 arrived, the bus is idle afterwards, and the next request is served as itself.
-Every cycle of a cut is relative to the cycle the simulator takes the batch at
-(`rx +N`, `wait`), so the cut lands at the same byte however late the wall
-clock delivers the batch."""
+A cut follows the bus, not the clock: the batch waits for its byte to end
+(`wait i2c`) and cuts a fixed number of cycles after it, so it lands in the
+same byte however late the wall clock delivers the batch and wherever the
+gateway's main loop and clock interrupt were when the request came."""
 
 import pytest
 
-from conftest import (DRV_LAYOUT, F_CPU, REPLY_TIMEOUT, require_builds, require_slave,
-                      running)
+from conftest import DRV_LAYOUT, F_CPU, require_builds, require_slave, running
 from orfa.sim import BOARDS, SimBoard
 
 M128S, M32D = 0x10, 0x12
@@ -24,6 +24,15 @@ SLAVES = {M128S: "m128s", M32D: "m32d"}
 OK, DROPPED = 0x00, 0x09
 MS = F_CPU // 1000
 LEAD = 2000                      # cycles from the batch to the request's first bit
+REACH = 200000                   # the write's bytes are on the bus by then (cycles)
+#: Cycles from the end of a byte (its acknowledge's SCL falling edge) to the
+#: cut in the middle of the next one: that begins 40..190 cycles later (the
+#: slave's stretch, the gateway's reaction, over 1600 random phases; seen
+#: later than MID in a few of some 5000 cuts: those fell between the two
+#: bytes, which leaves the slave the same bytes) and takes 9 SCL periods
+#: (666 cycles at 100 kHz). After the last byte the cut is at once: the slave
+#: still holds SCL after its acknowledge, the STOP comes 190 cycles later.
+MID = 400
 HOLD = 100000                    # SCL held this long: more than the gateway waits (9.7 ms)
 AFTER = 30000                    # then the next request comes this soon
 
@@ -36,7 +45,6 @@ def robot(request):
     sim = SimBoard(gateway, trace=True, control=True, slaves=slaves)
     sim.expect_resets = True     # the gateway is reset on purpose below
     with running(sim) as b:
-        b.timings = {}
         yield b
 
 
@@ -91,37 +99,20 @@ def applied_nothing(b, addr, since):
     assert b.sim.control.slave(a).edges(pin, since) == []
 
 
-def byte_times(b, kind, addr):
-    """Cycles from the request's first start bit to the address byte and to
-    each data byte of the write on the bus, from one run that is not cut
-    (then undone): the gateway's timing does not depend on what follows."""
-    key = (kind, addr)
-    if key not in b.timings:
-        text = write_of(kind, addr)
-        n = (len(text) - 4) // 2                 # bytes after the address
-        req = (text + "\r").encode()
-        ctl = b.sim.control
-        mark = b.mark()
-        end = int(ctl.requests(["rx +%d %s" % (LEAD, req.hex().upper())])[0])
-        first = end - 10 * ctl.line()["bit"] * len(req)
-        assert b.read_lines(1) == b"SW" + b"A" * n + b"P\r\n"
-        ev = [e for e in b.events(mark, ["twi"]) if e.kind in ("twi addr", "twi write")]
-        assert ev[0].kind == "twi addr" and len(ev) == 1 + n, ev
-        b.timings[key] = [e.cycle - first for e in ev]
-        clear(b, addr)
-    return b.timings[key]
+def bytes_of(kind, addr):
+    """The write's bytes on the bus, its address included."""
+    return 1 + (len(write_of(kind, addr)) - 4) // 2
 
 
 def cut_batch(b, kind, addr, after, fault):
-    """The write on the serial line and, `after` bytes of it on the bus (the
-    address counts), the fault: SCL held, or the gateway reset. The batch's
-    requests up to the fault; the cycle the write began at."""
+    """The write on the serial line and, `after` bytes of it on the bus
+    after its address, the fault: SCL held, or the gateway reset. The
+    batch's requests up to the fault (its fourth reply: the fault's cycle);
+    its first reply is the cycle the write began at."""
     req = (write_of(kind, addr) + "\r").encode()
-    t = byte_times(b, kind, addr)
-    # in the middle of the next byte; after the last one, before the STOP
-    # (the slave still holds SCL after that byte's acknowledge then)
-    at = LEAD + t[after] + ((t[1] - t[0]) // 2 if after < len(t) - 1 else 10)
-    lines = ["time", "rx +%d %s" % (LEAD, req.hex().upper()), "wait %d" % at]
+    last = after + 1 == bytes_of(kind, addr)
+    lines = ["time", "rx +%d %s" % (LEAD, req.hex().upper()),
+             "wait i2c %d %d" % (after + 1, REACH), "wait %d" % (0 if last else MID)]
     if fault == "hold":
         lines += ["i2c hold-scl on", "wait %d" % HOLD, "i2c hold-scl off"]
     else:
@@ -129,8 +120,23 @@ def cut_batch(b, kind, addr, after, fault):
     return lines
 
 
-#: after how many bytes on the bus (the address counts) the write is cut: in
-#: the register byte, in data, in the last byte, before the STOP
+def assert_landed(b, kind, addr, after, out):
+    """The cut of cut_batch (replies OUT) came where it was meant: after the
+    byte `wait i2c` waited for and before the next one ended (SCL fell
+    fewer than 9 times since); or after the last one, before the STOP (the
+    bus busy from the write's START on)."""
+    ctl = b.sim.control
+    began, waited, cut = int(out[0]), int(out[2]), int(out[3])
+    if after + 1 == bytes_of(kind, addr):
+        busy = [level for c, level in ctl.edges("i2c", began) if c <= cut]
+        assert busy == [1], (began, cut, busy)
+        return
+    falls = [c for c, level in ctl.edges("scl", waited + 1) if not level and c <= cut]
+    assert len(falls) < 9, (waited, cut, falls)
+
+
+#: after how many of its bytes after the address the write is cut: in the
+#: register byte, in data, in the last byte, before the STOP
 CUTS = {"servo": [0, 1, 4, 25, 48, 49], "gpio": [0, 1, 2, 3]}
 CASES = [(kind, after) for kind in CUTS for after in CUTS[kind]]
 
@@ -145,6 +151,7 @@ def test_cut_write_applies_nothing_next_to_same(rb, victim, kind, after, fault):
     nxt = b"S%02X01S%02X01P\r" % (victim, victim | 1)   # the status, first of all
     out = ctl.requests(lines + ["wait %d" % AFTER, "rx +10 %s" % nxt.hex().upper()])
     began = int(out[0])
+    assert_landed(b, kind, victim, after, out)
     want_status = DROPPED if after >= 2 else OK     # data had arrived (the register byte is not)
     got = b.read_lines(2 if fault == "hold" else 1)
     if fault == "hold":
@@ -170,6 +177,7 @@ def test_cut_write_applies_nothing_next_to_other(rb, victim, kind, after, fault)
     nxt = b"S%02X%02X0105DCP\r" % (other, sp(other))       # channel 1 at 1500 us
     out = ctl.requests(lines + ["wait %d" % AFTER, "rx +10 %s" % nxt.hex().upper()])
     began = int(out[0])
+    assert_landed(b, kind, victim, after, out)
     got = b.read_lines(2 if fault == "hold" else 1)
     assert got == (b"ERROR 07\r\n" if fault == "hold" else b"") + b"SWAAAAP\r\n", got
     assert status(b, victim) == (DROPPED if after >= 2 else OK)
