@@ -79,7 +79,7 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 			servo_hw_claim(ch);
 		}
 	}
-	servo_hw_apply(next);
+	servo_hw_apply(next, servo.width);
 	for (uint8_t i = 0; i < len; i += 3) {
 		uint8_t ch = data[i];
 		if (!next[ch] && servo.width[ch]) {

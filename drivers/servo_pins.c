@@ -280,7 +280,7 @@ void servo_hw_release(uint8_t ch)
 	pins_release(board_pin(BF_SERVO, ch), PIN_SERVO);
 }
 
-void servo_hw_apply(const uint16_t *widths_us)
+void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
 {
 	uint8_t newer;
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
@@ -290,7 +290,7 @@ void servo_hw_apply(const uint16_t *widths_us)
 	}
 	/* The last plan: the buffer not taken over yet, else the running one. */
 	servo_sched_t *s = &pulses.sched[pulses.active ^ 1];
-	servo_plan(s, newer ? s : &pulses.sched[pulses.active], widths_us);
+	servo_plan(s, newer ? s : &pulses.sched[pulses.active], widths_us, was_us);
 	uint8_t n = s->n;
 
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {

@@ -3,12 +3,17 @@
  *
  * A write changes a few widths, so the plan is changed, not made afresh:
  * the channels that keep their width keep their place and their order in
- * the last schedule; the changed channels are placed among them one after
- * the other and put into the order. Placing looks at the edges in time
- * order from where a binary search finds the pulse's ends, and skips past
- * every edge in the way at once, instead of trying one place after the
- * other. The schedule holds each edge's cycle in the frame, so nothing
- * needs adding up.
+ * the last schedule; the changed channels are placed one after the other
+ * and put into the order where a binary search finds their edges' places.
+ * A channel can only come near the edges of the three channels either side
+ * of it (a pulse is at most 2.25 slots long and moves at most 3072
+ * cycles), so placing one looks at those few edges alone, from the
+ * channels' places, not the schedule: each edge near enough to matter rules
+ * out a range of moves, and the nearest move outside all of them is found
+ * by skipping past each range in the way. Distances are cycles modulo 2^16
+ * (16-bit sums: the ones that matter are under 3472, the others never come
+ * within 2^16 - 3472 of 0). The schedule holds each edge's cycle in the
+ * frame, so nothing needs adding up.
  */
 #include "drivers/servo_plan.h"
 
@@ -23,9 +28,23 @@ _Static_assert(SERVO_FRAME <= 0x40000UL, "a cycle in the frame fits 18 bits (SER
 _Static_assert(SERVO_CHANNELS <= SERVO_CHAN + 1, "a channel fits the edge code");
 _Static_assert(SERVO_SLOT >= SERVO_SHIFT * SERVO_MOVES, "only channel 0 can move before the frame");
 
+/* The most a channel moves, cycles, and the distance from its ends (at
+ * move 0) within which another edge can be in its way. */
+#define SERVO_REACH ((int16_t)(SERVO_SHIFT * SERVO_MOVES))
+#define SERVO_NEAR_ENOUGH (SERVO_REACH + SERVO_GAP)
+/* The longest pulse (2500 us) in cycles: only channels NEIGHBOURS either
+ * side can come near. */
+#define SERVO_LONGEST 18432UL
+#define SERVO_NEIGHBOURS 3
+_Static_assert(SERVO_SLOT - SERVO_REACH >= SERVO_NEAR_ENOUGH, "two rises are never near");
+_Static_assert(SERVO_SLOT * (SERVO_NEIGHBOURS + 1) > SERVO_LONGEST + 2UL * SERVO_NEAR_ENOUGH,
+	       "a channel NEIGHBOURS + 1 away is never in the way");
+_Static_assert(SERVO_SLOT * (SERVO_NEIGHBOURS + 1) + SERVO_LONGEST + 2UL * SERVO_REACH
+	       < 65536UL - SERVO_NEAR_ENOUGH, "16-bit distances to the neighbours are exact");
+
 static struct {
 	int8_t move[SERVO_CHANNELS];     /* each channel's place: SERVO_SHIFTs off its slot */
-	uint16_t us[SERVO_CHANNELS];     /* width as last planned; 0 = off */
+	uint16_t w[SERVO_CHANNELS];      /* width in cycles as last planned; 0 = off */
 } placed;
 
 /* Frame offset of each channel's pulse start. */
@@ -79,96 +98,85 @@ static uint8_t servo_count(const servo_edge_t *e, uint8_t n, int32_t t)
 	return (uint8_t)(lo - e);
 }
 
-/* How far the next edge of e[0..n) from *i on in direction `dir` (1:
- * later, -1: earlier) is in the way of a pulse end at cycle `end`: 0 if it
- * keeps SERVO_GAP, else the cycles the end has to go on to keep it. Edges
- * behind the end by SERVO_GAP or more are passed for good (*i moves on).
- * *i: the next edge's index (dir 1), one more than that (dir -1). */
-static int16_t servo_in_way(const servo_edge_t *e, uint8_t n, uint8_t *i, int32_t end, int8_t dir)
+/* The least move in cycles from 0 on (a whole number of SERVO_SHIFTs) that
+ * keeps SERVO_GAP from every edge d[0..n) (each edge's distance from the
+ * pulse's end it is compared with, at move 0); more than SERVO_REACH if
+ * there is none. An edge in the way pushes the move just past it; the
+ * edges are looked at in turn until n in a row are clear. */
+static int16_t servo_clear(const int16_t *d, uint8_t n)
 {
-	for (;;) {
-		if (dir > 0 ? *i >= n : !*i) {
-			return 0;
-		}
-		const servo_edge_t *x = e + (dir > 0 ? *i : *i - 1);
-		int32_t d = (int32_t)servo_cycle(x) - end;
-		if (dir < 0) {
-			d = -d;
-		}
-		if (d > -SERVO_GAP) {
-			return d < SERVO_GAP ? (int16_t)(d + SERVO_GAP) : 0;
-		}
-		*i = (uint8_t)(*i + dir);
-	}
-}
-
-/* The first move from 0 on in direction `dir` (its size; > SERVO_MOVES
- * if there is none) at which a pulse whose rise and fall are at b[0] and
- * b[1] at move 0 keeps SERVO_GAP from the edges e[0..n); each end starts
- * at at[] (see servo_in_way) and ends where it stopped: with the move
- * found, how many edges come before that end. An edge in the way of one end
- * pushes the move just past it; then that end looks again, and the other.
- * Edges passed stay passed, so each end looks at each edge once. */
-static int16_t servo_free(const servo_edge_t *e, uint8_t n, const int32_t *b, uint8_t *at,
-			  int8_t dir)
-{
-	int16_t m = 0;
-	uint8_t k = 0, clear = 0;  /* ends found clear at this move */
-	while (clear < 2 && m <= SERVO_MOVES) {
-		int16_t in = servo_in_way(e, n, &at[k], b[k] + dir * (int16_t)(m * SERVO_SHIFT), dir);
-		if (in) {
-			m = (int16_t)(m + (uint16_t)(in + SERVO_SHIFT - 1) / SERVO_SHIFT);
-			clear = 0;
+	int16_t t = 0;
+	uint8_t i = 0, ok = 0;
+	while (ok < n && t <= SERVO_REACH) {
+		int16_t x = d[i];
+		if (x - SERVO_GAP < t && t < x + SERVO_GAP) {
+			t = (int16_t)((x + SERVO_GAP + SERVO_SHIFT - 1) & -SERVO_SHIFT);
+			ok = 0;
 		} else {
-			clear++;
-			k ^= 1;
+			ok++;
+		}
+		if (++i == n) {
+			i = 0;
 		}
 	}
-	return m;
+	return t;
 }
 
-/* Channel ch (its width w changed, not 0) at the nearest place clear of the
- * edges e[0..n): 0, -1, +1, -2, ... SERVO_SHIFTs from its slot, never
- * before the frame's start; where none is clear, it stays where it was (and
- * the interrupt makes its edges as near their cycles as it can). Returns
- * its rise's cycle; at[0] and at[1]: how many edges come before its rise
- * and before its fall. */
-static __attribute__((noinline)) uint32_t servo_move(const servo_edge_t *e, uint8_t n, uint8_t ch,
-						     uint16_t w, uint8_t *at)
+/* Channel ch (its width changed, not 0) at the nearest place clear of the
+ * channels placed (changed[] those still to place): 0, -1, +1, -2, ...
+ * SERVO_SHIFTs from its slot, never before the frame's start; where none
+ * is clear, it stays where it was (and the interrupt makes its edges as
+ * near their cycles as it can). */
+/* Adds distance x to the edges at `end` if it is near enough to matter. */
+static inline int16_t *servo_near(int16_t *end, uint16_t x)
 {
-	int32_t b[2] = { (int32_t)slot_start[ch], (int32_t)slot_start[ch] + w };
-	/* Where each end starts looking at move 0: later from the first edge
-	 * not SERVO_GAP before it (at[]), earlier from the last edge not
-	 * SERVO_GAP after it (down[], one more). */
-	uint8_t down[2];
-	for (uint8_t k = 0; k < 2; k++) {
-		uint8_t i = servo_count(e, n, b[k] - SERVO_GAP);
-		at[k] = i;
-		while (i < n && (int32_t)servo_cycle(e + i) < b[k] + SERVO_GAP) {
-			i++;
+	if ((int16_t)x > -SERVO_NEAR_ENOUGH && (int16_t)x < SERVO_NEAR_ENOUGH) {
+		*end++ = (int16_t)x;
+	}
+	return end;
+}
+
+static __attribute__((noinline)) void servo_place(uint8_t ch, const uint8_t *changed)
+{
+	/* Each neighbour's edges as distances from this channel's rise at
+	 * move 0; of those, a channel before it can only come near its rise
+	 * and fall with its own fall, one after with its rise and fall, each
+	 * only near this channel's fall (rises are SERVO_SLOT apart, a pulse
+	 * is at least 500 us). */
+	int16_t d[2 * 2 * SERVO_NEIGHBOURS], *end = d;
+	uint16_t w = placed.w[ch];
+	for (int8_t k = -SERVO_NEIGHBOURS; k <= SERVO_NEIGHBOURS; k++) {
+		uint8_t c = (uint8_t)(ch + k);
+		if (!k || c >= SERVO_CHANNELS) {
+			continue;
 		}
-		down[k] = i;
+		uint16_t cw = placed.w[c];
+		if (!cw || (k > 0 && changed[c])) {
+			continue;
+		}
+		uint16_t x = (uint16_t)(k * (int16_t)SERVO_SLOT + placed.move[c] * SERVO_SHIFT);
+		uint16_t y = (uint16_t)(x + cw);
+		end = servo_near(end, (uint16_t)(y - w));
+		end = servo_near(end, k < 0 ? y : (uint16_t)(x - w));
 	}
-	int16_t m = servo_free(e, n, b, at, 1);
-	if (m && ch) {
-		int16_t earlier = servo_free(e, n, b, down, -1);
-		if (earlier <= m) {
-			m = (int16_t)-earlier;
-			at[0] = down[0];
-			at[1] = down[1];
+	uint8_t n = (uint8_t)(end - d);
+	if (!n) {
+		placed.move[ch] = 0;  /* nothing near: its slot */
+		return;
+	}
+	int16_t t = servo_clear(d, n);
+	if (t && ch) {
+		for (uint8_t i = 0; i < n; i++) {
+			d[i] = (int16_t)-d[i];
+		}
+		int16_t earlier = servo_clear(d, n);
+		if (earlier <= t) {
+			t = (int16_t)-earlier;
 		}
 	}
-	uint32_t r = slot_start[ch];
-	if (m >= -SERVO_MOVES && m <= SERVO_MOVES) {
-		placed.move[ch] = (int8_t)m;
-		r += (int16_t)(m * SERVO_SHIFT);
-	} else {
-		/* No clear place: where it was, among edges it may be near. */
-		r += (int16_t)(placed.move[ch] * SERVO_SHIFT);
-		at[0] = servo_count(e, n, (int32_t)r);
-		at[1] = servo_count(e, n, (int32_t)(r + w));
+	if (t >= -SERVO_REACH && t <= SERVO_REACH) {
+		placed.move[ch] = (int8_t)(t / SERVO_SHIFT);
 	}
-	return r;
 }
 
 /* Copies the edges from[0..n) whose channel has not changed to `to`
@@ -192,34 +200,37 @@ static __attribute__((noinline)) servo_edge_t *servo_keep(servo_edge_t *to, cons
 	return to;
 }
 
-void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us)
+__attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us,
+		const uint16_t *was_us)
 {
 	uint8_t changed[SERVO_CHANNELS];
+	uint16_t *w = placed.w;
 
-	const uint16_t *now = widths_us;
-	uint16_t *was = placed.us;
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, now++, was++) {
-		changed[ch] = *now != *was;
-		*was = *now;
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, w++) {
+		uint16_t us = widths_us[ch];
+		changed[ch] = us != was_us[ch];
+		if (changed[ch]) {
+			*w = us ? servo_cycles(us) : 0;
+		}
 	}
 	/* The others stay where they were, in their order. */
 	servo_edge_t *e = s->edge;
 	uint8_t n = (uint8_t)(servo_keep(e, last->edge, last->n, changed) - e);
-	/* The changed channels in channel order, each placed among the edges
-	 * now in s, then into the order: the edges after its fall move up two
-	 * places, those between its edges one. */
+	/* The changed channels in channel order, each placed clear of those
+	 * placed before it, then into the order: the edges after its fall
+	 * move up two places, those between its edges one. */
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		if (!changed[ch] || !placed.us[ch]) {
+		uint16_t cw = placed.w[ch];
+		if (!changed[ch] || !cw) {
 			continue;
 		}
-		uint16_t w = servo_cycles(placed.us[ch]);
-		uint8_t at[2];
-		uint32_t r = servo_move(e, n, ch, w, at);
-		uint8_t i = at[0], j = at[1];
+		servo_place(ch, changed);
+		uint32_t r = slot_start[ch] + (int16_t)(placed.move[ch] * SERVO_SHIFT);
+		uint8_t i = servo_count(e, n, r), j = servo_count(e, n, r + cw);
 		memmove(e + j + 2, e + j, (n - j) * sizeof *e);
 		memmove(e + i + 1, e + i, (j - i) * sizeof *e);
 		e[i] = servo_edge(ch, r);
-		e[j + 1] = servo_edge((uint8_t)(ch | SERVO_FALL), r + w);
+		e[j + 1] = servo_edge((uint8_t)(ch | SERVO_FALL), r + cw);
 		n = (uint8_t)(n + 2);
 	}
 	s->n = n;
