@@ -4,7 +4,7 @@
  * A write changes a few widths, so the plan is changed, not made afresh:
  * the channels that keep their width keep their place and their order in
  * the last schedule; the changed channels are placed one after the other
- * and put into the order where a binary search finds their edges' places.
+ * and their edges put into the order.
  * A channel can only come near the edges of the three channels either side
  * of it (a pulse is at most 2.25 slots long and moves at most 3072
  * cycles), so placing one looks at those few edges alone, from the
@@ -47,15 +47,6 @@ static struct {
 	uint16_t w[SERVO_CHANNELS];      /* width in cycles as last planned; 0 = off */
 } placed;
 
-/* Frame offset of each channel's pulse start. */
-static const ORFA_FLASH uint32_t slot_start[SERVO_CHANNELS] = {
-#define S(n) SERVO_SLOT * (n)
-	S(0), S(1), S(2), S(3), S(4), S(5), S(6), S(7),
-	S(8), S(9), S(10), S(11), S(12), S(13), S(14), S(15),
-#undef S
-};
-_Static_assert(SERVO_CHANNELS == 16, "slot_start lists 16 channels");
-
 /* Cycles for a width in microseconds, rounded to the nearest: us * 7.3728
  * as a 16.16 fixed-point product (a division took 600 cycles a channel). */
 #define SERVO_CYCLES_PER_US_Q16 ((uint32_t)((F_CPU * 65536ULL + 500000ULL) / 1000000ULL))
@@ -64,38 +55,6 @@ static uint16_t servo_cycles(uint16_t us)
 	/* The whole cycles apart: a 16 x 16-bit product is all that is left. */
 	return (uint16_t)(us * (uint16_t)(SERVO_CYCLES_PER_US_Q16 >> 16)
 			  + (((uint32_t)us * (uint16_t)SERVO_CYCLES_PER_US_Q16 + 32768UL) >> 16));
-}
-
-/* Edge `code` at cycle t. */
-static servo_edge_t servo_edge(uint8_t code, uint32_t t)
-{
-	servo_edge_t e = { (uint8_t)(code | (uint8_t)((uint8_t)(t >> 16) << 4)), (uint16_t)t };
-	return e;
-}
-
-/* How many of the edges e[0..n) are at cycle t or before (a binary
- * search). */
-static uint8_t servo_count(const servo_edge_t *e, uint8_t n, int32_t t)
-{
-	if (t < 0) {
-		return 0;
-	}
-	/* Bits 16-17 and 0-15 apart: byte and word compares. */
-	uint8_t th = (uint8_t)((uint32_t)t >> 16);
-	uint16_t tl = (uint16_t)t;
-	const servo_edge_t *lo = e;
-	while (n) {
-		uint8_t half = n >> 1;
-		const servo_edge_t *mid = lo + half;
-		uint8_t h = (uint8_t)(mid->code >> 4) & 3;
-		if (h < th || (h == th && mid->at <= tl)) {
-			lo = mid + 1;
-			n = (uint8_t)(n - half - 1);
-		} else {
-			n = half;
-		}
-	}
-	return (uint8_t)(lo - e);
 }
 
 /* The least move in cycles from 0 on (a whole number of SERVO_SHIFTs) that
@@ -179,29 +138,61 @@ static __attribute__((noinline)) void servo_place(uint8_t ch, const uint8_t *cha
 	}
 }
 
-/* Copies the edges from[0..n) whose channel has not changed to `to`
- * (which may be `from`: it never gets ahead; the edges before the first
- * one left out then stay as they are); returns where the copy ends. */
-static __attribute__((noinline)) servo_edge_t *servo_keep(servo_edge_t *to, const servo_edge_t *from,
-							  uint8_t n, const uint8_t *changed)
+/* Edge `code` at cycle t put in the place of the edge at p, then moved
+ * into the order of the edges first..end (all in order but for p): those
+ * it passes move a place towards where it was (it goes after one at the
+ * same cycle). An edge moves little where it changes little; one put at
+ * the end goes back past a few falls where the channels come in order (a
+ * rise comes after the rises before it, a fall before those after it). */
+static __attribute__((noinline)) servo_edge_t *servo_put(servo_edge_t *first, servo_edge_t *end,
+							 servo_edge_t *p, uint8_t code, uint32_t t)
 {
-	if (to == from) {
-		while (n && !changed[to->code & SERVO_CHAN]) {
-			n--;
-			to++;
+	uint8_t hi = (uint8_t)((uint8_t)(t >> 16) << 4);
+	uint16_t at = (uint16_t)t;
+	while (p != first) {
+		servo_edge_t *q = p - 1;
+		uint8_t qh = q->code & SERVO_HI;
+		if (qh < hi || (qh == hi && q->at <= at)) {
+			break;
 		}
-		from = to;
+		*p = *q;
+		p = q;
 	}
-	for (; n; n--, from++) {
-		if (!changed[from->code & SERVO_CHAN]) {
-			*to++ = *from;
+	while (p + 1 != end) {
+		servo_edge_t *q = p + 1;
+		uint8_t qh = q->code & SERVO_HI;
+		if (qh > hi || (qh == hi && q->at > at)) {
+			break;
 		}
+		*p = *q;
+		p = q;
 	}
-	return to;
+	p->code = (uint8_t)(code | hi);
+	p->at = at;
+	return p;
 }
 
-__attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us,
-		const uint16_t *was_us)
+/* The first edge of p..end with code `code` (cycle bits aside); end if
+ * none. */
+static __attribute__((noinline)) servo_edge_t *servo_find(servo_edge_t *p, const servo_edge_t *end, uint8_t code)
+{
+	while (p != end && (p->code & (uint8_t)~SERVO_HI) != code) {
+		p++;
+	}
+	return p;
+}
+
+/* Takes the edge at p out of first..end; returns the new end. */
+static __attribute__((noinline)) servo_edge_t *servo_drop(servo_edge_t *p, servo_edge_t *end)
+{
+	for (end--; p != end; p++) {
+		*p = p[1];
+	}
+	return end;
+}
+
+__attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t *last,
+					  const uint16_t *widths_us, const uint16_t *was_us)
 {
 	uint8_t changed[SERVO_CHANNELS];
 	uint16_t *w = placed.w;
@@ -213,25 +204,48 @@ __attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t 
 			*w = us ? servo_cycles(us) : 0;
 		}
 	}
-	/* The others stay where they were, in their order. */
-	servo_edge_t *e = s->edge;
-	uint8_t n = (uint8_t)(servo_keep(e, last->edge, last->n, changed) - e);
-	/* The changed channels in channel order, each placed clear of those
-	 * placed before it, then into the order: the edges after its fall
-	 * move up two places, those between its edges one. */
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
+	/* The last schedule, then each changed channel in channel order: placed
+	 * clear of those placed before it, its edges moved to their new cycles
+	 * (or taken out, or put in). The order holds throughout: an edge not
+	 * moved yet is still at its last cycle. The rises stay in channel
+	 * order, so a channel's rise is after the one changed before it. */
+	servo_edge_t *first = s->edge, *end = first + last->n;
+	if (last != s) {
+		memcpy(first, last->edge, (size_t)last->n * sizeof *first);
+	}
+	servo_edge_t *from = first;  /* no changed channel's rise before this */
+	uint32_t slot = 0;           /* the channel's slot start */
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, slot += SERVO_SLOT) {
+		if (!changed[ch]) {
+			continue;
+		}
 		uint16_t cw = placed.w[ch];
-		if (!changed[ch] || !cw) {
+		/* Its fall is after its rise, and stays so however the rise moves
+		 * (the edges it passes move towards where it was). */
+		servo_edge_t *rise = servo_find(from, end, ch);
+		if (rise != end && !cw) {
+			end = servo_drop(rise, end);
+			end = servo_drop(servo_find(rise, end, (uint8_t)(ch | SERVO_FALL)), end);
+			from = rise;
+			continue;
+		}
+		if (!cw) {
 			continue;
 		}
 		servo_place(ch, changed);
-		uint32_t r = slot_start[ch] + (int16_t)(placed.move[ch] * SERVO_SHIFT);
-		uint8_t i = servo_count(e, n, r), j = servo_count(e, n, r + cw);
-		memmove(e + j + 2, e + j, (n - j) * sizeof *e);
-		memmove(e + i + 1, e + i, (j - i) * sizeof *e);
-		e[i] = servo_edge(ch, r);
-		e[j + 1] = servo_edge((uint8_t)(ch | SERVO_FALL), r + cw);
-		n = (uint8_t)(n + 2);
+		uint32_t r = slot + (int16_t)(placed.move[ch] * SERVO_SHIFT);
+		servo_edge_t *fall;
+		if (rise == end) {
+			/* It starts: both edges put in at the end. */
+			rise = servo_put(first, ++end, rise, ch, r);
+			fall = end++;
+		} else {
+			servo_edge_t *was = rise;
+			rise = servo_put(first, end, rise, ch, r);
+			fall = servo_find(was < rise ? was : rise, end, (uint8_t)(ch | SERVO_FALL));
+		}
+		servo_put(first, end, fall, (uint8_t)(ch | SERVO_FALL), r + cw);
+		from = rise + 1;
 	}
-	s->n = n;
+	s->n = (uint8_t)(end - first);
 }
