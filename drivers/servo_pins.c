@@ -154,18 +154,22 @@ static bool servo_arm(void)
  * the next edge is SERVO_FAR away, BOARD_RX_BURST characters when it is
  * SERVO_NEAR away, nothing closer (the caller then waits for the edge in
  * place, holding). */
-static void servo_rx_release(int16_t left)
+static void servo_rx_release(void)
 {
+	int16_t left = servo_ticks_left();
+
 	if (left > SERVO_NEAR / 8) {
 		front_rx_poll(left > SERVO_FAR / 8 ? FRONT_HOLD_ALL : BOARD_RX_BURST);
 	}
 }
 
-/* The wake-up's work: each edge at its cycle, as long as the next one is
- * too close to come back for. */
-static __attribute__((noinline)) void servo_run(void)
+ISR(TIMER2_COMP_vect)
 {
 	front_rx_hold();
+	if (!pulses.running || servo_ticks_left() > SERVO_NEAR / 8) {
+		servo_rx_release();
+		return;  /* an earlier wrap, or a stale flag */
+	}
 	for (;;) {
 		const servo_edge_t *edge = pulses.edge;
 		uint8_t e = edge->code;
@@ -226,25 +230,11 @@ static __attribute__((noinline)) void servo_run(void)
 		 * than SERVO_NEAR is waited for in place. */
 		servo_aim(edge);
 		front_rx_hold();
-		servo_rx_release(servo_ticks_left());
+		servo_rx_release();
 		if (servo_arm()) {
 			return;
 		}
 	}
-}
-
-/* Every Timer2 wrap wakes it while servos run, most of them before the
- * next edge's: those only release what the hold keeps, with no more
- * registers saved than that needs (servo_run() saves its own). */
-ISR(TIMER2_COMP_vect)
-{
-	int16_t left = servo_ticks_left();
-
-	if (!pulses.running || left > SERVO_NEAR / 8) {
-		servo_rx_release(left);
-		return;  /* an earlier wrap, or a stale flag */
-	}
-	servo_run();
 }
 
 void servo_hw_init(void)
