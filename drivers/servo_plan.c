@@ -232,6 +232,7 @@ __attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t 
 		if (!cw) {
 			continue;
 		}
+		int8_t move = placed.move[ch];
 		servo_place(ch, changed);
 		uint32_t r = slot + (int16_t)(placed.move[ch] * SERVO_SHIFT);
 		servo_edge_t *fall;
@@ -240,8 +241,11 @@ __attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t 
 			rise = servo_put(first, ++end, rise, ch, r);
 			fall = end++;
 		} else {
+			/* A rise stays where it was unless its channel moves. */
 			servo_edge_t *was = rise;
-			rise = servo_put(first, end, rise, ch, r);
+			if (placed.move[ch] != move) {
+				rise = servo_put(first, end, rise, ch, r);
+			}
 			fall = servo_find(was < rise ? was : rise, end, (uint8_t)(ch | SERVO_FALL));
 		}
 		servo_put(first, end, fall, (uint8_t)(ch | SERVO_FALL), r + cw);
