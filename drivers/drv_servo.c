@@ -65,10 +65,9 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	bool changed = false, starts = false, stops = false;
 	for (uint8_t i = 0; i < len; i += 3) {
 		uint8_t ch = data[i];
-		uint16_t was = servo.width[ch];
-		if (next[ch] != was) {
+		if (next[ch] != servo.width[ch]) {
 			changed = true;
-			if (!was) {
+			if (!servo.width[ch]) {
 				starts = true;
 				if (!servo_hw_can_claim(ch)) {
 					return REG_PIN_BUSY;
