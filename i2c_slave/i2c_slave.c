@@ -48,45 +48,83 @@ static bool slave_quiet(void)
 	return slave_fsm_in_frame() && slave_quiet_since();
 }
 
-/* The answer into TWDR/TWCR: TWINT written 1 lets the bus go on. */
+/* TWCR answers: TWINT written 1 lets the bus go on; TWEA acknowledges
+ * what comes next. */
+#define SLAVE_GO_ON (_BV(TWINT) | SLAVE_TWCR)
+#define SLAVE_REFUSE_NEXT (_BV(TWINT) | _BV(TWEN))
+
+/* The answer into TWDR/TWCR (SLAVE_ACK, SLAVE_NACK, SLAVE_SEND or
+ * SLAVE_RECOVER: the others are answered before their work). */
 static void slave_apply(slave_action_t act, uint8_t byte)
 {
 	/* the common answers tested first */
 	if (act == SLAVE_SEND) {
 		TWDR = byte;
-		TWCR = _BV(TWINT) | SLAVE_TWCR;
-	} else if (act == SLAVE_ACK || act == SLAVE_DEFER_ACK) {
-		TWCR = _BV(TWINT) | SLAVE_TWCR;
+		TWCR = SLAVE_GO_ON;
+	} else if (act == SLAVE_ACK) {
+		TWCR = SLAVE_GO_ON;
 	} else if (act == SLAVE_NACK) {
-		TWCR = _BV(TWINT) | _BV(TWEN);
-	} else if (act == SLAVE_RECOVER) {
+		TWCR = SLAVE_REFUSE_NEXT;
+	} else {
 		TWCR = _BV(TWINT) | _BV(TWSTO) | SLAVE_TWCR;
 	}
-	/* SLAVE_RESUME: the event was answered before its work */
 }
 
-/* One TWI event (TWINT set), answered. */
+/* One TWI event (TWINT set), answered: as soon as its answer is known,
+ * the bookkeeping after. */
 static void slave_event(void)
 {
-	uint8_t byte = TWDR;
 	uint8_t status = TW_STATUS;
-	/* The one event that applies a write (STOP or repeated START) ends
-	 * a frame gone quiet, however soon it comes after the quiet spell:
-	 * then it is dropped, not applied. (A START in the middle of a frame
-	 * is a repeated START to this TWI.) */
-	if (status == TW_SR_STOP && slave_quiet_since()) {
-		slave_fsm_drop();
+	uint8_t byte, next;
+
+	if (status == TW_ST_DATA_ACK && slave_fsm_ahead(&next)) {
+		/* the common read byte, taken ahead: sent at once */
+		TWDR = next;
+		TWCR = SLAVE_GO_ON;
+		slave_seen = clock_now8();
+		slave_fsm_after();
+		return;
 	}
-	slave_action_t act = slave_fsm_event(status, &byte);
-	if (act == SLAVE_DEFER) {
-		/* a driver's read answer: SCL held meanwhile */
-		act = slave_fsm_work(&byte);
-	}
-	slave_apply(act, byte);
-	if (act == SLAVE_DEFER_ACK) {
-		/* a write applied while the bus goes on: the next event
-		 * waits in TWINT until this one is done */
-		slave_fsm_work(&byte);
+	if (status == TW_SR_DATA_ACK) {
+		/* a byte received: its value decides the next one's
+		 * acknowledge */
+		TWCR = slave_fsm_received(TWDR) ? SLAVE_GO_ON : SLAVE_REFUSE_NEXT;
+	} else if (status == TW_ST_SLA_ACK || status == TW_ST_ARB_LOST_SLA_ACK) {
+		/* a read frame: its first byte is the driver's, the master
+		 * waits for it (SCL held) */
+		slave_fsm_read_start(&byte);
+		TWDR = byte;
+		TWCR = SLAVE_GO_ON;
+	} else {
+		/* A frame's end, the own write address, a read byte not taken
+		 * ahead, a bus error. Where the status alone decides the
+		 * answer (acknowledged whatever the state) the bus goes on
+		 * first: the next event waits in TWINT until this one's work
+		 * is done. */
+		bool first = slave_fsm_acks(status);
+		if (first) {
+			TWCR = SLAVE_GO_ON;
+		}
+		/* The one event that applies a write (STOP or repeated
+		 * START) ends a frame gone quiet, however soon it comes
+		 * after the quiet spell: then it is dropped, not applied. (A
+		 * START in the middle of a frame is a repeated START to this
+		 * TWI.) */
+		if (status == TW_SR_STOP && slave_quiet_since()) {
+			slave_fsm_drop();
+		}
+		byte = TWDR;
+		slave_action_t act = slave_fsm_event(status, &byte);
+		if (act == SLAVE_DEFER) {
+			/* a driver's read answer: SCL held meanwhile */
+			act = slave_fsm_work(&byte);
+		}
+		if (act == SLAVE_DEFER_ACK) {
+			/* answered first: a write applied while the bus goes on */
+			slave_fsm_work(&byte);
+		} else if (!first) {
+			slave_apply(act, byte);
+		}
 	}
 	slave_seen = clock_now8();
 	/* Its own address (SLA+W or SLA+R) keeps the link alive; frames for

@@ -83,12 +83,34 @@ static slave_action_t slave_end_read(void)
 	return SLAVE_DEFER_ACK;
 }
 
+bool slave_fsm_acks(uint8_t status)
+{
+	/* the sending statuses are TW_ST_SLA_ACK, TW_ST_ARB_LOST_SLA_ACK
+	 * and TW_ST_DATA_ACK, in a row */
+	return status != TW_SR_DATA_ACK && status != TW_BUS_ERROR &&
+	       (uint8_t)(status - TW_ST_SLA_ACK) > TW_ST_DATA_ACK - TW_ST_SLA_ACK;
+}
+
+bool slave_fsm_ahead(uint8_t *byte)
+{
+	if (!slave.next_ok) {
+		return false;
+	}
+	slave.next_ok = 0;
+	*byte = slave.next;
+	return true;
+}
+
+bool slave_fsm_received(uint8_t byte)
+{
+	slave.in_frame = 1;
+	return xact_write_received(byte);
+}
+
 slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 {
 	/* The byte taken ahead first: the master waits for it, SCL held. */
-	if (status == TW_ST_DATA_ACK && slave.next_ok) {
-		slave.next_ok = 0;
-		*byte = slave.next;
+	if (status == TW_ST_DATA_ACK && slave_fsm_ahead(byte)) {
 		return SLAVE_SEND;
 	}
 	/* addressed until a frame's end: STOP or repeated START, a refused
@@ -96,11 +118,10 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 	slave.in_frame = 1;
 	/* Then the two the master waits on longest, tested first. */
 	if (status == TW_ST_SLA_ACK || status == TW_ST_ARB_LOST_SLA_ACK) {
-		slave.next_ok = 0;
 		return slave_defer(WORK_READ_START);
 	}
 	if (status == TW_SR_DATA_ACK) {
-		return xact_write_received(*byte) ? SLAVE_ACK : SLAVE_NACK;
+		return slave_fsm_received(*byte) ? SLAVE_ACK : SLAVE_NACK;
 	}
 	switch (status) {
 	case TW_SR_SLA_ACK:
@@ -142,6 +163,17 @@ slave_action_t slave_fsm_event(uint8_t status, uint8_t *byte)
 	}
 }
 
+void slave_fsm_read_start(uint8_t *byte)
+{
+	slave.in_frame = 1;
+	slave.next_ok = 0;
+	slave.reading = 1;
+	/* the driver's answer goes to the buffer's start: its first byte
+	 * taken where it is */
+	*byte = xact_read_requested(slave.buf, sizeof slave.buf) && xact_read_take(1) ?
+		slave.buf[0] : 0xFF;
+}
+
 slave_action_t slave_fsm_work(uint8_t *byte)
 {
 	slave_work_t work = (slave_work_t)slave.work;
@@ -149,9 +181,7 @@ slave_action_t slave_fsm_work(uint8_t *byte)
 	slave.work = WORK_NONE;
 	if (work == WORK_READ_START) {
 		/* first: the master waits for its byte, SCL held */
-		xact_read_requested(slave.buf, sizeof slave.buf);
-		slave.reading = 1;
-		xact_read_processed(byte);
+		slave_fsm_read_start(byte);
 		return SLAVE_SEND;
 	}
 	switch (work) {

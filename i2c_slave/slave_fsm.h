@@ -1,8 +1,9 @@
 /*
  * The TWI slave's decisions (docs/registers.md, "On a slave board"), free of
  * hardware: one call per TWI event with its status code (avr-libc's TW_*
- * names), one action back for the thin interrupt layer in i2c_slave.c to put into TWCR/TWDR. Host
- * unit tests drive it with status sequences as the AVR TWI produces them.
+ * names), one action back for the thin layer in i2c_slave.c to put into
+ * TWCR/TWDR. Host unit tests drive it with status sequences as the AVR TWI
+ * produces them.
  *
  * What the hardware decides first, and what follows here:
  *  - a received byte is acknowledged before its value is seen, so a refusal
@@ -23,6 +24,13 @@
  * go on (the next address is acknowledged by the TWI alone) and holds the
  * next event until the write is applied. Everything else is a few byte
  * moves, with the bookkeeping after the answer (slave_fsm_after()).
+ *
+ * The polled layer (i2c_slave.c) takes the shortest way to each answer,
+ * the master waiting with SCL held: the byte taken ahead
+ * (slave_fsm_ahead()), a received byte's decision (slave_fsm_received()),
+ * a read frame's first byte without the deferral (slave_fsm_read_start()),
+ * and the answer first wherever the status alone decides it
+ * (slave_fsm_acks()); each gives what slave_fsm_event() would.
  */
 #ifndef SLAVE_FSM_H
 #define SLAVE_FSM_H
@@ -54,6 +62,29 @@ void slave_fsm_init(void);
  * dropped, a write in it not applied, the status says so. Also a bus
  * error's doing. */
 void slave_fsm_drop(void);
+
+/* True when the answer to an event with this status is SLAVE_ACK or
+ * SLAVE_DEFER_ACK whatever came before (a frame's end, its own write
+ * address, what is never ours): the TWI layer may let the bus go on
+ * first and call slave_fsm_event() after. False for a byte received (its
+ * value decides), the statuses that send and a bus error. */
+bool slave_fsm_acks(uint8_t status);
+
+/* A byte of a write frame received (a TW_SR_DATA_ACK event, as
+ * slave_fsm_event() takes it): true to acknowledge the next one
+ * (SLAVE_ACK), false to refuse it (SLAVE_NACK). */
+bool slave_fsm_received(uint8_t byte);
+
+/* A read frame begins (TW_ST_SLA_ACK, TW_ST_ARB_LOST_SLA_ACK): the
+ * driver's answer asked for at once, its first byte in *byte to send (as
+ * slave_fsm_event()'s SLAVE_DEFER and slave_fsm_work()'s SLAVE_SEND give
+ * it, for a layer that need not defer). */
+void slave_fsm_read_start(uint8_t *byte);
+
+/* The byte the master reads next (a TW_ST_DATA_ACK event), if
+ * slave_fsm_after() took it ahead: true and *byte, to send at once; the
+ * event is then answered (slave_fsm_event() would say SLAVE_SEND). */
+bool slave_fsm_ahead(uint8_t *byte);
 
 /* A TWI event: `status` is TW_STATUS; `*byte` holds TWDR for received
  * data and receives the byte to send for SLAVE_SEND. */

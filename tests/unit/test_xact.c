@@ -409,8 +409,22 @@ static void test_faults_mid_byte(void)
 	CHECK(!slave_fsm_in_frame());
 }
 
+/* The statuses whose answer i2c_slave.c gives before the event: all but
+ * a byte received, the three that send and a bus error (xact_model.c checks
+ * the answer of each event that comes). */
+static void test_acks_first(void)
+{
+	for (unsigned st = 0; st < 0x100; st += 8) {
+		int decides = st == TW_SR_DATA_ACK || st == TW_ST_SLA_ACK ||
+			      st == TW_ST_ARB_LOST_SLA_ACK || st == TW_ST_DATA_ACK ||
+			      st == TW_BUS_ERROR;
+		CHECK_EQ(slave_fsm_acks((uint8_t)st), !decides);
+	}
+}
+
 void xact_tests(void)
 {
+	test_acks_first();
 	test_aborted_frames();
 	test_faults_mid_byte();
 	test_check_agrees_with_write();

@@ -73,7 +73,23 @@ void xact_model_slave(const frame_t *f, result_t *r)
  * next byte's acknowledge, deferred work done as the main loop would. */
 slave_action_t xact_model_twi_event(uint8_t status, uint8_t *byte)
 {
+	/* i2c_slave.c's ways: the byte taken ahead sent at once; a read
+	 * frame's first byte asked for at once (every other time here, the
+	 * deferred way of slave_fsm_event() the others); an answer known
+	 * from the status alone given before the event */
+	static unsigned turn;
+	if (status == TW_ST_DATA_ACK && slave_fsm_ahead(byte)) {
+		slave_fsm_after();
+		return SLAVE_SEND;
+	}
+	if ((status == TW_ST_SLA_ACK || status == TW_ST_ARB_LOST_SLA_ACK) && turn++ % 2) {
+		slave_fsm_read_start(byte);
+		slave_fsm_after();
+		return SLAVE_SEND;
+	}
+	int acks = slave_fsm_acks(status);
 	slave_action_t act = slave_fsm_event(status, byte);
+	CHECK(!acks || act == SLAVE_ACK || act == SLAVE_DEFER_ACK);
 	if (act == SLAVE_DEFER) {
 		act = slave_fsm_work(byte);
 	} else if (act == SLAVE_DEFER_ACK) {
