@@ -59,30 +59,37 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	 * triples (a channel written twice is looked at twice, to the same
 	 * effect). Channels turned on take their pins. All are checked before
 	 * any is taken: a claim sets its pin up (output low) and a release
-	 * cannot bring back what GPIO had there. */
-	bool changed = false;
+	 * cannot bring back what GPIO had there. Most writes only change
+	 * widths: the claims and releases are looked for only where some
+	 * channel starts or stops. */
+	bool changed = false, starts = false, stops = false;
 	for (uint8_t i = 0; i < len; i += 3) {
 		uint8_t ch = data[i];
 		if (next[ch] != servo.width[ch]) {
 			changed = true;
-			if (!servo.width[ch] && !servo_hw_can_claim(ch)) {
-				return REG_PIN_BUSY;
+			if (!servo.width[ch]) {
+				starts = true;
+				if (!servo_hw_can_claim(ch)) {
+					return REG_PIN_BUSY;
+				}
+			} else if (!next[ch]) {
+				stops = true;
 			}
 		}
 	}
 	if (!changed) {
 		return REG_OK;  /* the pulses already are so: no new schedule */
 	}
-	for (uint8_t i = 0; i < len; i += 3) {
+	for (uint8_t i = 0; starts && i < len; i += 3) {
 		uint8_t ch = data[i];
 		if (next[ch] && !servo.width[ch]) {
 			servo_hw_claim(ch);
 		}
 	}
-	servo_hw_apply(next);
+	servo_hw_apply(next, servo.width);
 	for (uint8_t i = 0; i < len; i += 3) {
 		uint8_t ch = data[i];
-		if (!next[ch] && servo.width[ch]) {
+		if (stops && !next[ch] && servo.width[ch]) {
 			servo_hw_release(ch);
 		}
 		servo.width[ch] = next[ch];

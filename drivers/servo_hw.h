@@ -22,7 +22,9 @@ bool servo_hw_claim(uint8_t ch);
 void servo_hw_release(uint8_t ch);
 
 /* Channel widths in microseconds (0 = off, else 500..2500), applied together
- * from the next 20 ms frame on. */
-void servo_hw_apply(const uint16_t *widths_us);
+ * from the next 20 ms frame on; `was_us`: the widths the last call applied
+ * (all 0 after servo_hw_init()), so only the channels that change need
+ * planning. */
+void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us);
 
 #endif

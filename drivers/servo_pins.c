@@ -227,10 +227,17 @@ ISR(TIMER2_COMP_vect)
 		 * burst (~320 cycles) after an arm at SERVO_NEAR ran past the
 		 * wake-up, and the interrupt came back late for the edge (8-11
 		 * cycles late at 460800). An edge the release brought closer
-		 * than SERVO_NEAR is waited for in place. */
+		 * than SERVO_NEAR is waited for in place. What reached UDR
+		 * while the release ran (it hands on BOARD_RX_BURST at most
+		 * when the edge is near) goes into the hold before the arm:
+		 * left in UDR it waited for the arm, the return and the clock
+		 * tick's interrupt, ~230 cycles, and a third character was lost
+		 * now and then at 460800 (tests/sim/test_fast_rates.py's
+		 * flow-rule test, 2 runs in 10). */
 		servo_aim(edge);
 		front_rx_hold();
 		servo_rx_release();
+		front_rx_hold();
 		if (servo_arm()) {
 			return;
 		}
@@ -280,7 +287,7 @@ void servo_hw_release(uint8_t ch)
 	pins_release(board_pin(BF_SERVO, ch), PIN_SERVO);
 }
 
-void servo_hw_apply(const uint16_t *widths_us)
+void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
 {
 	uint8_t newer;
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
@@ -290,7 +297,7 @@ void servo_hw_apply(const uint16_t *widths_us)
 	}
 	/* The last plan: the buffer not taken over yet, else the running one. */
 	servo_sched_t *s = &pulses.sched[pulses.active ^ 1];
-	servo_plan(s, newer ? s : &pulses.sched[pulses.active], widths_us);
+	servo_plan(s, newer ? s : &pulses.sched[pulses.active], widths_us, was_us);
 	uint8_t n = s->n;
 
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {

@@ -3,12 +3,17 @@
  *
  * A write changes a few widths, so the plan is changed, not made afresh:
  * the channels that keep their width keep their place and their order in
- * the last schedule; the changed channels are placed among them one after
- * the other and put into the order. Placing looks at the edges in time
- * order from where a binary search finds the pulse's ends, and skips past
- * every edge in the way at once, instead of trying one place after the
- * other. The schedule holds each edge's cycle in the frame, so nothing
- * needs adding up.
+ * the last schedule; the changed channels are placed one after the other
+ * and their edges put into the order.
+ * A channel can only come near the edges of the three channels either side
+ * of it (a pulse is at most 2.25 slots long and moves at most 3072
+ * cycles), so placing one looks at those few edges alone, from the
+ * channels' places, not the schedule: each edge near enough to matter rules
+ * out a range of moves, and the nearest move outside all of them is found
+ * by skipping past each range in the way. Distances are cycles modulo 2^16
+ * (16-bit sums: the ones that matter are under 3472, the others never come
+ * within 2^16 - 3472 of 0). The schedule holds each edge's cycle in the
+ * frame, so nothing needs adding up.
  */
 #include "drivers/servo_plan.h"
 
@@ -23,19 +28,24 @@ _Static_assert(SERVO_FRAME <= 0x40000UL, "a cycle in the frame fits 18 bits (SER
 _Static_assert(SERVO_CHANNELS <= SERVO_CHAN + 1, "a channel fits the edge code");
 _Static_assert(SERVO_SLOT >= SERVO_SHIFT * SERVO_MOVES, "only channel 0 can move before the frame");
 
+/* The most a channel moves, cycles, and the distance from its ends (at
+ * move 0) within which another edge can be in its way. */
+#define SERVO_REACH ((int16_t)(SERVO_SHIFT * SERVO_MOVES))
+#define SERVO_NEAR_ENOUGH (SERVO_REACH + SERVO_GAP)
+/* The longest pulse (2500 us) in cycles: only channels NEIGHBOURS either
+ * side can come near. */
+#define SERVO_LONGEST 18432UL
+#define SERVO_NEIGHBOURS 3
+_Static_assert(SERVO_SLOT - SERVO_REACH >= SERVO_NEAR_ENOUGH, "two rises are never near");
+_Static_assert(SERVO_SLOT * (SERVO_NEIGHBOURS + 1) > SERVO_LONGEST + 2UL * SERVO_NEAR_ENOUGH,
+	       "a channel NEIGHBOURS + 1 away is never in the way");
+_Static_assert(SERVO_SLOT * (SERVO_NEIGHBOURS + 1) + SERVO_LONGEST + 2UL * SERVO_REACH
+	       < 65536UL - SERVO_NEAR_ENOUGH, "16-bit distances to the neighbours are exact");
+
 static struct {
 	int8_t move[SERVO_CHANNELS];     /* each channel's place: SERVO_SHIFTs off its slot */
-	uint16_t us[SERVO_CHANNELS];     /* width as last planned; 0 = off */
+	uint16_t w[SERVO_CHANNELS];      /* width in cycles as last planned; 0 = off */
 } placed;
-
-/* Frame offset of each channel's pulse start. */
-static const ORFA_FLASH uint32_t slot_start[SERVO_CHANNELS] = {
-#define S(n) SERVO_SLOT * (n)
-	S(0), S(1), S(2), S(3), S(4), S(5), S(6), S(7),
-	S(8), S(9), S(10), S(11), S(12), S(13), S(14), S(15),
-#undef S
-};
-_Static_assert(SERVO_CHANNELS == 16, "slot_start lists 16 channels");
 
 /* Cycles for a width in microseconds, rounded to the nearest: us * 7.3728
  * as a 16.16 fixed-point product (a division took 600 cycles a channel). */
@@ -47,180 +57,199 @@ static uint16_t servo_cycles(uint16_t us)
 			  + (((uint32_t)us * (uint16_t)SERVO_CYCLES_PER_US_Q16 + 32768UL) >> 16));
 }
 
-/* Edge `code` at cycle t. */
-static servo_edge_t servo_edge(uint8_t code, uint32_t t)
+/* The least move in cycles from 0 on (a whole number of SERVO_SHIFTs) that
+ * keeps SERVO_GAP from every edge d[0..n) (each edge's distance from the
+ * pulse's end it is compared with, at move 0); more than SERVO_REACH if
+ * there is none. An edge in the way pushes the move just past it; the
+ * edges are looked at in turn until n in a row are clear. */
+static int16_t servo_clear(const int16_t *d, uint8_t n)
 {
-	servo_edge_t e = { (uint8_t)(code | (uint8_t)((uint8_t)(t >> 16) << 4)), (uint16_t)t };
-	return e;
-}
-
-/* How many of the edges e[0..n) are at cycle t or before (a binary
- * search). */
-static uint8_t servo_count(const servo_edge_t *e, uint8_t n, int32_t t)
-{
-	if (t < 0) {
-		return 0;
-	}
-	/* Bits 16-17 and 0-15 apart: byte and word compares. */
-	uint8_t th = (uint8_t)((uint32_t)t >> 16);
-	uint16_t tl = (uint16_t)t;
-	const servo_edge_t *lo = e;
-	while (n) {
-		uint8_t half = n >> 1;
-		const servo_edge_t *mid = lo + half;
-		uint8_t h = (uint8_t)(mid->code >> 4) & 3;
-		if (h < th || (h == th && mid->at <= tl)) {
-			lo = mid + 1;
-			n = (uint8_t)(n - half - 1);
+	int16_t t = 0;
+	uint8_t i = 0, ok = 0;
+	while (ok < n && t <= SERVO_REACH) {
+		int16_t x = d[i];
+		if (x - SERVO_GAP < t && t < x + SERVO_GAP) {
+			t = (int16_t)((x + SERVO_GAP + SERVO_SHIFT - 1) & -SERVO_SHIFT);
+			ok = 0;
 		} else {
-			n = half;
+			ok++;
+		}
+		if (++i == n) {
+			i = 0;
 		}
 	}
-	return (uint8_t)(lo - e);
+	return t;
 }
 
-/* How far the next edge of e[0..n) from *i on in direction `dir` (1:
- * later, -1: earlier) is in the way of a pulse end at cycle `end`: 0 if it
- * keeps SERVO_GAP, else the cycles the end has to go on to keep it. Edges
- * behind the end by SERVO_GAP or more are passed for good (*i moves on).
- * *i: the next edge's index (dir 1), one more than that (dir -1). */
-static int16_t servo_in_way(const servo_edge_t *e, uint8_t n, uint8_t *i, int32_t end, int8_t dir)
+/* Channel ch (its width changed, not 0) at the nearest place clear of the
+ * channels placed (changed[] those still to place): 0, -1, +1, -2, ...
+ * SERVO_SHIFTs from its slot, never before the frame's start; where none
+ * is clear, it stays where it was (and the interrupt makes its edges as
+ * near their cycles as it can). */
+/* Adds distance x to the edges at `end` if it is near enough to matter. */
+static inline int16_t *servo_near(int16_t *end, uint16_t x)
 {
-	for (;;) {
-		if (dir > 0 ? *i >= n : !*i) {
-			return 0;
-		}
-		const servo_edge_t *x = e + (dir > 0 ? *i : *i - 1);
-		int32_t d = (int32_t)servo_cycle(x) - end;
-		if (dir < 0) {
-			d = -d;
-		}
-		if (d > -SERVO_GAP) {
-			return d < SERVO_GAP ? (int16_t)(d + SERVO_GAP) : 0;
-		}
-		*i = (uint8_t)(*i + dir);
+	if ((int16_t)x > -SERVO_NEAR_ENOUGH && (int16_t)x < SERVO_NEAR_ENOUGH) {
+		*end++ = (int16_t)x;
 	}
+	return end;
 }
 
-/* The first move from 0 on in direction `dir` (its size; > SERVO_MOVES
- * if there is none) at which a pulse whose rise and fall are at b[0] and
- * b[1] at move 0 keeps SERVO_GAP from the edges e[0..n); each end starts
- * at at[] (see servo_in_way) and ends where it stopped: with the move
- * found, how many edges come before that end. An edge in the way of one end
- * pushes the move just past it; then that end looks again, and the other.
- * Edges passed stay passed, so each end looks at each edge once. */
-static int16_t servo_free(const servo_edge_t *e, uint8_t n, const int32_t *b, uint8_t *at,
-			  int8_t dir)
+static __attribute__((noinline)) void servo_place(uint8_t ch, const uint8_t *changed)
 {
-	int16_t m = 0;
-	uint8_t k = 0, clear = 0;  /* ends found clear at this move */
-	while (clear < 2 && m <= SERVO_MOVES) {
-		int16_t in = servo_in_way(e, n, &at[k], b[k] + dir * (int16_t)(m * SERVO_SHIFT), dir);
-		if (in) {
-			m = (int16_t)(m + (uint16_t)(in + SERVO_SHIFT - 1) / SERVO_SHIFT);
-			clear = 0;
-		} else {
-			clear++;
-			k ^= 1;
-		}
-	}
-	return m;
-}
-
-/* Channel ch (its width w changed, not 0) at the nearest place clear of the
- * edges e[0..n): 0, -1, +1, -2, ... SERVO_SHIFTs from its slot, never
- * before the frame's start; where none is clear, it stays where it was (and
- * the interrupt makes its edges as near their cycles as it can). Returns
- * its rise's cycle; at[0] and at[1]: how many edges come before its rise
- * and before its fall. */
-static __attribute__((noinline)) uint32_t servo_move(const servo_edge_t *e, uint8_t n, uint8_t ch,
-						     uint16_t w, uint8_t *at)
-{
-	int32_t b[2] = { (int32_t)slot_start[ch], (int32_t)slot_start[ch] + w };
-	/* Where each end starts looking at move 0: later from the first edge
-	 * not SERVO_GAP before it (at[]), earlier from the last edge not
-	 * SERVO_GAP after it (down[], one more). */
-	uint8_t down[2];
-	for (uint8_t k = 0; k < 2; k++) {
-		uint8_t i = servo_count(e, n, b[k] - SERVO_GAP);
-		at[k] = i;
-		while (i < n && (int32_t)servo_cycle(e + i) < b[k] + SERVO_GAP) {
-			i++;
-		}
-		down[k] = i;
-	}
-	int16_t m = servo_free(e, n, b, at, 1);
-	if (m && ch) {
-		int16_t earlier = servo_free(e, n, b, down, -1);
-		if (earlier <= m) {
-			m = (int16_t)-earlier;
-			at[0] = down[0];
-			at[1] = down[1];
-		}
-	}
-	uint32_t r = slot_start[ch];
-	if (m >= -SERVO_MOVES && m <= SERVO_MOVES) {
-		placed.move[ch] = (int8_t)m;
-		r += (int16_t)(m * SERVO_SHIFT);
-	} else {
-		/* No clear place: where it was, among edges it may be near. */
-		r += (int16_t)(placed.move[ch] * SERVO_SHIFT);
-		at[0] = servo_count(e, n, (int32_t)r);
-		at[1] = servo_count(e, n, (int32_t)(r + w));
-	}
-	return r;
-}
-
-/* Copies the edges from[0..n) whose channel has not changed to `to`
- * (which may be `from`: it never gets ahead; the edges before the first
- * one left out then stay as they are); returns where the copy ends. */
-static __attribute__((noinline)) servo_edge_t *servo_keep(servo_edge_t *to, const servo_edge_t *from,
-							  uint8_t n, const uint8_t *changed)
-{
-	if (to == from) {
-		while (n && !changed[to->code & SERVO_CHAN]) {
-			n--;
-			to++;
-		}
-		from = to;
-	}
-	for (; n; n--, from++) {
-		if (!changed[from->code & SERVO_CHAN]) {
-			*to++ = *from;
-		}
-	}
-	return to;
-}
-
-void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us)
-{
-	uint8_t changed[SERVO_CHANNELS];
-
-	const uint16_t *now = widths_us;
-	uint16_t *was = placed.us;
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, now++, was++) {
-		changed[ch] = *now != *was;
-		*was = *now;
-	}
-	/* The others stay where they were, in their order. */
-	servo_edge_t *e = s->edge;
-	uint8_t n = (uint8_t)(servo_keep(e, last->edge, last->n, changed) - e);
-	/* The changed channels in channel order, each placed among the edges
-	 * now in s, then into the order: the edges after its fall move up two
-	 * places, those between its edges one. */
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		if (!changed[ch] || !placed.us[ch]) {
+	/* Each neighbour's edges as distances from this channel's rise at
+	 * move 0; of those, a channel before it can only come near its rise
+	 * and fall with its own fall, one after with its rise and fall, each
+	 * only near this channel's fall (rises are SERVO_SLOT apart, a pulse
+	 * is at least 500 us). */
+	int16_t d[2 * 2 * SERVO_NEIGHBOURS], *end = d;
+	uint16_t w = placed.w[ch];
+	for (int8_t k = -SERVO_NEIGHBOURS; k <= SERVO_NEIGHBOURS; k++) {
+		uint8_t c = (uint8_t)(ch + k);
+		if (!k || c >= SERVO_CHANNELS) {
 			continue;
 		}
-		uint16_t w = servo_cycles(placed.us[ch]);
-		uint8_t at[2];
-		uint32_t r = servo_move(e, n, ch, w, at);
-		uint8_t i = at[0], j = at[1];
-		memmove(e + j + 2, e + j, (n - j) * sizeof *e);
-		memmove(e + i + 1, e + i, (j - i) * sizeof *e);
-		e[i] = servo_edge(ch, r);
-		e[j + 1] = servo_edge((uint8_t)(ch | SERVO_FALL), r + w);
-		n = (uint8_t)(n + 2);
+		uint16_t cw = placed.w[c];
+		if (!cw || (k > 0 && changed[c])) {
+			continue;
+		}
+		uint16_t x = (uint16_t)(k * (int16_t)SERVO_SLOT + placed.move[c] * SERVO_SHIFT);
+		uint16_t y = (uint16_t)(x + cw);
+		end = servo_near(end, (uint16_t)(y - w));
+		end = servo_near(end, k < 0 ? y : (uint16_t)(x - w));
 	}
-	s->n = n;
+	uint8_t n = (uint8_t)(end - d);
+	if (!n) {
+		placed.move[ch] = 0;  /* nothing near: its slot */
+		return;
+	}
+	int16_t t = servo_clear(d, n);
+	if (t && ch) {
+		for (uint8_t i = 0; i < n; i++) {
+			d[i] = (int16_t)-d[i];
+		}
+		int16_t earlier = servo_clear(d, n);
+		if (earlier <= t) {
+			t = (int16_t)-earlier;
+		}
+	}
+	if (t >= -SERVO_REACH && t <= SERVO_REACH) {
+		placed.move[ch] = (int8_t)(t / SERVO_SHIFT);
+	}
+}
+
+/* Edge `code` at cycle t put in the place of the edge at p, then moved
+ * into the order of the edges first..end (all in order but for p): those
+ * it passes move a place towards where it was (it goes after one at the
+ * same cycle). An edge moves little where it changes little; one put at
+ * the end goes back past a few falls where the channels come in order (a
+ * rise comes after the rises before it, a fall before those after it). */
+static __attribute__((noinline)) servo_edge_t *servo_put(servo_edge_t *first, servo_edge_t *end,
+							 servo_edge_t *p, uint8_t code, uint32_t t)
+{
+	uint8_t hi = (uint8_t)((uint8_t)(t >> 16) << 4);
+	uint16_t at = (uint16_t)t;
+	while (p != first) {
+		servo_edge_t *q = p - 1;
+		uint8_t qh = q->code & SERVO_HI;
+		if (qh < hi || (qh == hi && q->at <= at)) {
+			break;
+		}
+		*p = *q;
+		p = q;
+	}
+	while (p + 1 != end) {
+		servo_edge_t *q = p + 1;
+		uint8_t qh = q->code & SERVO_HI;
+		if (qh > hi || (qh == hi && q->at > at)) {
+			break;
+		}
+		*p = *q;
+		p = q;
+	}
+	p->code = (uint8_t)(code | hi);
+	p->at = at;
+	return p;
+}
+
+/* The first edge of p..end with code `code` (cycle bits aside); end if
+ * none. */
+static __attribute__((noinline)) servo_edge_t *servo_find(servo_edge_t *p, const servo_edge_t *end, uint8_t code)
+{
+	while (p != end && (p->code & (uint8_t)~SERVO_HI) != code) {
+		p++;
+	}
+	return p;
+}
+
+/* Takes the edge at p out of first..end; returns the new end. */
+static __attribute__((noinline)) servo_edge_t *servo_drop(servo_edge_t *p, servo_edge_t *end)
+{
+	for (end--; p != end; p++) {
+		*p = p[1];
+	}
+	return end;
+}
+
+__attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t *last,
+					  const uint16_t *widths_us, const uint16_t *was_us)
+{
+	uint8_t changed[SERVO_CHANNELS];
+	uint16_t *w = placed.w;
+
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, w++) {
+		uint16_t us = widths_us[ch];
+		changed[ch] = us != was_us[ch];
+		if (changed[ch]) {
+			*w = us ? servo_cycles(us) : 0;
+		}
+	}
+	/* The last schedule, then each changed channel in channel order: placed
+	 * clear of those placed before it, its edges moved to their new cycles
+	 * (or taken out, or put in). The order holds throughout: an edge not
+	 * moved yet is still at its last cycle. The rises stay in channel
+	 * order, so a channel's rise is after the one changed before it. */
+	servo_edge_t *first = s->edge, *end = first + last->n;
+	if (last != s) {
+		memcpy(first, last->edge, (size_t)last->n * sizeof *first);
+	}
+	servo_edge_t *from = first;  /* no changed channel's rise before this */
+	uint32_t slot = 0;           /* the channel's slot start */
+	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, slot += SERVO_SLOT) {
+		if (!changed[ch]) {
+			continue;
+		}
+		uint16_t cw = placed.w[ch];
+		/* Its fall is after its rise, and stays so however the rise moves
+		 * (the edges it passes move towards where it was). */
+		servo_edge_t *rise = servo_find(from, end, ch);
+		if (rise != end && !cw) {
+			end = servo_drop(rise, end);
+			end = servo_drop(servo_find(rise, end, (uint8_t)(ch | SERVO_FALL)), end);
+			from = rise;
+			continue;
+		}
+		if (!cw) {
+			continue;
+		}
+		int8_t move = placed.move[ch];
+		servo_place(ch, changed);
+		uint32_t r = slot + (int16_t)(placed.move[ch] * SERVO_SHIFT);
+		servo_edge_t *fall;
+		if (rise == end) {
+			/* It starts: both edges put in at the end. */
+			rise = servo_put(first, ++end, rise, ch, r);
+			fall = end++;
+		} else {
+			/* A rise stays where it was unless its channel moves. */
+			servo_edge_t *was = rise;
+			if (placed.move[ch] != move) {
+				rise = servo_put(first, end, rise, ch, r);
+			}
+			fall = servo_find(was < rise ? was : rise, end, (uint8_t)(ch | SERVO_FALL));
+		}
+		servo_put(first, end, fall, (uint8_t)(ch | SERVO_FALL), r + cw);
+		from = rise + 1;
+	}
+	s->n = (uint8_t)(end - first);
 }

@@ -141,9 +141,10 @@ static void decode(const servo_sched_t *s, long *rise, long *fall, long step)
 
 /* The firmware's two buffers: the planner plans into the one the interrupt
  * is not running, from the last plan: that buffer itself while it waits to
- * be taken over, else the running one. */
+ * be taken over, else the running one; and the widths the last plan had. */
 static servo_sched_t buf[2];
 static int running;
+static uint16_t last_us[NCH];
 
 /* One write of `us` (all channels); the planner must place as the model
  * does. `taken`: the last plan was taken over before this write. */
@@ -158,7 +159,8 @@ static void step(const uint16_t *us, int taken, long n)
 		running ^= 1;
 	}
 	servo_sched_t *s = &buf[running ^ 1];
-	servo_plan(s, taken ? &buf[running] : s, us);
+	servo_plan(s, taken ? &buf[running] : s, us, last_us);
+	memcpy(last_us, us, sizeof last_us);
 	decode(s, rise, fall, n);
 	int count = 0, ok_width = 1, ok_move = 1, ok_same = 1;
 	for (int ch = 0; ch < NCH; ch++) {
