@@ -16,8 +16,38 @@ void clock_init(void)
 	TIMSK |= MCU_CLOCK_TOIE;
 }
 
-/* The next overflow is 2048 cycles away: it cannot come again before its end. */
+#ifdef BOARD_CLOCK_COMPARE
+/* clock_compare_from()'s wrap, while armed. */
+static uint8_t compare_armed, compare_from;
+
+void clock_compare_from(uint8_t wrap)
+{
+	compare_from = wrap;
+	compare_armed = 1;
+}
+
+void clock_compare_cancel(void)
+{
+	compare_armed = 0;
+}
+
+/* The next overflow is 2048 cycles away: it cannot come again before its
+ * end. The compare is turned on at its wrap or, if an overflow was counted
+ * by the servo interrupt instead (servo_pins.c), at the next one: "at or
+ * after", not "at". */
+ISR(MCU_CLOCK_OVF_vect, FRONT_ISR_LETS_RX)
+{
+	uint8_t now = (uint8_t)++clock_wraps;
+
+	if (compare_armed && (int8_t)(now - compare_from) >= 0) {
+		compare_armed = 0;
+		TIMSK |= MCU_CLOCK_OCIE;
+	}
+}
+#else
+/* No driver's compare on the time base (board.h): only the count. */
 ISR(MCU_CLOCK_OVF_vect, FRONT_ISR_LETS_RX)
 {
 	clock_wraps++;
 }
+#endif

@@ -33,8 +33,11 @@
 #define BOARD_TWI_SDA   1
 
 /* The time base (firmware/clock.c): Timer2 at clk/8, whose overflows the
- * servo pulses (drivers/servo_pins.c) count on too. */
+ * servo pulses (drivers/servo_pins.c) count on too; its compare unit is
+ * theirs, and the clock's overflow turns it on again after a long wait
+ * (clock_compare_from()). */
 #define BOARD_CLOCK_TIMER 2
+#define BOARD_CLOCK_COMPARE
 
 /* GPIO driver (UID 0x0020): its ports, in register order. */
 #define BOARD_GPIO_UID  0x0020
