@@ -7,10 +7,11 @@ in simulated time, the simulator at real time (orfa-sim --real-time) so the
 PC has a real board's time per byte.
 
 Where the target is missed the firmware is what limits (docs/python.md,
-"Pipelining across calls", has the figures): the M32-D's 16-triple servo
-write (about 27000 cycles) and every board's per-character and per-request
-cost above 115200; the M32-D loses received characters to its servo
-interrupt above 115200 (test_fast_rates.py).
+"Pipelining across calls", has the figures): above 115200 every board's
+per-character and per-request cost (docs/protocol.md, The line: 460800's
+budget), on the M32-D its 16-triple servo write too (about 35000 cycles).
+The M32-D at 115200 is at the target's edge (95.6 % in make bench): a
+busy machine's real-time simulator can leave it just under.
 """
 
 import sys
@@ -36,8 +37,11 @@ FIRMWARE_TIME = pytest.mark.xfail(reason="issue 20: the firmware's time per step
                                   "than the step's wire time (its servo write, per character "
                                   "and per request costs)")
 
+AT_THE_EDGE = pytest.mark.xfail(reason="issue 20: 95.6 % in make bench, the simulator at real "
+                                "time: a busy machine can leave it just under 95")
+
 CORRECT = {}
-AT_TARGET = {("m32d", 115200): FIRMWARE_TIME, ("m32d", 230400): FIRMWARE_TIME,
+AT_TARGET = {("m32d", 115200): AT_THE_EDGE, ("m32d", 230400): FIRMWARE_TIME,
              ("m32d", 460800): FIRMWARE_TIME, ("m128s", 230400): FIRMWARE_TIME,
              ("m128s", 460800): FIRMWARE_TIME}
 
