@@ -16,7 +16,7 @@ static __attribute__((noinline)) bool room(sg_parser_t *p, uint16_t bytes, uint1
 	return p->nbytes + bytes <= SG_BUF_SIZE && p->reply_len + reply_chars <= SG_REPLY_MAX;
 }
 
-static sg_event_t start_frame(sg_parser_t *p)
+sg_event_t sg_parse_frame(sg_parser_t *p)
 {
 	if (!room(p, 2, 2)) {
 		return fail(p, SG_ERR_DATA);
@@ -111,7 +111,7 @@ static sg_event_t begin_command(sg_parser_t *p, uint8_t c)
 	case 's':
 		p->cmd = SG_CMD_I2C;
 		p->reply_len = 1;  /* the closing "P" */
-		return start_frame(p);
+		return sg_parse_frame(p);
 	default:
 		return fail(p, SG_ERR_COMMAND);
 	}
@@ -237,7 +237,7 @@ sg_event_t sg_parse_slow(sg_parser_t *p, uint8_t c)
 	}
 	uint8_t lc = c | 0x20;
 	if (lc == 's' && (p->state == SG_ST_WDATA || p->state == SG_ST_RDONE)) {
-		return start_frame(p);
+		return sg_parse_frame(p);
 	}
 	if (lc == 'p' && (p->state == SG_ST_WDATA || p->state == SG_ST_RDONE)) {
 		p->state = SG_ST_DONE;

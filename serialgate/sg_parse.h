@@ -109,10 +109,14 @@ sg_event_t sg_parse_slow(sg_parser_t *p, uint8_t c);
 /* A byte complete in a state that takes one (SG_ST_ARGS to SG_ST_RCOUNT). */
 sg_event_t sg_parse_byte(sg_parser_t *p, uint8_t b);
 
+/* An I2C frame begins (its S). */
+sg_event_t sg_parse_frame(sg_parser_t *p);
+
 /* Feeds one character. After SG_REQUEST, `err` holds the error to reply (or
  * SG_OK), `cmd`, `nbytes` and `buf` the request; the parser is ready for the
  * next line. The common characters inside a request, the line short (a
- * space between bytes, a byte's digit), are taken here in a few cycles,
+ * space between bytes, a byte's digit, a frame's S or P after a byte), are
+ * taken here in a few cycles,
  * without sg_parse_slow()'s call: what it does with them
  * (tests/unit's test_parse_fast_path checks both agree). At 460800 baud
  * the parser has a share of the 160 cycles a character lasts. */
@@ -136,6 +140,20 @@ static inline sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 			}
 			p->hi = SG_NO_DIGIT;
 			return sg_parse_byte(p, (uint8_t)(hi << 4 | d));
+		}
+		/* a frame's end: the next frame's S, or the request's P */
+		if (hi == SG_NO_DIGIT && (p->state == SG_ST_WDATA || p->state == SG_ST_RDONE)) {
+			uint8_t lc = c | 0x20;
+
+			if (lc == 'p') {
+				p->len++;
+				p->state = SG_ST_DONE;
+				return SG_MORE;
+			}
+			if (lc == 's') {
+				p->len++;
+				return sg_parse_frame(p);
+			}
 		}
 	}
 	return sg_parse_slow(p, c);
