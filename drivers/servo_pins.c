@@ -29,7 +29,14 @@
 #include "firmware/port_io.h"
 #include "firmware/uart.h"
 
-#define SERVO_FINE   96        /* last stretch, waited on Timer0 */
+/* The last stretch, waited on Timer0 (its signed 8-bit compare reaches
+ * 127 cycles back). The Timer2 wait's last turn can begin SERVO_HOLD_TICKS
+ * + 1 ticks before this stretch and take two characters into the hold
+ * (~50 cycles) before it looks at the time again (~40): with 96 that turn
+ * now and then ran past the edge's cycle, and the edge came 8-13 cycles
+ * late at 460800 (test_fast_rates.py::test_servo_widths_with_the_line_busy,
+ * about 1 run in 4 under load); with 112, none in 200. */
+#define SERVO_FINE   112
 /* The receive interrupt's longest run (BOARD_RX_BURST characters, ~85
  * cycles each, and its entry), and the interrupt's own from the wake-up to
  * the last stretch, cycles: the lead allows for both. */
