@@ -70,8 +70,10 @@ _Static_assert(SERVO_LEAD >= SERVO_RX_ISR + SERVO_ENTRY, "the lead allows a rece
  * its wait until SERVO_HOLD_TICKS Timer2 ticks before the last stretch (a
  * turn that holds one must end inside that stretch) and right after each
  * edge, and lets the receive interrupt hand them on (front_rx_poll()) as it
- * returns, within the next wake-up's lead. Every Timer2 wrap wakes it while
- * servos run (0.28 ms), so nothing stays held longer than that.
+ * returns, within the next wake-up's lead. What it could not hand on goes
+ * with the next receive interrupt (it hands the hold on first) or the main
+ * loop's flush (uart_rx_flush()), in order, even while the interrupt sleeps
+ * between frames (servo_arm()).
  */
 #define SERVO_HOLD_TICKS 3
 
