@@ -10,7 +10,7 @@ Where the target is missed the firmware is what limits (docs/python.md,
 "Pipelining across calls", has the figures): above 115200 every board's
 per-character and per-request cost (docs/protocol.md, The line: 460800's
 budget), on the M32-D its 16-triple servo write too (about 35000 cycles).
-The M32-D at 115200 is at the target's edge (95.6 % in make bench): a
+The M32-D at 115200 is at the target's edge (about 95.5 % in make bench): a
 busy machine's real-time simulator can leave it just under.
 """
 
@@ -37,7 +37,7 @@ FIRMWARE_TIME = pytest.mark.xfail(reason="issue 20: the firmware's time per step
                                   "than the step's wire time (its servo write, per character "
                                   "and per request costs)")
 
-AT_THE_EDGE = pytest.mark.xfail(reason="issue 20: 95.6 % in make bench, the simulator at real "
+AT_THE_EDGE = pytest.mark.xfail(reason="issue 20: about 95.5 % in make bench, the simulator at real "
                                 "time: a busy machine can leave it just under 95")
 
 CORRECT = {}
