@@ -178,6 +178,9 @@ static bool servo_arm(void)
  * place, holding). */
 static void servo_rx_release(void)
 {
+	if (SERVO_RX_ISR == 0) {
+		return;  /* the I2C slave: no receiver, nothing held (~40 cycles an edge) */
+	}
 	int16_t left = servo_ticks_left();
 
 	if (left > SERVO_NEAR / 8) {
