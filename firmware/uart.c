@@ -24,6 +24,22 @@ static struct {
 void uart_rx_all(void) __asm__("__vector_uart_rx_all") __attribute__((signal, used, externally_visible));
 #define RX_ALL_HANDLER void uart_rx_all(void)
 
+/* UDR's character, the line told first: it may look at FE, which reading
+ * UDR clears (uart_line.h). */
+static inline __attribute__((always_inline)) uint8_t udr_take(void)
+{
+	uart_line_rx();
+	return MCU_UDR;
+}
+
+/* The receive interrupt called as a function: it keeps every register it
+ * uses; its RETI sets I, and the one instruction that runs before an
+ * interrupt can be taken clears it. Interrupts off. */
+static inline __attribute__((always_inline)) void rx_all_call(void)
+{
+	__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (uart_rx_all) : "memory");
+}
+
 #ifdef BOARD_RX_BURST
 /* A board whose interrupts hold received characters (uart.h). */
 _Static_assert((UART_HOLD & (UART_HOLD - 1)) == 0, "hold size is a power of two");
@@ -46,8 +62,7 @@ static inline __attribute__((always_inline)) void uart_hold(void)
 	uint8_t head = held.head;
 
 	while ((MCU_UCSRA & _BV(RXC)) && (uint8_t)(head - held.tail) < UART_HOLD) {
-		uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
-		held.c[head & (UART_HOLD - 1)] = MCU_UDR;
+		held.c[head & (UART_HOLD - 1)] = udr_take();
 		held.head = ++head;
 	}
 }
@@ -71,8 +86,7 @@ RX_ALL_HANDLER
 			held.tail = (uint8_t)(tail + 1);
 			c = held.c[tail & (UART_HOLD - 1)];
 		} else if (MCU_UCSRA & _BV(RXC)) {
-			uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
-			c = MCU_UDR;
+			c = udr_take();
 		} else {
 			break;
 		}
@@ -102,10 +116,7 @@ void front_rx_poll(uint8_t most)
 {
 	if (held.head != held.tail || (MCU_UCSRA & _BV(RXC))) {
 		held.budget = most;
-		/* The receive interrupt called as a function: it keeps every
-		 * register it uses; its RETI sets I, and the one instruction
-		 * that runs before an interrupt can be taken clears it. */
-		__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (uart_rx_all) : "memory");
+		rx_all_call();
 	}
 }
 
@@ -116,8 +127,7 @@ void front_rx_poll(uint8_t most)
 RX_ALL_HANDLER
 {
 	do {
-		uart_line_rx();	/* before UDR is read: the line may look at FE (uart_line.h) */
-		uart_received(MCU_UDR);
+		uart_received(udr_take());
 	} while (MCU_UCSRA & _BV(RXC));
 }
 
@@ -133,8 +143,7 @@ void front_rx_poll(uint8_t most)
 {
 	(void)most;
 	if (MCU_UCSRA & _BV(RXC)) {
-		/* As above: the receive interrupt called as a function. */
-		__asm__ __volatile__("%~call %x0\n\tcli" : : "i" (uart_rx_all) : "memory");
+		rx_all_call();
 	}
 }
 #endif
