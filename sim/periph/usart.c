@@ -133,16 +133,24 @@ static void usart_rx_flush(usart_t *u)
 	u->rx_dor = 0;
 }
 
+/* The frame in the shift register is lost (DOR): the next frame to enter
+ * the FIFO carries DOR ("frames lost between the last frame read and the
+ * next one"). */
+static void usart_rx_overrun(usart_t *u, avr_cycle_count_t cycle)
+{
+	trace_event(u->trace, cycle, "uart overrun %02X", u->rx_shift_byte);
+	u->rx_dor = 1;
+	u->rx_lost++;
+}
+
 /* A start bit on the wire. Silicon overruns here, not when the frame
  * ends: with two frames unread in UDR and a third complete in the shift
  * register, the new frame shifts in over that third (DOR). */
 static void usart_rx_start_bit(usart_t *u, avr_cycle_count_t start)
 {
 	if (u->rx_fifo_len == 2 && u->rx_shift_full) {
-		trace_event(u->trace, start, "uart overrun %02X", u->rx_shift_byte);
+		usart_rx_overrun(u, start);
 		u->rx_shift_full = 0;
-		u->rx_dor = 1;
-		u->rx_lost++;
 	}
 }
 
@@ -159,14 +167,10 @@ static void usart_rx_deliver(usart_t *u, uint8_t byte, int fe)
 		u->rx_shift_byte = byte;
 		u->rx_shift_fe = (uint8_t)fe;
 	} else {
-		/* Overrun: the frame waiting in the shifter is overwritten.
-		 * The next frame to enter the FIFO carries DOR ("frames lost
-		 * between the last frame read and the next one"). */
-		trace_event(u->trace, u->avr->cycle, "uart overrun %02X", u->rx_shift_byte);
+		/* Overrun: the frame waiting in the shifter is overwritten. */
+		usart_rx_overrun(u, u->avr->cycle);
 		u->rx_shift_byte = byte;
 		u->rx_shift_fe = (uint8_t)fe;
-		u->rx_dor = 1;
-		u->rx_lost++;
 	}
 }
 

@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from conftest import (DRV_LAYOUT, F_CPU, REPLY_TIMEOUT, SERVO_FRAME, require_builds,
+from conftest import (WIDTH_TOL, DRV_LAYOUT, F_CPU, REPLY_TIMEOUT, SERVO_FRAME, require_builds,
                       require_slave, running, us_to_cycles)
 from orfa import (BadLengthError, BadValueError, Board, DataNackError, Gateway,
                   NoDriverError, NotWritableError, OrfaError, PinBusyError,
@@ -22,7 +22,6 @@ TARGETS = {"m32d": ("m32d", None), "m128s": ("m128s", None),
 #: the chip select of each board's SPI EEPROM (a GPIO line)
 SPI_CS = {"m32d": "C2", "m128s": "A0"}
 ADC_MV = 1000
-WIDTH_TOL = 8                            # cycles (1.1 us), as test_drv_servo.py
 PWM_PERIOD = 368                         # docs/registers.md "Motors"
 
 

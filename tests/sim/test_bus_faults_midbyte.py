@@ -24,6 +24,7 @@ from conftest import F_CPU, require_builds, require_slave, running
 from orfa.sim import REPO_ROOT, SimBoard
 from test_abandoned import (DROPPED, M128S, M32D, OK, SLAVES, applied_nothing, clear, mode,
                             robot, sp, status)  # noqa: F401 (robot: the fixture)
+from sigrok import needs_sigrok
 from test_sigrok_i2c import run_capture, sigrok_view, trace_view
 
 MS = F_CPU // 1000
@@ -324,8 +325,7 @@ def test_a_master_addressed_while_it_loses(arb_robot):
 
 # --- what a logic analyzer sees ------------------------------------------------
 
-@pytest.mark.skipif(shutil.which("sigrok-cli") is None,
-                    reason="needs sigrok-cli (tools/setup.sh installs it)")
+@needs_sigrok
 def test_a_logic_analyzer_sees_the_rivals_bit():
     """The rival is on the wire: sigrok's i2c decoder, on the VCD's `sda`
     and `scl`, reads the bytes the devices read (05 with its bit 5 pulled

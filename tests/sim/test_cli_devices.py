@@ -6,11 +6,10 @@ socket, in simulated time."""
 
 import pytest
 
-from conftest import SERVO_FRAME, cli_runner, require_builds, us_to_cycles
+from conftest import WIDTH_TOL, SERVO_FRAME, cli_runner, require_builds, us_to_cycles
 from orfa import boardmap
 from orfa.sim import SimRobot
 
-WIDTH_TOL = 8                    # cycles: 1.1 us, as tests/sim/test_drv_servo.py
 M32D = boardmap.load("m32d")
 
 

@@ -18,7 +18,7 @@ import sys
 
 import pytest
 
-from conftest import ROOT, SERVO_FRAME, raw, require_builds, us_to_cycles
+from conftest import WIDTH_TOL, ROOT, SERVO_FRAME, raw, require_builds, us_to_cycles
 from orfa import Board, Gateway
 from orfa.sim import SimBoard
 
@@ -27,7 +27,6 @@ PARTS = [("mpu6050", 0xD0), ("hmc5883l", 0x3C), ("srf08", 0xE0)]
 IMU, COMPASS, RANGER = 0xD0, 0x3C, 0xE0
 G = 9.80665
 STEPS = 3
-WIDTH_TOL = 8                     # cycles (1.1 us), as test_drv_servo.py
 PWM_PERIOD = 368                  # the motors' PWM (test_drv_motor.py)
 SERVO_PIN, PWM_PINS, DIR_PINS = "A0", ("D5", "D4"), ("B0", "B1")
 
