@@ -176,17 +176,17 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"lds r24, %[hhead]\n\t"
 		"lds r25, %[htail]\n\t"
 		"cp r24, r25\n\t"
-		"brne 2f\n\t"
+		"brne 10f\n\t"
 #endif
 		"lds r24, %[line]\n\t"
 		"cpi r24, %[plain]\n\t"
-		"brne 2f\n\t"
+		"brne 8f\n\t"
 		"lds r24, %[head]\n\t"
 		"lds r25, %[tail]\n\t"
 		"sub r25, r24\n\t"
 		"subi r25, 1\n\t"
 		"cpi r25, %[record] + 1\n\t"
-		"brlo 2f\n\t"
+		"brlo 10f\n\t"
 		"lds r25, %[udr]\n\t"
 		"ldi r31, 0\n\t"
 		"tst r25\n\t"
@@ -209,6 +209,41 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"1:\n\t"
 		RX_FAST_RESTORE
 		"reti\n"
+		"10:\n\t"
+		"rjmp 2f\n"
+		"8:\n\t"
+		/* a new line (line 0, nothing being lost): its first
+		 * character, a request's letter, makes it plain (sg_rx.h's
+		 * rule); a space, a '#', a mark's range: uart_rx_all() */
+		"tst r24\n\t"
+		"brne 2f\n\t"
+		"lds r25, %[losing]\n\t"
+		"tst r25\n\t"
+		"brne 2f\n\t"
+		"lds r24, %[head]\n\t"
+		"lds r25, %[tail]\n\t"
+		"sub r25, r24\n\t"
+		"subi r25, 1\n\t"
+		"cpi r25, %[record] + 1\n\t"
+		"brlo 2f\n\t"
+		"lds r25, %[udr]\n\t"
+		"ldi r31, 0\n\t"
+		"cpi r25, 0x21\n\t"
+		"brlo 9f\n\t"
+		"tst r25\n\t"
+		"brmi 3f\n\t"
+		"cpi r25, '#'\n\t"
+		"breq 3f\n\t"
+		"ldi r30, %[plain]\n\t"
+		"sts %[line], r30\n\t"
+		"rjmp 6b\n"
+		"9:\n\t"
+		/* an empty line's CR or LF: as is, the line stays 0 */
+		"cpi r25, '\\n'\n\t"
+		"breq 6b\n\t"
+		"cpi r25, '\\r'\n\t"
+		"breq 6b\n\t"
+		"rjmp 3f\n"
 #ifdef BOARD_RX_BURST
 		"3:\n\t"
 		/* into the empty hold: uart_rx_all() takes it first */
@@ -252,7 +287,7 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"rjmp 1b\n"
 #endif
 		: : [udr] "n" (_SFR_MEM_ADDR(MCU_UDR)), [line] "i" (&sg_rx.line),
-		[plain] "n" (SG_RX_LINE_PLAIN), [head] "i" (&sg_rx.head), [tail] "i" (&sg_rx.tail),
+		[plain] "n" (SG_RX_LINE_PLAIN), [head] "i" (&sg_rx.head), [losing] "i" (&sg_rx.losing), [tail] "i" (&sg_rx.tail),
 		[record] "n" (SG_RX_RECORD), [buf] "i" (sg_rx.buf), [all] "i" (uart_rx_all),
 #ifdef BOARD_RX_BURST
 		[hhead] "i" (&held.head), [htail] "i" (&held.tail), [hbuf] "i" (held.c),

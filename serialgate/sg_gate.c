@@ -72,7 +72,17 @@ void front_poll(void)
 		}
 	}
 	sg_event_t ev = sg_parse_char(&parser, (uint8_t)c);
-	if (ev == SG_REQUEST) {
+	if (ev == SG_MORE) {
+		/* What else the ring holds of the request's common run, in one
+		 * loop (sg_parse_run()); the character it stops at comes back
+		 * through sg_parse_char(). Only with a character waiting: while
+		 * they come one at a time, the call would be all overhead. */
+		uint8_t tail = sg_rx.tail;
+
+		if (tail != sg_rx.head) {
+			sg_rx.tail = sg_parse_run(&parser, sg_rx.buf, tail, sg_rx.head);
+		}
+	} else if (ev == SG_REQUEST) {
 		SYS_HEARD();  /* any request line keeps the link alive */
 		if (parser.err == SG_OK) {
 			uart_line_confirm();	/* a good request proves the rate */

@@ -795,6 +795,73 @@ static void test_parse_fast_path(void)
 	check(!bad, "parse fast path agrees", NULL);
 }
 
+/* sg_parse_run() takes from the ring exactly what sg_parse_char() would
+ * take in its inline front, all SG_MORE, and leaves the parser as the
+ * whole rule (sg_parse_slow()) character by character does; the character
+ * it stops at then goes through sg_parse_char(). Characters arrive a few
+ * at a time (head moves in steps), so runs end anywhere: inside a byte,
+ * at the line's limit, at the ring's wrap. */
+static void test_parse_run(void)
+{
+	static const char alphabet[] = "SSPp    0123456789ABCDEFabcdef  0A1B  Gz#VLC\r\n\x80\x81\x82";
+	static const char prefix[] = "S 20 01 02 03 04 05 06 07 08 09 0A 0B 0C 0D 0E 0F 10 11 12 "
+		"13 14 15 16 17 18 19 1A 1B 1C 1D 1E 1F 20 21 22 23 24 25 26 27 28";
+	static sg_parser_t fast, slow;
+	static uint8_t ring[256];
+	uint32_t seed = 4242;
+	int bad = 0;
+	unsigned taken = 0;
+
+	for (int round = 0; round < 3000 && !bad; round++) {
+		size_t skip = (round & 1) ? (size_t)(round / 2 % 8) : sizeof prefix - 1;
+		uint8_t head = (uint8_t)(round * 37), tail = head;
+		sg_parse_init(&fast);
+		sg_parse_init(&slow);
+		size_t len = 1 + (size_t)(round % 400), i = 0;
+		while ((i < len || tail != head) && !bad) {
+			/* 0..5 more characters arrive */
+			seed ^= seed << 13;
+			seed ^= seed >> 17;
+			seed ^= seed << 5;
+			for (unsigned k = seed % 6; k && i < len; k--, i++) {
+				seed ^= seed << 13;
+				seed ^= seed >> 17;
+				seed ^= seed << 5;
+				ring[head++] = (uint8_t)(skip + i < sizeof prefix - 1 ? prefix[skip + i] :
+							 alphabet[seed % (sizeof alphabet - 1)]);
+			}
+			if (tail == head) {
+				continue;
+			}
+			uint8_t to = sg_parse_run(&fast, ring, tail, head);
+			for (; tail != to && !bad; tail++) {
+				taken++;
+				if (sg_parse_slow(&slow, ring[tail]) != SG_MORE) {
+					check(0, "parse run", "took a character that is not SG_MORE");
+					bad = 1;
+				}
+			}
+			if (!bad && memcmp(&fast, &slow, sizeof fast) != 0) {
+				check(0, "parse run", "the parser after a run differs");
+				bad = 1;
+			}
+			if (!bad && tail != head) {
+				/* the character it stopped at, as front_poll() does */
+				uint8_t c = ring[tail++];
+				if (sg_parse_char(&fast, c) != sg_parse_slow(&slow, c) ||
+				    memcmp(&fast, &slow, sizeof fast) != 0) {
+					char what[80];
+					snprintf(what, sizeof what, "round %d, character 0x%02X", round, c);
+					check(0, "parse run then char", what);
+					bad = 1;
+				}
+			}
+		}
+	}
+	check(!bad, "parse run agrees", NULL);
+	check(taken > 20000, "parse run takes characters (29700 of them)", NULL);
+}
+
 int main(void)
 {
 	test_simple_commands();
@@ -811,6 +878,7 @@ int main(void)
 	test_sys();
 	test_fuzz();
 	test_parse_fast_path();
+	test_parse_run();
 	printf("%d passed, %d failed\n", passed, failed);
 	return failed ? 1 : 0;
 }
