@@ -249,7 +249,7 @@ sg_event_t sg_parse_slow(sg_parser_t *p, uint8_t c)
 	return fail(p, SG_ERR_HEX);  /* not a hex digit where a byte is expected */
 }
 
-__attribute__((noinline)) uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t head)
+uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t head)
 {
 	uint8_t len = p->len;
 	uint8_t state = p->state;

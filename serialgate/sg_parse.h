@@ -168,6 +168,7 @@ static inline sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
  * digits, a frame's S and its P) costs ~15 cycles a character here
  * against ~70 taken one at a time from the main loop, where at 460800
  * baud a character lasts 160 (docs/protocol.md, The line). */
-uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t head);
+uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t head)
+	__attribute__((noinline));  /* one copy: front_poll()'s paths would each inline it */
 
 #endif
