@@ -171,7 +171,7 @@ void sg_parse_init(sg_parser_t *p)
 	p->lost_info = 0;
 }
 
-sg_event_t sg_parse_slow(sg_parser_t *p, uint8_t c)
+sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 {
 	if (p->lost_info) {
 		return lost_run(p, c);
@@ -254,9 +254,10 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 	uint8_t len = p->len;
 	uint8_t state = p->state;
 
-	/* the inline front's conditions that no character of the run changes:
-	 * not in a lost run's record; at most the line's room */
-	if (p->lost_info || len >= SG_LINE_MAX) {
+	/* not in a lost run's record, within the line's room, a state the
+	 * run takes characters in (it may leave it only where a byte or a
+	 * frame ends: the state is looked at there) */
+	if (p->lost_info || len >= SG_LINE_MAX || !sg_parse_in_run(p)) {
 		return tail;
 	}
 	uint8_t n = (uint8_t)(head - tail);
@@ -268,9 +269,6 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 	for (; n; n--, tail++) {
 		uint8_t c = ring[tail];
 
-		if ((uint8_t)(state - SG_ST_ARGS) > SG_ST_DONE - SG_ST_ARGS) {
-			break;
-		}
 		if (c == ' ') {
 			if (hi != SG_NO_DIGIT) {
 				break;
@@ -308,6 +306,10 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 				/* it uses neither len nor hi */
 				sg_parse_byte(p, b);
 				state = p->state;
+				if (!sg_parse_in_run(p)) {
+					tail++;  /* taken: an error ends the run */
+					break;
+				}
 			}
 			continue;
 		}
@@ -321,6 +323,10 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 		} else if (c == 's') {
 			sg_parse_frame(p);
 			state = p->state;
+			if (!sg_parse_in_run(p)) {
+				tail++;  /* taken: no room for the frame */
+				break;
+			}
 		} else {
 			break;
 		}
