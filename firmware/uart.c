@@ -151,16 +151,17 @@ void front_rx_poll(uint8_t most)
 /* The receive interrupt at 460800 has 160 cycles a character, the
  * parser's share and the reply's included; the whole handler's register
  * saves alone cost ~60. Its fast path takes the common character with
- * four registers (the vector runs only while UDR holds a character: no
- * other code calls it): one inside a line, or its CR or LF (sg_rx.h's rule), the ring not losing
- * and with room, the M32-D's hold empty. Anything else goes to
+ * three registers (the vector runs only while UDR holds a character: no
+ * other code calls it): one inside a line, a request's first letter, a
+ * line's CR or LF (sg_rx.h's rule), the ring not losing and with room, the
+ * M32-D's hold empty. Anything else goes to
  * uart_rx_all(), which on the M32-D finds a character already read from
  * UDR in the hold, first in line; on the M128-S such a character goes to
  * uart_received() with the call-clobbered registers saved. A rate found
  * by autobaud needs uart_line_rx() on every character: uart_rx_all(). */
 /* The fast path's registers back, SREG last, as they were. */
 #define RX_FAST_RESTORE \
-	"pop r31\n\tpop r30\n\tpop r25\n\tpop r24\n\tout __SREG__, r24\n\tpop r24\n\t"
+	"pop r31\n\tpop r30\n\tpop r24\n\tout __SREG__, r24\n\tpop r24\n\t"
 
 ISR(MCU_UART_RX_vect, ISR_NAKED)
 {
@@ -169,57 +170,92 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"push r24\n\t"
 		"in r24, __SREG__\n\t"
 		"push r24\n\t"
-		"push r25\n\t"
 		"push r30\n\t"
 		"push r31\n\t"
 #ifdef BOARD_RX_BURST
-		"lds r24, %[hhead]\n\t"
-		"lds r25, %[htail]\n\t"
-		"cp r24, r25\n\t"
-		"brne 2f\n\t"
+		"lds r30, %[hhead]\n\t"
+		"lds r31, %[htail]\n\t"
+		"cp r30, r31\n\t"
+		"brne 10f\n\t"
 #endif
 		"lds r24, %[line]\n\t"
 		"cpi r24, %[plain]\n\t"
-		"brne 2f\n\t"
-		"lds r24, %[head]\n\t"
-		"lds r25, %[tail]\n\t"
-		"sub r25, r24\n\t"
-		"subi r25, 1\n\t"
-		"cpi r25, %[record] + 1\n\t"
-		"brlo 2f\n\t"
-		"lds r25, %[udr]\n\t"
-		"ldi r31, 0\n\t"
-		"tst r25\n\t"
+		"brne 8f\n\t"
+		"lds r30, %[head]\n\t"
+		"lds r31, %[tail]\n\t"
+		"sub r31, r30\n\t"
+		"subi r31, 1\n\t"
+		"cpi r31, %[record] + 1\n\t"
+		"brlo 10f\n\t"
+		"lds r24, %[udr]\n\t"
+		"tst r24\n\t"
 		"brmi 3f\n\t"
-		"cpi r25, 0x20\n\t"
+		"cpi r24, 0x20\n\t"
 		"brsh 6f\n\t"
-		"cpi r25, '\\n'\n\t"
+		"cpi r24, '\\n'\n\t"
 		"breq 5f\n\t"
-		"cpi r25, '\\r'\n\t"
+		"cpi r24, '\\r'\n\t"
 		"brne 3f\n"
 		"5:\n\t"
+		"ldi r31, 0\n\t"
 		"sts %[line], r31\n"	/* the line's end: a new line next */
 		"6:\n\t"
-		"mov r30, r24\n\t"
+		/* buf[head] = c; head + 1 (r30 = head + lo8(buf), less lo8(buf) - 1) */
+		"ldi r31, 0\n\t"
 		"subi r30, lo8(-(%[buf]))\n\t"
 		"sbci r31, hi8(-(%[buf]))\n\t"
-		"st Z, r25\n\t"
-		"subi r24, 0xFF\n\t"
-		"sts %[head], r24\n"
+		"st Z, r24\n\t"
+		"subi r30, lo8(%[buf] - 1)\n\t"
+		"sts %[head], r30\n"
 		"1:\n\t"
 		RX_FAST_RESTORE
 		"reti\n"
+		"10:\n\t"
+		"rjmp 2f\n"
+		"8:\n\t"
+		/* a new line (line 0, nothing being lost): its first
+		 * character, a request's letter, makes it plain (sg_rx.h's
+		 * rule); a space, a '#', a mark's range: uart_rx_all() */
+		"tst r24\n\t"
+		"brne 2f\n\t"
+		"lds r24, %[losing]\n\t"
+		"tst r24\n\t"
+		"brne 2f\n\t"
+		"lds r30, %[head]\n\t"
+		"lds r31, %[tail]\n\t"
+		"sub r31, r30\n\t"
+		"subi r31, 1\n\t"
+		"cpi r31, %[record] + 1\n\t"
+		"brlo 2f\n\t"
+		"lds r24, %[udr]\n\t"
+		"cpi r24, 0x21\n\t"
+		"brlo 9f\n\t"
+		"tst r24\n\t"
+		"brmi 3f\n\t"
+		"cpi r24, '#'\n\t"
+		"breq 3f\n\t"
+		"ldi r31, %[plain]\n\t"
+		"sts %[line], r31\n\t"
+		"rjmp 6b\n"
+		"9:\n\t"
+		/* an empty line's CR or LF: as is, the line stays 0 */
+		"cpi r24, '\\n'\n\t"
+		"breq 6b\n\t"
+		"cpi r24, '\\r'\n\t"
+		"breq 6b\n\t"
+		"rjmp 3f\n"
 #ifdef BOARD_RX_BURST
 		"3:\n\t"
 		/* into the empty hold: uart_rx_all() takes it first */
-		"lds r24, %[hhead]\n\t"
-		"mov r30, r24\n\t"
-		"andi r30, %[hmask]\n\t"	/* r31 is 0 */
+		"lds r30, %[hhead]\n\t"
+		"andi r30, %[hmask]\n\t"
+		"ldi r31, 0\n\t"
 		"subi r30, lo8(-(%[hbuf]))\n\t"
 		"sbci r31, hi8(-(%[hbuf]))\n\t"
-		"st Z, r25\n\t"
-		"subi r24, 0xFF\n\t"
-		"sts %[hhead], r24\n"
+		"st Z, r24\n\t"
+		"lds r30, %[hhead]\n\t"
+		"subi r30, 0xFF\n\t"
+		"sts %[hhead], r30\n"
 #endif
 		"2:\n\t"
 		RX_FAST_RESTORE
@@ -235,12 +271,13 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"push r21\n\t"
 		"push r22\n\t"
 		"push r23\n\t"
+		"push r25\n\t"
 		"push r26\n\t"
 		"push r27\n\t"
-		"mov r24, r25\n\t"
 		"%~call %x[recv]\n\t"
 		"pop r27\n\t"
 		"pop r26\n\t"
+		"pop r25\n\t"
 		"pop r23\n\t"
 		"pop r22\n\t"
 		"pop r21\n\t"
@@ -253,7 +290,8 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 #endif
 		: : [udr] "n" (_SFR_MEM_ADDR(MCU_UDR)), [line] "i" (&sg_rx.line),
 		[plain] "n" (SG_RX_LINE_PLAIN), [head] "i" (&sg_rx.head), [tail] "i" (&sg_rx.tail),
-		[record] "n" (SG_RX_RECORD), [buf] "i" (sg_rx.buf), [all] "i" (uart_rx_all),
+		[losing] "i" (&sg_rx.losing), [record] "n" (SG_RX_RECORD), [buf] "i" (sg_rx.buf),
+		[all] "i" (uart_rx_all),
 #ifdef BOARD_RX_BURST
 		[hhead] "i" (&held.head), [htail] "i" (&held.tail), [hbuf] "i" (held.c),
 		[hmask] "n" (UART_HOLD - 1)

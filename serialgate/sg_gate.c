@@ -40,12 +40,12 @@ void front_poll(void)
 	 * cycles: nothing to autobaud's watch of the pin) before the idle
 	 * work: a request's end is taken within a few cycles of its
 	 * arrival, not after the rest of an idle round. */
-	int16_t c;
+	uint8_t tail;
 	uint8_t spin = 16;
 	do {
-		c = sg_rx_get();
-	} while (c < 0 && --spin);
-	if (c < 0) {
+		tail = sg_rx.tail;
+	} while (tail == sg_rx.head && --spin);
+	if (tail == sg_rx.head) {
 		uart_rx_flush();
 		if (!sg_rx_losing()) {
 			if (uart_line_poll()) {
@@ -66,12 +66,25 @@ void front_poll(void)
 		ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 			sg_rx_close();
 		}
-		c = sg_rx_get();
-		if (c < 0) {
+		if (tail == sg_rx.head) {
 			return;
 		}
 	}
-	sg_event_t ev = sg_parse_char(&parser, (uint8_t)c);
+	uint8_t c = sg_rx.buf[tail];
+	/* c >= ' ' first: a line's end (the latency's character) goes to
+	 * sg_parse_char() at once. Inside a request, what the ring holds of
+	 * its common run (spaces, digits, a frame's S and P) is taken in one
+	 * loop (sg_parse_run()); the character it stops at, or anything else,
+	 * goes through sg_parse_char(). */
+	if (c >= ' ' && sg_parse_in_run(&parser)) {
+		uint8_t to = sg_parse_run(&parser, sg_rx.buf, tail, sg_rx.head);
+		if (to != tail) {
+			sg_rx.tail = to;
+			return;
+		}
+	}
+	sg_rx.tail = (uint8_t)(tail + 1);
+	sg_event_t ev = sg_parse_char(&parser, c);
 	if (ev == SG_REQUEST) {
 		SYS_HEARD();  /* any request line keeps the link alive */
 		if (parser.err == SG_OK) {

@@ -171,7 +171,7 @@ void sg_parse_init(sg_parser_t *p)
 	p->lost_info = 0;
 }
 
-sg_event_t sg_parse_slow(sg_parser_t *p, uint8_t c)
+sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 {
 	if (p->lost_info) {
 		return lost_run(p, c);
@@ -247,4 +247,92 @@ sg_event_t sg_parse_slow(sg_parser_t *p, uint8_t c)
 		return fail(p, SG_ERR_DATA);  /* a read frame without its count */
 	}
 	return fail(p, SG_ERR_HEX);  /* not a hex digit where a byte is expected */
+}
+
+uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t head)
+{
+	uint8_t len = p->len;
+	uint8_t state = p->state;
+
+	/* not in a lost run's record, within the line's room, a state the
+	 * run takes characters in (it may leave it only where a byte or a
+	 * frame ends: the state is looked at there) */
+	if (p->lost_info || len >= SG_LINE_MAX || !sg_parse_in_run(p)) {
+		return tail;
+	}
+	uint8_t n = (uint8_t)(head - tail);
+	if (n > (uint8_t)(SG_LINE_MAX - len)) {
+		n = (uint8_t)(SG_LINE_MAX - len);
+	}
+	uint8_t hi = p->hi;
+	uint8_t from = tail;
+	for (; n; n--, tail++) {
+		uint8_t c = ring[tail];
+
+		if (c == ' ') {
+			if (hi != SG_NO_DIGIT) {
+				break;
+			}
+			continue;
+		}
+		uint8_t d = sg_hex_value(c);  /* SG_NO_DIGIT for a control character or a mark */
+		if (d != SG_NO_DIGIT) {
+			if (state > SG_ST_RCOUNT) {
+				break;
+			}
+			if (hi == SG_NO_DIGIT) {
+				hi = d;
+				continue;
+			}
+			uint8_t b = (uint8_t)(hi << 4 | d);
+			uint8_t at = p->nbytes;
+
+			hi = SG_NO_DIGIT;
+			/* sg_parse_byte()'s common cases in place: a write frame's
+			 * data byte, a frame's address */
+			if (state == SG_ST_WDATA && at < SG_BUF_SIZE && p->reply_len < SG_REPLY_MAX) {
+				p->buf[at] = b;
+				p->nbytes = (uint8_t)(at + 1);
+				p->buf[p->frame + 1]++;
+				p->reply_len++;
+			} else if (state == SG_ST_ADDR) {
+				at = p->frame;
+				p->buf[at] = b;
+				p->buf[at + 1] = 0;
+				p->nbytes = (uint8_t)(at + 2);
+				state = (b & 1) ? SG_ST_RCOUNT : SG_ST_WDATA;
+				p->state = state;
+			} else {
+				/* it uses neither len nor hi */
+				sg_parse_byte(p, b);
+				state = p->state;
+				if (!sg_parse_in_run(p)) {
+					tail++;  /* taken: an error ends the run */
+					break;
+				}
+			}
+			continue;
+		}
+		if (hi != SG_NO_DIGIT || (state != SG_ST_WDATA && state != SG_ST_RDONE)) {
+			break;
+		}
+		c |= 0x20;
+		if (c == 'p') {
+			state = SG_ST_DONE;
+			p->state = state;
+		} else if (c == 's') {
+			sg_parse_frame(p);
+			state = p->state;
+			if (!sg_parse_in_run(p)) {
+				tail++;  /* taken: no room for the frame */
+				break;
+			}
+		} else {
+			break;
+		}
+	}
+	/* each character taken is one of the line's */
+	p->len = (uint8_t)(len + (uint8_t)(tail - from));
+	p->hi = hi;
+	return tail;
 }

@@ -8,6 +8,7 @@
 #ifndef SG_PARSE_H
 #define SG_PARSE_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 /* The protocol's error codes (docs/protocol.md): X(name, code, when). The
@@ -103,8 +104,10 @@ static inline uint8_t sg_hex_value(uint8_t c)
 	return c <= 5 ? (uint8_t)(c + 10) : SG_NO_DIGIT;
 }
 
-/* Feeds one character, the whole rule. */
-sg_event_t sg_parse_slow(sg_parser_t *p, uint8_t c);
+/* Feeds one character. After SG_REQUEST, `err` holds the error to reply (or
+ * SG_OK), `cmd`, `nbytes` and `buf` the request; the parser is ready for the
+ * next line. */
+sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c);
 
 /* A byte complete in a state that takes one (SG_ST_ARGS to SG_ST_RCOUNT). */
 sg_event_t sg_parse_byte(sg_parser_t *p, uint8_t b);
@@ -112,51 +115,23 @@ sg_event_t sg_parse_byte(sg_parser_t *p, uint8_t b);
 /* An I2C frame begins (its S). */
 sg_event_t sg_parse_frame(sg_parser_t *p);
 
-/* Feeds one character. After SG_REQUEST, `err` holds the error to reply (or
- * SG_OK), `cmd`, `nbytes` and `buf` the request; the parser is ready for the
- * next line. The common characters inside a request, the line short (a
- * space between bytes, a byte's digit, a frame's S or P after a byte), are
- * taken here in a few cycles,
- * without sg_parse_slow()'s call: what it does with them
- * (tests/unit's test_parse_fast_path checks both agree). At 460800 baud
- * the parser has a share of the 160 cycles a character lasts. */
-static inline sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
+/* The states sg_parse_run() takes characters in (a command's arguments, an
+ * I2C request's frames, a complete command's trailing spaces). */
+static inline bool sg_parse_in_run(const sg_parser_t *p)
 {
-	/* c >= ' ' first: a line's end (the latency's character) is out at once */
-	if (c >= ' ' && (uint8_t)(p->state - SG_ST_ARGS) <= SG_ST_DONE - SG_ST_ARGS &&
-	    p->len < SG_LINE_MAX && !p->lost_info) {
-		uint8_t hi = p->hi;
-
-		if (c == ' ' && hi == SG_NO_DIGIT) {
-			p->len++;
-			return SG_MORE;
-		}
-		uint8_t d = sg_hex_value(c);
-		if (d != SG_NO_DIGIT && p->state <= SG_ST_RCOUNT) {
-			p->len++;
-			if (hi == SG_NO_DIGIT) {
-				p->hi = d;
-				return SG_MORE;
-			}
-			p->hi = SG_NO_DIGIT;
-			return sg_parse_byte(p, (uint8_t)(hi << 4 | d));
-		}
-		/* a frame's end: the next frame's S, or the request's P */
-		if (hi == SG_NO_DIGIT && (p->state == SG_ST_WDATA || p->state == SG_ST_RDONE)) {
-			uint8_t lc = c | 0x20;
-
-			if (lc == 'p') {
-				p->len++;
-				p->state = SG_ST_DONE;
-				return SG_MORE;
-			}
-			if (lc == 's') {
-				p->len++;
-				return sg_parse_frame(p);
-			}
-		}
-	}
-	return sg_parse_slow(p, c);
+	return (uint8_t)(p->state - SG_ST_ARGS) <= SG_ST_DONE - SG_ST_ARGS;
 }
+
+/* Feeds the run of characters at ring[tail], ring[tail + 1], ... (indices
+ * wrapping at 256) up to `head` that keep the parser in a request's common
+ * path: a space between bytes, a byte's digits, a frame's S or P after a
+ * byte, the line short; each of them SG_MORE. Returns the index of the
+ * first character it did not take (`head` if it took all): that one is
+ * for sg_parse_char(). In one loop with the line's length and the digit in
+ * progress in registers, a write frame's data byte and a frame's address
+ * stored in place: ~40 cycles a character, where at 460800 baud a
+ * character lasts 160 (docs/protocol.md, The line); sg_parse_char()'s
+ * whole rule does the same with them (tests/unit's test_parse_run). */
+uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t head);
 
 #endif

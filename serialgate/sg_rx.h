@@ -45,9 +45,11 @@ struct sg_rx {
 	uint8_t line;              /* what is known of the line coming in */
 };
 
-/* The ring's state, open for one reader: the receive interrupt's fast path
- * (firmware/uart.c), which stores a character as sg_rx_put() would with a
- * few registers. Its rule: while line == SG_RX_LINE_PLAIN (a line started,
+/* The ring's state, open for two: the main loop's parser takes runs of
+ * characters straight from buf (sg_parse_run() in front_poll(), tail moved
+ * past them, as sg_rx_get() would one at a time), and the receive
+ * interrupt's fast path (firmware/uart.c) stores a character as sg_rx_put()
+ * would with a few registers. Its rule: while line == SG_RX_LINE_PLAIN (a line started,
  * something but spaces in it, not a comment, nothing lost; never so while
  * characters are being lost: sg_rx.c keeps that) and
  * (uint8_t)(tail - head - 1) > SG_RX_RECORD, a character from ' ' to 0x7F

@@ -754,45 +754,71 @@ static void test_fuzz(void)
 	check(bad == 0, "fuzz", NULL);
 }
 
-/* sg_parse_char()'s inline path for the common characters (sg_parse.h)
- * does what sg_parse_slow() does with them: two parsers fed the same random
- * lines, one through each, agree after every character (event and state,
- * the request bytes included). The alphabet leans to a request's own
- * characters, with the receive ring's lost-run marks and long lines. */
-static void test_parse_fast_path(void)
+/* sg_parse_run() takes from the ring only characters that sg_parse_char()
+ * answers SG_MORE, and leaves the parser as sg_parse_char() character by
+ * character does; the character it stops at then goes through
+ * sg_parse_char(), as in front_poll(). Characters arrive a few
+ * at a time (head moves in steps), so runs end anywhere: inside a byte,
+ * at the line's limit, at the ring's wrap. */
+static void test_parse_run(void)
 {
-	static const char alphabet[] = "SSPp  0123456789ABCDEFabcdef  0A1B  Gz#VLC\r\n\x80\x81\x82";
+	static const char alphabet[] = "SSPp    0123456789ABCDEFabcdef  0A1B  Gz#VLC\r\n\x80\x81\x82";
+	static const char prefix[] = "S 20 01 02 03 04 05 06 07 08 09 0A 0B 0C 0D 0E 0F 10 11 12 "
+		"13 14 15 16 17 18 19 1A 1B 1C 1D 1E 1F 20 21 22 23 24 25 26 27 28";
 	static sg_parser_t fast, slow;
-	uint32_t seed = 777;
+	static uint8_t ring[256];
+	uint32_t seed = 4242;
 	int bad = 0;
+	unsigned taken = 0;
 
-	for (int round = 0; round < 4000 && !bad; round++) {
-		/* every other round a request near the line's limit first:
-		 * its characters then meet the limit (128) */
-		static const char prefix[] = "S 20 01 02 03 04 05 06 07 08 09 0A 0B 0C 0D 0E 0F 10 11 12 "
-			"13 14 15 16 17 18 19 1A 1B 1C 1D 1E 1F 20 21 22 23 24 25 26 27 28";
+	for (int round = 0; round < 3000 && !bad; round++) {
 		size_t skip = (round & 1) ? (size_t)(round / 2 % 8) : sizeof prefix - 1;
+		uint8_t head = (uint8_t)(round * 37), tail = head;
 		sg_parse_init(&fast);
 		sg_parse_init(&slow);
-		size_t len = 1 + (size_t)(round % 400);
-		for (size_t i = 0; i < len && !bad; i++) {
+		size_t len = 1 + (size_t)(round % 400), i = 0;
+		while ((i < len || tail != head) && !bad) {
+			/* 0..5 more characters arrive */
 			seed ^= seed << 13;
 			seed ^= seed >> 17;
 			seed ^= seed << 5;
-			uint8_t c = (uint8_t)(skip + i < sizeof prefix - 1 ? prefix[skip + i] :
-					      alphabet[seed % (sizeof alphabet - 1)]);
-			sg_event_t a = sg_parse_char(&fast, c);
-			sg_event_t b = sg_parse_slow(&slow, c);
-			if (a != b || memcmp(&fast, &slow, sizeof fast) != 0) {
-				char what[80];
-				snprintf(what, sizeof what, "round %d, character %u (0x%02X)", round,
-					 (unsigned)i, c);
-				check(0, "parse fast path", what);
+			for (unsigned k = seed % 6; k && i < len; k--, i++) {
+				seed ^= seed << 13;
+				seed ^= seed >> 17;
+				seed ^= seed << 5;
+				ring[head++] = (uint8_t)(skip + i < sizeof prefix - 1 ? prefix[skip + i] :
+							 alphabet[seed % (sizeof alphabet - 1)]);
+			}
+			if (tail == head) {
+				continue;
+			}
+			uint8_t to = sg_parse_run(&fast, ring, tail, head);
+			for (; tail != to && !bad; tail++) {
+				taken++;
+				if (sg_parse_char(&slow, ring[tail]) != SG_MORE) {
+					check(0, "parse run", "took a character that is not SG_MORE");
+					bad = 1;
+				}
+			}
+			if (!bad && memcmp(&fast, &slow, sizeof fast) != 0) {
+				check(0, "parse run", "the parser after a run differs");
 				bad = 1;
+			}
+			if (!bad && tail != head) {
+				/* the character it stopped at, as front_poll() does */
+				uint8_t c = ring[tail++];
+				if (sg_parse_char(&fast, c) != sg_parse_char(&slow, c) ||
+				    memcmp(&fast, &slow, sizeof fast) != 0) {
+					char what[80];
+					snprintf(what, sizeof what, "round %d, character 0x%02X", round, c);
+					check(0, "parse run then char", what);
+					bad = 1;
+				}
 			}
 		}
 	}
-	check(!bad, "parse fast path agrees", NULL);
+	check(!bad, "parse run agrees", NULL);
+	check(taken > 20000, "parse run takes characters (29700 of them)", NULL);
 }
 
 int main(void)
@@ -810,7 +836,7 @@ int main(void)
 	test_registers();
 	test_sys();
 	test_fuzz();
-	test_parse_fast_path();
+	test_parse_run();
 	printf("%d passed, %d failed\n", passed, failed);
 	return failed ? 1 : 0;
 }
