@@ -1116,8 +1116,8 @@ static void client_wait_over(control_t *c, control_client_t *cl)
 	uint64_t now = c->avr->cycle;
 
 	/* a `wait i2c` whose bytes came is answered even at its bound: they
-	 * came in the quantum that reached it (sim_main.c runs a quantum at a
-	 * time while bytes are due) */
+	 * came in the quantum that reached it (world_run stops at the end of
+	 * the quantum they came in) */
 	if ((!cl->wait.n || due) && now < cl->wait.until) {
 		return;
 	}
