@@ -11,6 +11,7 @@
 #include "periph/io_hook.h"
 #include "periph/sim_twi.h"
 #include "periph/avr_libc_twi.h"
+#include "simavr16/interrupt.h"
 
 /* TWCR bits (the datasheet's names; avr-libc has them only per MCU). */
 enum {
@@ -47,7 +48,7 @@ static void twi_sync(sim_twi_t *t)
 			avr_raise_interrupt(t->avr, v);
 		}
 	} else if (v->pending) {
-		avr_clear_interrupt(t->avr, v);
+		simavr16_withdraw_interrupt(t->avr, v);
 	}
 }
 
