@@ -365,11 +365,8 @@ def ping_pong_run(board, request, starts):
         ends = [ctl.rx(at, request) for at in starts]
         with serial.Serial(sim.port, 115200, timeout=30) as port:
             replies = read_replies(port, len(starts))
-        tx = [e.cycle for e in parse_trace(sim.trace_text()) if e.kind == "uart tx"]
-    done, i = [], 0
-    for reply in replies:
-        i += len(reply)
-        done.append(tx[i - 1] + CYCLES_PER_BYTE)
+        sent = sent_lines(parse_trace(sim.trace_text()), last=True)
+    done = [at + CYCLES_PER_BYTE for at, _ in sent[:len(replies)]]
     return ends, done, replies
 
 
@@ -1033,14 +1030,15 @@ def bench_burst(board, rate):
         start = ctl.time() + F_CPU // 2
         ctl.rx(start, BURST_REQUEST * BURST_COUNT)
         ctl.wait(start - ctl.time() + 4 * BURST_COUNT * len(BURST_REQUEST) * byte)
-        tx = [e for e in sim.trace_events(kinds=["uart tx"]) if e.cycle >= start]
-        sent = bytes(int(e.fields[0], 16) for e in tx)
-        lines = sent.split(b"\r\n")
-        if len(lines) != BURST_COUNT + 1 or lines[-1] or len(set(lines[:-1])) != 1 \
-                or not lines[0].startswith(b"SWAASR"):
-            return {"error": "%s at %d: the burst's replies %r" % (board, rate, sent[:80])}
-        reply = len(lines[0]) + 2
-    return (tx[-1].cycle + byte - start,
+        tx = sim.trace_events(kinds=["uart tx"])
+        lines = sent_lines(tx, start, last=True)
+        texts = [text for _, text in lines]
+        # every reply whole and the same, the last byte sent the last one's
+        if len(lines) != BURST_COUNT or len(set(texts)) != 1 \
+                or not texts[0].startswith("SWAASR") or lines[-1][0] != tx[-1].cycle:
+            return {"error": "%s at %d: the burst's replies %r" % (board, rate, texts[:4])}
+        reply = len(texts[0]) + 2
+    return (lines[-1][0] + byte - start,
             (BURST_COUNT * len(BURST_REQUEST) + reply) * byte)
 
 

@@ -67,19 +67,31 @@ def parse_trace(text: str) -> List[TraceEvent]:
 SlaveSpec = Union[Tuple[str, int], Tuple[str, int, Union[str, Path, None]]]
 
 
-def sent_lines(events: Iterable[TraceEvent], since: int = 0) -> List[Tuple[int, str]]:
-    """The lines the gateway sent (its `uart tx` trace events) from cycle
-    `since` on, as (the cycle of the line's first byte, the line without its
-    CR LF)."""
+#: The trace's serial events and how their lines end: the gateway's replies
+#: (`uart tx`) with CR LF, the PC's requests (`uart rx`) with LF.
+_LINE_ENDS = {"uart tx": b"\r\n", "uart rx": b"\n"}
+
+
+def sent_lines(events: Iterable[TraceEvent], since: int = 0, kind: str = "uart tx",
+               last: bool = False) -> List[Tuple[int, str]]:
+    """The lines on the gateway's serial line from cycle `since` on: with
+    `kind` "uart tx" (the default) those the gateway sent, each ended by CR
+    LF; with "uart rx" those it received, each ended by LF. As (the cycle
+    of the line's first byte, or with `last` of its last, the line without
+    its end); bytes after the last end are no line yet."""
+    if kind not in _LINE_ENDS:
+        raise ValueError("kind %r: one of %s" % (kind, ", ".join(map(repr, _LINE_ENDS))))
+    end = _LINE_ENDS[kind]
     out, cur, first = [], bytearray(), 0
     for e in events:
-        if e.kind != "uart tx" or e.cycle < since:
+        if e.kind != kind or e.cycle < since:
             continue
         if not cur:
             first = e.cycle
         cur.append(int(e.fields[0], 16))
-        if cur.endswith(b"\r\n"):
-            out.append((first, bytes(cur[:-2]).decode("ascii", "replace")))
+        if cur.endswith(end):
+            out.append((e.cycle if last else first,
+                        bytes(cur[:-len(end)]).decode("ascii", "replace")))
             cur = bytearray()
     return out
 

@@ -382,9 +382,6 @@ static int req_wait_i2c(control_req_ctx_t *q)
 	twi_bus_t *bus = q->c->bus;
 	uint64_t n, within;
 
-	if (strcasecmp(q->argv[1], "i2c")) {
-		return CONTROL_WRONG;
-	}
 	if (q->argc != 4 || parse_u64(q->argv[2], &n) < 0 || n < 1 || n > CONTROL_WAIT_BYTES ||
 	    parse_u64(q->argv[3], &within) < 0 || within < 1 || within > CONTROL_WAIT_MAX) {
 		reply_printf(q->r, "ERR wait i2c N WITHIN: N bytes 1..%u, WITHIN cycles 1..%" PRIu64
@@ -400,12 +397,16 @@ static int req_wait_i2c(control_req_ctx_t *q)
 	return 1;
 }
 
+/* `wait N`, or `wait i2c ...` (any count: its own error names the form) */
 static int req_wait(control_req_ctx_t *q)
 {
 	uint64_t u;
 
 	if (!strcasecmp(q->argv[1], "i2c")) {
-		return req_wait_i2c(q);		/* `wait i2c` short of its arguments */
+		return req_wait_i2c(q);
+	}
+	if (q->argc != 2) {
+		return CONTROL_WRONG;
 	}
 	if (parse_u64(q->argv[1], &u) < 0 || u > CONTROL_WAIT_MAX) {
 		reply_printf(q->r, "ERR wait N: N cycles, decimal");
@@ -817,10 +818,9 @@ enum {
 	CONTROL_PART,			/* @ADDR names a part on the I2C bus, not a board */
 };
 
-/* The requests: name, arguments (the help line), the argument counts it
- * takes (the name included), which boards, the handler. The forms of one
- * request (`wait N`, `wait i2c N WITHIN`) are entries of one name, next to
- * each other: the argument count picks the form. */
+/* The requests: name, arguments (the help line; a request of two forms
+ * names the second after a " | ", as the help separates requests), the
+ * argument counts it takes (the name included), which boards, the handler. */
 typedef struct control_req_t {
 	const char *name;
 	const char *args;
@@ -831,8 +831,7 @@ typedef struct control_req_t {
 
 static const control_req_t control_reqs[] = {
 	{ "time", "", 1, 1, CONTROL_ANY_BOARD, req_time },
-	{ "wait", "N", 2, 2, CONTROL_ANY_BOARD, req_wait },
-	{ "wait", "i2c N WITHIN", 3, 4, CONTROL_ANY_BOARD, req_wait_i2c },
+	{ "wait", "N | wait i2c N WITHIN", 2, 4, CONTROL_ANY_BOARD, req_wait },
 	{ "pin", "P", 2, 2, CONTROL_NAMES_BOARD, req_pin },
 	{ "drive", "P 0|1|z", 3, 3, CONTROL_NAMES_BOARD, req_pin },
 	{ "adc", "CH [MV]", 2, 3, CONTROL_NAMES_BOARD, req_adc },
@@ -857,19 +856,6 @@ static const control_req_t control_reqs[] = {
 };
 
 #define CONTROL_NREQS ((int)(sizeof(control_reqs) / sizeof(control_reqs[0])))
-
-/* The form of request E (its first entry) that takes ARGC arguments, or E
- * when none does. */
-static const control_req_t *control_req_form(const control_req_t *e, int argc)
-{
-	for (const control_req_t *f = e; f < control_reqs + CONTROL_NREQS &&
-	     !strcasecmp(f->name, e->name); f++) {
-		if (argc >= f->min_argc && argc <= f->max_argc) {
-			return f;
-		}
-	}
-	return e;
-}
 
 static void control_help(reply_t *r)
 {
@@ -968,9 +954,6 @@ int control_request(control_t *c, const char *line, char **out, size_t *len,
 	}
 	q.argc = argc;
 	q.argv = argv;
-	if (e) {
-		e = control_req_form(e, argc);
-	}
 	if (e && argc >= e->min_argc && argc <= e->max_argc) {
 		if (e->boards == CONTROL_GATEWAY && q.cb != &c->board[0]) {
 			reply_printf(&r, "ERR %s: only the gateway's serial line reaches the PC",
@@ -1116,8 +1099,8 @@ static void client_wait_over(control_t *c, control_client_t *cl)
 	uint64_t now = c->avr->cycle;
 
 	/* a `wait i2c` whose bytes came is answered even at its bound: they
-	 * came in the quantum that reached it (sim_main.c runs a quantum at a
-	 * time while bytes are due) */
+	 * came in the quantum that reached it (world_run stops at the end of
+	 * the quantum they came in) */
 	if ((!cl->wait.n || due) && now < cl->wait.until) {
 		return;
 	}

@@ -166,24 +166,6 @@ static int sim_parse_addr(const char *s, uint8_t *out)
 	return 0;
 }
 
-/* Run the world to TARGET, or stop after the quantum in which the bus's
- * master has clocked DUE more bytes (a control client's `wait i2c`): a
- * quantum at a time then, so that wait ends within a quantum of its byte;
- * a run that no client waits on bytes for goes on unchecked. As
- * world_run(). */
-static int sim_run_to_bytes(world_t *w, uint64_t target, uint32_t due)
-{
-	uint32_t from = w->bus.bytes;
-	int rc = 0;
-
-	while (!rc && w->now < target && w->bus.bytes - from < due) {
-		uint64_t end = w->now + WORLD_QUANTUM;
-
-		rc = world_run(w, end < target ? end : target);
-	}
-	return rc;
-}
-
 /* Run about a millisecond of simulated time and hand the gateway's output
  * to the pty. 0, or 1 when a firmware crashed or stopped for good. */
 static int sim_batch(sim_t *sim)
@@ -191,14 +173,14 @@ static int sim_batch(sim_t *sim)
 	world_t *w = &sim->world;
 	uint64_t target = world_cycle(w) + SIM_BATCH_CYCLES;
 	uint64_t deadline = control_deadline(&sim->control);
-	uint32_t due = control_bytes_due(&sim->control);
 	int rc;
 
 	/* a control client's `wait` ends near its cycle, not a batch later */
 	if (deadline < target) {
 		target = deadline;
 	}
-	rc = due ? sim_run_to_bytes(w, target, due) : world_run(w, target);
+	/* ... and a `wait i2c` at the quantum its last byte came in */
+	rc = world_run(w, target, control_bytes_due(&sim->control));
 	pty_flush(&sim->pty);
 	sim_check_twar(sim);
 	vcd_flush(&sim->vcd, world_cycle(w), 0);

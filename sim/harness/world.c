@@ -36,22 +36,31 @@ static int world_state_dead(int state)
 	return state == cpu_Done || state == cpu_Crashed;
 }
 
+/* Have BYTES bus bytes come since the count was FROM (world_run)? */
+static int world_bytes_came(const world_t *w, uint32_t from, uint32_t bytes)
+{
+	return bytes && w->bus.bytes - from >= bytes;
+}
+
 /* One board alone needs no lock-step: it runs to TARGET at once, parked
- * (park.h) wherever it idles, tried every WORLD_QUANTUM cycles. */
-static int world_run_one(world_t *w, uint64_t target)
+ * (park.h) wherever it idles, tried every WORLD_QUANTUM cycles. Waiting for
+ * BYTES, it runs a quantum at a time, parked or not, and stops after the
+ * one they came in. */
+static int world_run_one(world_t *w, uint64_t target, uint32_t bytes)
 {
 	avr_t *avr = w->boards[0]->avr;
 	park_t *park = &w->park[0];
+	uint32_t from = w->bus.bytes;
 
-	while (avr->cycle < target) {
+	while (avr->cycle < target && !world_bytes_came(w, from, bytes)) {
 		uint64_t end = avr->cycle + WORLD_QUANTUM;
 		int state;
 
-		if (park->parked && park_stays(park, avr, target)) {
-			break;
-		}
-		if (w->no_park || end > target) {
+		if ((w->no_park && !bytes) || end > target) {
 			end = target;
+		}
+		if (park->parked && park_stays(park, avr, bytes ? end : target)) {
+			continue;
 		}
 		state = park_run(park, avr, end, !w->no_park);
 		if (world_state_dead(state)) {
@@ -111,14 +120,15 @@ static void world_skip(world_t *w, uint64_t target)
 	w->now = end;
 }
 
-int world_run(world_t *w, uint64_t target)
+int world_run(world_t *w, uint64_t target, uint32_t bytes)
 {
+	uint32_t from = w->bus.bytes;
 	int parked = 0;
 
 	if (w->nboards == 1) {
-		return world_run_one(w, target);
+		return world_run_one(w, target, bytes);
 	}
-	while (w->now < target) {
+	while (w->now < target && !world_bytes_came(w, from, bytes)) {
 		uint64_t end;
 
 		if (parked == w->nboards) {

@@ -50,9 +50,12 @@ void world_init(world_t *w);
  * bus. NULL, or the text why not. */
 const char *world_add_part(world_t *w, const part_kind_t *kind, uint8_t addr8, const char *opts);
 
-/* Run every board up to cycle TARGET. 0, or 1 when a board's firmware
+/* Run every board up to cycle TARGET, or, with BYTES > 0, until the end of
+ * the quantum in which the bus's master has clocked BYTES more bytes
+ * (twi_bus_t.bytes; a control client's `wait i2c`), if that comes first:
+ * the boards idling meanwhile stay parked. 0, or 1 when a board's firmware
  * crashed or stopped for good (w->dead says which). */
-int world_run(world_t *w, uint64_t target);
+int world_run(world_t *w, uint64_t target, uint32_t bytes);
 
 /* The gateway's cycle: world time for the control interface. */
 static inline uint64_t world_cycle(const world_t *w)

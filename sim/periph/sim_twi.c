@@ -11,6 +11,7 @@
 #include "periph/io_hook.h"
 #include "periph/sim_twi.h"
 #include "periph/avr_libc_twi.h"
+#include "simavr16/interrupt.h"
 
 /* TWCR bits (the datasheet's names; avr-libc has them only per MCU). */
 enum {
@@ -47,7 +48,7 @@ static void twi_sync(sim_twi_t *t)
 			avr_raise_interrupt(t->avr, v);
 		}
 	} else if (v->pending) {
-		avr_clear_interrupt(t->avr, v);
+		simavr16_withdraw_interrupt(t->avr, v);
 	}
 }
 
@@ -314,20 +315,6 @@ static void twi_glitch(sim_twi_t *t, avr_cycle_count_t when)
 	twi_bus_error(t, when);
 }
 
-/* A START or STOP on the lines at CYCLE while this master clocks a byte
- * (another driver moved SDA with SCL high): its bus error, as the
- * datasheet's TWI detects it. */
-static void twi_master_condition(twi_bus_master_t *m, uint64_t cycle)
-{
-	sim_twi_t *t = (sim_twi_t *)((char *)m - offsetof(sim_twi_t, master));
-
-	avr_cycle_timer_cancel(t->avr, twi_timer, t);
-	twi_bus_cancel(t->bus, &t->master);
-	t->waiting = TWI_WAIT_NONE;
-	twi_bus_drive(t->bus, &t->bus->rival_drv, 0, 0, cycle);
-	twi_bus_error(t, cycle);
-}
-
 static void twi_master_resume(twi_bus_master_t *m, uint64_t cycle)
 {
 	sim_twi_t *t = (sim_twi_t *)((char *)m - offsetof(sim_twi_t, master));
@@ -450,12 +437,13 @@ static avr_cycle_count_t twi_timer(avr_t *avr, avr_cycle_count_t when, void *par
 	return 0;
 }
 
-/* The master lets the lines go (TWI off, reset): SDA first, so with SCL
- * low it is no STOP. With SCL high in a byte's first bit, SDA rising would
- * be a STOP on silicon, and a slave would take the frame cut there as
- * whole; the model makes any release inside a byte a bus error to the
- * devices instead (docs/simulator.md, "The lines"). */
-static void twi_master_off(sim_twi_t *t)
+/* The master stops at WHEN and lets the lines go (TWI off, reset, a bus
+ * error from the lines): SDA first, so with SCL low it is no STOP. With
+ * SCL high in a byte's first bit, SDA rising would be a STOP on silicon,
+ * and a slave would take the frame cut there as whole; the model makes any
+ * release inside a byte a bus error to the devices instead
+ * (docs/simulator.md, "The lines"). */
+static void twi_master_off(sim_twi_t *t, avr_cycle_count_t when)
 {
 	int in_byte = t->op == TWI_OP_SLA || t->op == TWI_OP_TX || t->op == TWI_OP_RX;
 
@@ -464,16 +452,29 @@ static void twi_master_off(sim_twi_t *t)
 	t->waiting = TWI_WAIT_NONE;
 	twi_byte_over(t);
 	t->bus->abort = in_byte;
-	twi_drive(t, 0, t->drv.scl_low, t->avr->cycle);
-	twi_drive(t, 0, 0, t->avr->cycle);
+	twi_drive(t, 0, t->drv.scl_low, when);
+	twi_drive(t, 0, 0, when);
 	/* the rival's bit ends with the clock that made it */
-	twi_bus_drive(t->bus, &t->bus->rival_drv, 0, 0, t->avr->cycle);
+	twi_bus_drive(t->bus, &t->bus->rival_drv, 0, 0, when);
 	t->bus->abort = 0;
 	if (t->owner) {
 		t->bus->clocked = 0;
 	}
 	t->op = TWI_OP_NONE;
 	t->owner = 0;
+}
+
+/* A START or STOP on the lines at CYCLE while this master clocks a byte
+ * (another driver moved SDA with SCL high): its bus error, as the
+ * datasheet's TWI detects it. The bus calls this while it tells that edge,
+ * so the lines let go here are told after it (the devices have seen the
+ * condition itself). */
+static void twi_master_condition(twi_bus_master_t *m, uint64_t cycle)
+{
+	sim_twi_t *t = (sim_twi_t *)((char *)m - offsetof(sim_twi_t, master));
+
+	twi_master_off(t, cycle);
+	twi_bus_error(t, cycle);
 }
 
 /* --- slave mode -----------------------------------------------------------
@@ -540,6 +541,14 @@ static void twi_slave_abandon(sim_twi_t *t)
 	t->addressed = 0;
 	twi_bus_release(t->bus, &t->dev, t->avr->cycle, t->sl_addr);
 	twi_bus_forget(t->bus, &t->dev, t->avr->cycle);
+}
+
+/* TWI off or reset: the master stops, the slave side forgets its transfer. */
+static void twi_off(sim_twi_t *t)
+{
+	twi_master_off(t, t->avr->cycle);
+	twi_slave_abandon(t);
+	t->status = TW_NO_INFO;
 }
 
 static sim_twi_t *twi_of_dev(twi_dev_t *dev)
@@ -801,9 +810,7 @@ static void twi_write_twcr(avr_t *avr, avr_io_addr_t addr, uint8_t v, void *para
 		} else if (t->addressed) {
 			trace_event(t->bus->trace, avr->cycle, "twi off %02X", t->sl_addr);
 		}
-		twi_master_off(t);
-		twi_slave_abandon(t);
-		t->status = TW_NO_INFO;
+		twi_off(t);
 		avr->data[addr] &= (uint8_t)~(BIT(TWCR_TWSTA) | BIT(TWCR_TWSTO));
 	} else if (t->op == TWI_OP_NONE &&
 		   (clear_int || (!(keep & BIT(TWCR_TWINT)) && !t->owner &&
@@ -856,9 +863,7 @@ static void twi_reset(avr_io_t *io)
 
 	/* simavr wiped the cycle timers already */
 	t->sl_pending = 0;
-	twi_master_off(t);
-	twi_slave_abandon(t);
-	t->status = TW_NO_INFO;
+	twi_off(t);
 	avr->data[t->regs->twbr] = 0;
 	avr->data[t->regs->twsr] = TW_NO_INFO;
 	avr->data[t->regs->twar] = 0xfe;

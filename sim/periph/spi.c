@@ -8,6 +8,7 @@
 #include "periph/io_hook.h"
 #include "periph/sim_mcu.h"
 #include "periph/spi.h"
+#include "simavr16/interrupt.h"
 
 enum {
 	SPCR_SPIE = 7, SPCR_SPE = 6, SPCR_DORD = 5, SPCR_MSTR = 4,
@@ -45,7 +46,7 @@ static void spi_sync(spi_t *s)
 			avr_raise_interrupt(s->avr, v);
 		}
 	} else if (v->pending) {
-		avr_clear_interrupt(s->avr, v);
+		simavr16_withdraw_interrupt(s->avr, v);
 	}
 }
 

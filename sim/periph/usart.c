@@ -9,6 +9,7 @@
 
 #include "periph/io_hook.h"
 #include "periph/usart.h"
+#include "simavr16/interrupt.h"
 
 /* Register bits (datasheet names; the same on ATmega32 and ATmega128). */
 enum {
@@ -78,29 +79,9 @@ static uint8_t usart_ucsra(const usart_t *u)
  * and forgets it once the ISR is entered; the USART's flags are levels
  * (RXC until UDR is emptied, UDRE while the buffer is free). So after every
  * change, on enable bit changes and on RETI, a vector is raised again while
- * its flag and enable bit are both set, and withdrawn when its flag drops.
+ * its flag and enable bit are both set, and withdrawn when its flag drops
+ * (with its entries in simavr 1.6's queue: simavr16/interrupt.h).
  */
-/* simavr 1.6's avr_clear_interrupt leaves the vector's entry in its queue
- * of pending interrupts. A firmware that empties UDR with the receive
- * interrupt masked (the M32-D's servo interrupt polls it) would add an
- * entry at every character while the queue serves one per interrupt taken:
- * the 64-entry queue fills, a later raise finds no room, and the vector
- * stays flagged pending without ever being taken. Its entries go too. */
-static void usart_withdraw(avr_t *avr, avr_int_vector_t *v)
-{
-	avr_int_pending_t *q = &avr->interrupts.pending;
-	unsigned keep = q->read;
-
-	avr_clear_interrupt(avr, v);
-	for (unsigned i = q->read; i != q->write; i = (i + 1) & (avr_int_pending_fifo_size - 1)) {
-		if (q->buffer[i] != v) {
-			q->buffer[keep] = q->buffer[i];
-			keep = (keep + 1) & (avr_int_pending_fifo_size - 1);
-		}
-	}
-	q->write = keep;
-}
-
 static void usart_sync_vector(usart_t *u, avr_int_vector_t *v, int flag)
 {
 	avr_t *avr = u->avr;
@@ -110,7 +91,7 @@ static void usart_sync_vector(usart_t *u, avr_int_vector_t *v, int flag)
 			avr_raise_interrupt(avr, v);
 		}
 	} else if (v->pending) {
-		usart_withdraw(avr, v);
+		simavr16_withdraw_interrupt(avr, v);
 	}
 }
 

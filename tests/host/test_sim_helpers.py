@@ -24,6 +24,21 @@ def test_bad_trace_lines(bad):
         sim.parse_trace_line(bad)
 
 
+def test_sent_lines_of_either_way():
+    """The gateway's lines (CR LF ended) or the PC's (LF ended), at their
+    first or last byte's cycle; bytes after the last end are no line."""
+    text = "".join("%d uart %s %02X\n" % (10 * k, way, b) for k, (way, b) in enumerate(
+        [("rx", 0x56), ("rx", 0x0A), ("tx", 0x56), ("tx", 0x31), ("tx", 0x0D), ("tx", 0x0A),
+         ("rx", 0x43), ("tx", 0x53)]))
+    events = sim.parse_trace(text)
+    assert sim.sent_lines(events) == [(20, "V1")]
+    assert sim.sent_lines(events, last=True) == [(50, "V1")]
+    assert sim.sent_lines(events, kind="uart rx", last=True) == [(10, "V")]
+    assert sim.sent_lines(events, since=60) == []
+    with pytest.raises(ValueError, match="kind 'uart': one of 'uart tx', 'uart rx'"):
+        sim.sent_lines(events, kind="uart")
+
+
 def test_paths_are_relative_to_the_repository():
     assert (sim.REPO_ROOT / "host" / "orfa" / "sim.py").is_file()
     assert sim.sim_path() == sim.REPO_ROOT / "build" / "sim" / "orfa-sim"

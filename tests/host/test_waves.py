@@ -7,7 +7,7 @@ import struct
 
 import pytest
 
-from orfa import boardmap, plot, vcd, waves
+from orfa import boardmap, decode, plot, vcd, waves
 from orfa.cli import main
 from orfa.cli import plot as cli_plot
 
@@ -371,6 +371,17 @@ def test_serial_rows_carry_their_decoded_bytes(tmp_path, capsys):
     texts = svg_texts(out)
     drawn = [plot.GLYPHS.get(t, t) for t in request]      # a space drawn as one glyph
     assert in_order(drawn, texts) and in_order(reply, texts)
+
+
+def test_each_row_is_decoded_once(tmp_path, monkeypatch):
+    """The window trimmed to the activity needs the rows' frames, and so
+    does the picture: each row's line is read once for both."""
+    pytest.importorskip("matplotlib")
+    read, uart = [], decode.uart
+    monkeypatch.setattr(decode, "uart", lambda wave, bit: read.append(wave.name) or uart(wave, bit))
+    assert main(["plot", str(serial_vcd(tmp_path)), "--signals", "D0", "D1",
+                 "-o", str(tmp_path / "serial.png")]) == 0
+    assert sorted(read) == ["D0", "D1"]
 
 
 def test_serial_rows_are_decoded_at_the_given_rate(tmp_path, capsys):

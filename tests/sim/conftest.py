@@ -511,6 +511,69 @@ def require_slave(board: str, addr: int) -> Path:
     return elf
 
 
+#: The robot of the bus-fault tests (test_abandoned.py,
+#: test_bus_faults_midbyte.py): a gateway and two slave boards of the test
+#: robot, an M128-S at 0x10 and an M32-D at 0x12.
+M128S, M32D = 0x10, 0x12
+SLAVES = {M128S: "m128s", M32D: "m32d"}
+OK, DROPPED = 0x00, 0x09          # a slave's status: a write applied, one dropped
+
+
+def sp(addr):
+    """The servo widths' register (SP) of slave ADDR."""
+    return DRV_LAYOUT[SLAVES[addr]]["servo"] + 1
+
+
+def mode(addr):
+    """The first GPIO port's mode register of slave ADDR."""
+    return DRV_LAYOUT[SLAVES[addr]]["gpio_mode"]
+
+
+def clear(b, addr):
+    """Every servo of the slave off, its first GPIO port inputs, status OK."""
+    a = addr
+    offs = "".join("%02X0000" % ch for ch in range(16))
+    assert b.ask("S %02X %02X %s P" % (a, sp(a), offs)) == b"SW" + b"A" * 49 + b"P\r\n"
+    assert b.ask("S %02X %02X 00 P" % (a, mode(a))) == b"SWAAP\r\n"
+    assert status(b, a) == OK
+
+
+def status(b, addr):
+    """Slave ADDR's status register (OK, DROPPED: docs/registers.md)."""
+    reply = b.ask("S %02X 01 S %02X 01 P" % (addr, addr | 1))
+    assert reply[:5] == b"SWASR" and reply[7:] == b"P\r\n", reply
+    return int(reply[5:7], 16)
+
+
+@pytest.fixture(scope="module", params=BOARDS)
+def pair_robot(request):
+    """Each gateway board in turn with the slaves of SLAVES, traced, with the
+    control socket; the gateway may be reset on purpose."""
+    gateway = request.param
+    require_builds([gateway])
+    slaves = [(SLAVES[a], a, require_slave(SLAVES[a], a)) for a in (M128S, M32D)]
+    sim = SimBoard(gateway, trace=True, control=True, slaves=slaves)
+    sim.expect_resets = True
+    with running(sim) as b:
+        yield b
+
+
+@pytest.fixture
+def pair_rb(pair_robot):
+    """pair_robot for one test: running, its input read, no bus fault
+    armed, both slaves cleared (clear); after it, no fault armed and the
+    board's defaults (restore)."""
+    robot = pair_robot
+    assert robot.sim.running, robot.sim.stderr
+    robot.gw.reset_input_buffer()
+    robot.sim.control.i2c_disarm()
+    for addr in SLAVES:
+        clear(robot, addr)
+    yield robot
+    robot.sim.control.i2c_disarm()
+    robot.restore()
+
+
 #: Simulator options of the driver test modules: a module sets
 #: `DRV_SIM_OPTIONS = {"m32d": {...}, "m128s": {...}}` (SimBoard keyword
 #: arguments such as spi=[...], adc={...}, aref=...) and

@@ -1,9 +1,11 @@
 """Debian's sigrok-cli on the simulator's VCD (docs/simulator.md, "VCD"):
 run one of sigrok's own protocol decoders on a capture and take its
 annotations back in CPU cycles. The tests that compare what sigrok decodes
-with what the host sent and received use this (test_sigrok_*.py)."""
+with what the host sent and received use this (test_sigrok_*.py,
+test_capture_doc.py, test_bus_faults_midbyte.py)."""
 
 import json
+import re
 import shutil
 import subprocess
 import time
@@ -45,6 +47,44 @@ def decode(path, decoder, annotations):
         elif ev["ph"] == "E":
             out.setdefault(ev["tid"], []).append((begun.pop(ev["tid"]), cycle, ev["name"]))
     return out, took
+
+
+def lines(path, decoder, annotations):
+    """sigrok-cli's plain output of DECODER's ANNOTATIONS on the capture at
+    PATH (`uart-1: 53`), as a shell prints it, trailing blanks off."""
+    r = subprocess.run(["sigrok-cli", "-i", str(path), "-I", "vcd", "-P", decoder,
+                        "-A", annotations], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    return [line.rstrip() for line in r.stdout.splitlines()]
+
+
+_I2C_CONDITIONS = {"Start": "S", "Start repeat": "Sr", "Stop": "P"}
+
+
+def i2c_view(path):
+    """sigrok's i2c decoder on the capture's wires `scl` and `sda`, in the
+    order its annotations begin: "S", "Sr" and "P" for START, repeated START
+    and STOP, (kind, value, ack) for every byte: kind "AW"/"AR" with the
+    7-bit address, "DW"/"DR" with the data byte; ack 1 for ACK, 0 for
+    NACK."""
+    rows, _ = decode(path, "i2c:scl=scl:sda=sda",
+                     "i2c=start:repeat-start:stop:ack:nack:address-read:address-write:"
+                     "data-read:data-write")
+    out = []
+    for _, _, name in sorted((a for row in rows.values() for a in row), key=lambda a: a[0]):
+        if name in ("Write", "Read"):
+            continue                    # the R/W bit: the address's annotation says it
+        if name in _I2C_CONDITIONS:
+            out.append(_I2C_CONDITIONS[name])
+        elif name in ("ACK", "NACK"):
+            kind, value, _ = out[-1]
+            out[-1] = (kind, value, int(name == "ACK"))
+        else:
+            m = re.fullmatch(r"(Address|Data) (write|read): ([0-9A-F]{2})", name)
+            assert m, name
+            kind = ("A" if m.group(1) == "Address" else "D") + m.group(2)[0].upper()
+            out.append((kind, int(m.group(3), 16), None))
+    return out
 
 
 #: sigrok's i2c annotations (its addr-data row) as orfa.decode's texts,

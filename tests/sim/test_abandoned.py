@@ -16,12 +16,8 @@ gateway's main loop and clock interrupt were when the request came."""
 
 import pytest
 
-from conftest import DRV_LAYOUT, F_CPU, require_builds, require_slave, running
-from orfa.sim import BOARDS, SimBoard
-
-M128S, M32D = 0x10, 0x12
-SLAVES = {M128S: "m128s", M32D: "m32d"}
-OK, DROPPED = 0x00, 0x09
+from conftest import (DRV_LAYOUT, DROPPED, F_CPU, M128S, M32D, OK, SLAVES, mode, sp,
+                      status)
 MS = F_CPU // 1000
 LEAD = 2000                      # cycles from the batch to the request's first bit
 REACH = 200000                   # the write's bytes are on the bus by then (cycles)
@@ -35,50 +31,6 @@ REACH = 200000                   # the write's bytes are on the bus by then (cyc
 MID = 400
 HOLD = 100000                    # SCL held this long: more than the gateway waits (9.7 ms)
 AFTER = 30000                    # then the next request comes this soon
-
-
-@pytest.fixture(scope="module", params=BOARDS)
-def robot(request):
-    gateway = request.param
-    require_builds([gateway])
-    slaves = [(SLAVES[a], a, require_slave(SLAVES[a], a)) for a in (M128S, M32D)]
-    sim = SimBoard(gateway, trace=True, control=True, slaves=slaves)
-    sim.expect_resets = True     # the gateway is reset on purpose below
-    with running(sim) as b:
-        yield b
-
-
-@pytest.fixture
-def rb(robot):
-    assert robot.sim.running, robot.sim.stderr
-    robot.gw.reset_input_buffer()
-    for addr in SLAVES:
-        clear(robot, addr)
-    yield robot
-    robot.restore()
-
-
-def sp(addr):
-    return DRV_LAYOUT[SLAVES[addr]]["servo"] + 1
-
-
-def mode(addr):
-    return DRV_LAYOUT[SLAVES[addr]]["gpio_mode"]
-
-
-def clear(b, addr):
-    """Every servo of the slave off, its first GPIO port inputs, status OK."""
-    a = addr
-    offs = "".join("%02X0000" % ch for ch in range(16))
-    assert b.ask("S %02X %02X %s P" % (a, sp(a), offs)) == b"SW" + b"A" * 49 + b"P\r\n"
-    assert b.ask("S %02X %02X 00 P" % (a, mode(a))) == b"SWAAP\r\n"
-    assert status(b, a) == OK
-
-
-def status(b, addr):
-    reply = b.ask("S %02X 01 S %02X 01 P" % (addr, addr | 1))
-    assert reply[:5] == b"SWASR" and reply[7:] == b"P\r\n", reply
-    return int(reply[5:7], 16)
 
 
 def write_of(kind, addr):
@@ -144,8 +96,8 @@ CASES = [(kind, after) for kind in CUTS for after in CUTS[kind]]
 @pytest.mark.parametrize("victim", [M128S, M32D], ids=["m128s@10", "m32d@12"])
 @pytest.mark.parametrize("kind,after", CASES, ids=["%s-%d" % c for c in CASES])
 @pytest.mark.parametrize("fault", ["hold", "reset"])
-def test_cut_write_applies_nothing_next_to_same(rb, victim, kind, after, fault):
-    b = rb
+def test_cut_write_applies_nothing_next_to_same(pair_rb, victim, kind, after, fault):
+    b = pair_rb
     ctl = b.sim.control
     lines = cut_batch(b, kind, victim, after, fault)
     nxt = b"S%02X01S%02X01P\r" % (victim, victim | 1)   # the status, first of all
@@ -166,11 +118,11 @@ def test_cut_write_applies_nothing_next_to_same(rb, victim, kind, after, fault):
 @pytest.mark.parametrize("kind,after", [("servo", 1), ("servo", 25), ("servo", 49), ("gpio", 2)],
                          ids=["servo-1", "servo-25", "servo-49", "gpio-2"])
 @pytest.mark.parametrize("fault", ["hold", "reset"])
-def test_cut_write_applies_nothing_next_to_other(rb, victim, kind, after, fault):
+def test_cut_write_applies_nothing_next_to_other(pair_rb, victim, kind, after, fault):
     """The next request goes to the other slave: a servo write it applies,
     while the cut one is dropped, not applied by the START that addressed
     the other."""
-    b = rb
+    b = pair_rb
     ctl = b.sim.control
     other = M32D if victim == M128S else M128S
     lines = cut_batch(b, kind, victim, after, fault)
@@ -187,10 +139,10 @@ def test_cut_write_applies_nothing_next_to_other(rb, victim, kind, after, fault)
         == b"SWAASR05DCP\r\n"
 
 
-def test_a_healthy_write_right_after_is_applied(rb):
+def test_a_healthy_write_right_after_is_applied(pair_rb):
     """The fence does not eat the next write: the same write, sent again
     right after a cut one, is applied whole."""
-    b = rb
+    b = pair_rb
     ctl = b.sim.control
     lines = cut_batch(b, "servo", M32D, 25, "hold")
     again = (write_of("servo", M32D) + "\r").encode()
@@ -201,12 +153,12 @@ def test_a_healthy_write_right_after_is_applied(rb):
     assert reply == b"SWAASR" + b"05DC" * 16 + b"P\r\n", reply
 
 
-def test_an_old_fence_never_delays_an_error(rb):
+def test_an_old_fence_never_delays_an_error(pair_rb):
     """The quiet time after a fault is over for good once it has passed: a
     request long after it (here 4 x 256 clock ticks + 20 ms, where a clock
     read modulo 256 ticks would think the fault fresh) with the bus stuck
     again gets its ERROR within 10 ms, as the first did."""
-    b = rb
+    b = pair_rb
     ctl = b.sim.control
     req = b"S1201S1301P\r"
     mark = b.mark()

@@ -20,30 +20,24 @@ import shutil
 
 import pytest
 
-from conftest import F_CPU, require_builds, require_slave, running
+from conftest import (DROPPED, F_CPU, M128S, M32D, OK, mode, require_builds,
+                      require_slave, running, sp, status)
 from orfa.sim import REPO_ROOT, SimBoard
-from test_abandoned import (DROPPED, M128S, M32D, OK, SLAVES, applied_nothing, clear, mode,
-                            robot, sp, status)  # noqa: F401 (robot: the fixture)
-from sigrok import needs_sigrok
-from test_sigrok_i2c import run_capture, sigrok_view, trace_view
+from test_abandoned import applied_nothing
+from sigrok import i2c_view, needs_sigrok
+from test_sigrok_i2c import run_capture, trace_view
 
 MS = F_CPU // 1000
+SLOW_P = 7447        # cycles: the SCL period at the slowest clock, C0001
 LEAD = 2000          # cycles from the batch to the request's first bit
 
 
 @pytest.fixture
-def rb(robot):  # noqa: F811
-    assert robot.sim.running, robot.sim.stderr
-    robot.gw.reset_input_buffer()
-    robot.sim.control.i2c_disarm()
-    for addr in SLAVES:
-        clear(robot, addr)
+def rb(pair_rb):
     # a servo pulse a test before left running ends within a 20 ms frame
     # or two: none is seen as a write applied
-    robot.sim.control.wait(45 * MS)
-    yield robot
-    robot.sim.control.i2c_disarm()
-    robot.restore()
+    pair_rb.sim.control.wait(45 * MS)
+    return pair_rb
 
 
 def servo_write(addr):
@@ -348,7 +342,7 @@ def test_a_logic_analyzer_sees_the_rivals_bit():
     run_capture(sim, talk)
     try:
         trace = trace_view(sim.trace_events(kinds=["twi"]))
-        decoded = sigrok_view(sim.vcd_path)
+        decoded = i2c_view(sim.vcd_path)
     finally:
         shutil.rmtree(sim.dir, ignore_errors=True)
     assert decoded == trace
@@ -363,27 +357,26 @@ def test_a_start_on_the_lines_in_a_byte_is_a_bus_error(rb):
     bit the gateway sends high, makes a real START on the lines (no glitch
     involved): the gateway's TWI and the slave's see the bus error as the
     datasheet's TWI detects it (ERROR 07, the write dropped). At the
-    slowest clock (C0001, an SCL period of 7447 cycles) so the pull lands
-    in the high half of byte 4's bit 1 (DC: a 1) however long the slave
-    stretched before it."""
+    slowest clock (C0001, an SCL period of SLOW_P cycles) the pull, timed
+    from the end of byte 3 (`wait i2c`), lands in the high half of byte 4's
+    bit 1 (DC: a 1) however long the slave stretched before it."""
     b = rb
     ctl = b.sim.control
     req = (servo_write(M128S) + "\n").encode()
     try:
         assert b.ask("C0001") == b"C0000\r\n"
-        # where that bit's SCL high half is, from a run not cut
-        start = int(ctl.requests(["time", "rx +%d %s" % (LEAD, req.hex().upper())])[0])
-        assert b.read_lines(1) == b"SWAAAAAAAP\r\n"
-        rises = [c for c, lvl in ctl.edges("scl", start) if lvl == 1]
-        falls = [c for c, lvl in ctl.edges("scl", start) if lvl == 0]
-        rise = rises[9 * 4 + 1]
-        fall = next(c for c in falls if c > rise)
-        clear(b, M128S)
         mark = b.mark()
+        # bit 0's SCL rises half a period after byte 3's acknowledge, bit
+        # 1's a period later, and falls after another half
         out = ctl.requests(["time", "rx +%d %s" % (LEAD, req.hex().upper()),
-                            "wait %d" % ((rise + fall) // 2 - start),
+                            "wait i2c 4 %d" % (40 * SLOW_P), "wait %d" % (7 * SLOW_P // 4),
                             "i2c stuck 1"])
         assert b.read_lines(1) == b"ERROR 07\r\n"
+        waited, pulled = int(out[2]), int(out[3])
+        scl = ctl.edges("scl", waited + 1)
+        rise = [c for c, lvl in scl if lvl][1]
+        fall = next((c for c, lvl in scl if not lvl and c > rise), None)
+        assert rise < pulled and (fall is None or pulled < fall), (waited, pulled, scl)
         ev = [(e.kind,) + e.fields for e in b.events(mark, ["twi"])]
         assert ("twi line", "SDA", "0") in ev and ("twi bus-error",) in ev, ev
         assert ("twi bus-error", "%02X" % M128S) in ev and not any(

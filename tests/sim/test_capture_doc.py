@@ -20,7 +20,7 @@ from conftest import REPLY_TIMEOUT, require_builds
 from orfa import vcd
 from orfa.protocol import F_CPU
 from orfa.sim import SimBoard
-from sigrok import i2c_texts, needs_sigrok
+from sigrok import i2c_texts, lines as sigrok_lines, needs_sigrok
 
 pytestmark = needs_sigrok
 pytest.importorskip("matplotlib")
@@ -95,14 +95,6 @@ def plot(path, start, end, signals, out):
         rows.setdefault(line[:10].strip(), []).append(line[11:])
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     return rows
-
-
-def sigrok_lines(path, dec, ann):
-    """sigrok-cli's plain output, as a shell prints it (trailing blanks off)."""
-    r = subprocess.run(["sigrok-cli", "-i", str(path), "-I", "vcd", "-P", dec, "-A", ann],
-                       capture_output=True, text=True, timeout=120)
-    assert r.returncode == 0, r.stderr
-    return [line.rstrip() for line in r.stdout.splitlines()]
 
 
 def quoted(lines):

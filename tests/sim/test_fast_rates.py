@@ -22,7 +22,7 @@ from orfa import boardmap
 from orfa.flow import FLOW_WINDOW
 from orfa.gateway import Gateway
 from orfa.protocol import F_CPU
-from orfa.sim import BOARDS, SimBoard
+from orfa.sim import BOARDS, SimBoard, sent_lines
 from orfa.simctl import RX_MAX, SimControlError
 
 FAST = (230400, 460800)
@@ -322,17 +322,10 @@ def test_flow_rule_holds_the_host_back_at_460800():
     # (from its line end, or the reply before, to its reply's last byte,
     # less the reply's wire time); writes and replies found in the trace
     byte = 10 * F_CPU // rate
-    write_ends, reply_ends = [], []
-    for kind, out, want in (("uart rx", write_ends, lines[0][:10].encode()),
-                            ("uart tx", reply_ends, replies[0].encode())):
-        text = b""
-        for e in events:
-            if e.kind == kind:
-                text += bytes([int(e.fields[0], 16)])
-                if text.endswith(b"\n"):
-                    if text.startswith(want):
-                        out.append(e.cycle + (byte if kind == "uart tx" else 0))
-                    text = b""
+    write_ends = [at for at, text in sent_lines(events, kind="uart rx", last=True)
+                  if text.startswith(lines[0][:10])]
+    reply_ends = [at + byte for at, text in sent_lines(events, last=True)
+                  if text.startswith(replies[0])]
     assert len(write_ends) == len(reply_ends) == count
     run = [d - max(r, prev) - len(replies[0] + "\r\n") * byte
            for r, d, prev in zip(write_ends, reply_ends, [0] + reply_ends)]

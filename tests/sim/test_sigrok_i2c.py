@@ -9,16 +9,15 @@ repeated START), an M128-S slave board at 0x10 that stretches SCL (a servo
 write of 16 triples, then reads) and an address nobody answers (NACK);
 each gateway board in turn."""
 
-import json
 import re
 import shutil
-import subprocess
 
 import pytest
 import serial
 
 from conftest import DRV_LAYOUT, REPLY_TIMEOUT, require_builds, require_slave
 from orfa.sim import BOARDS, SimBoard
+from sigrok import i2c_view, needs_sigrok
 
 SLAVE = 0x10
 SP = DRV_LAYOUT["m128s"]["servo"] + 1          # the M128-S's servo widths (3 bytes a channel)
@@ -36,8 +35,7 @@ REQUESTS = [
      "SWAASR%04XSRFFP" % 1000),
 ]
 
-pytestmark = pytest.mark.skipif(shutil.which("sigrok-cli") is None,
-                                reason="needs sigrok-cli (tools/setup.sh installs it)")
+pytestmark = needs_sigrok
 
 
 def host_view(request, reply):
@@ -86,37 +84,6 @@ def trace_view(events):
     return out
 
 
-ANNOTATIONS = {"Start": "S", "Start repeat": "Sr", "Stop": "P"}
-
-
-def sigrok_view(path):
-    """sigrok-cli's i2c decoder on the wires `scl` and `sda`: the same,
-    in the order of the annotations' start times."""
-    cmd = ["sigrok-cli", "-i", str(path), "-I", "vcd", "-P", "i2c:scl=scl:sda=sda",
-           "-A", "i2c=start:repeat-start:stop:ack:nack:address-read:address-write:"
-                 "data-read:data-write", "--protocol-decoder-jsontrace"]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
-    assert r.returncode == 0, r.stderr
-    begins = [e for e in json.loads(r.stdout)["traceEvents"] if e["ph"] == "B"]
-    begins.sort(key=lambda e: e["ts"])
-    out = []
-    for e in begins:
-        name = e["name"]
-        if name in ("Write", "Read"):
-            continue                    # the R/W bit: the address's annotation says it
-        if name in ANNOTATIONS:
-            out.append(ANNOTATIONS[name])
-        elif name in ("ACK", "NACK"):
-            kind, value, _ = out[-1]
-            out[-1] = (kind, value, int(name == "ACK"))
-        else:
-            m = re.fullmatch(r"(Address|Data) (write|read): ([0-9A-F]{2})", name)
-            assert m, name
-            kind = ("A" if m.group(1) == "Address" else "D") + m.group(2)[0].upper()
-            out.append((kind, int(m.group(3), 16), None))
-    return out
-
-
 def run_capture(sim, talk):
     """Starts `sim` (made with vcd=True, trace=True, control=True), calls
     talk(port) with its serial port open, lets 20000 cycles pass and stops
@@ -153,7 +120,7 @@ def capture(request):
     sim = run_capture(SimBoard(board, eeproms=(0xA0,), control=True, vcd=True, trace=True,
                                slaves=[("m128s", SLAVE, require_slave("m128s", SLAVE))]), talk)
     try:
-        yield host, trace_view(sim.trace_events(kinds=["twi"])), sigrok_view(sim.vcd_path), sim
+        yield host, trace_view(sim.trace_events(kinds=["twi"])), i2c_view(sim.vcd_path), sim
     finally:
         shutil.rmtree(sim.dir, ignore_errors=True)
 

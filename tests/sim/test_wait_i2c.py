@@ -109,3 +109,25 @@ def test_requests_behind_act_at_the_byte(bench):
     assert "twi write" not in kinds[3:], kinds
     assert 0 <= ev[2].cycle - ev[1].cycle <= SLACK
     assert ev[2].cycle == int(out[1])
+
+
+@pytest.mark.parametrize("with_slave", [False, True], ids=["alone", "slave"])
+def test_parked_boards_give_the_same_cycles(with_slave):
+    """While a client waits for bytes the boards idling stay parked (the run
+    stops at the quantum of the byte itself): that changes no answer, the
+    same cycles as with every board run every quantum (`--no-park`), for a
+    request at a fixed cycle."""
+    require_builds(["m32d"])
+    slaves = [("m32d", 0x12, require_slave("m32d", 0x12))] if with_slave else []
+    req = b"S A0 00 S A1 02 P\r"
+    at, within = 1 << 22, 1 << 23
+
+    def answers(extra):
+        with SimBoard("m32d", eeproms=(0xA0,), control=True, slaves=slaves,
+                      extra_args=extra) as sim:
+            return sim.control.requests(["rx %d %s" % (at, req.hex())] +
+                                        ["wait i2c %d %d" % (n, within) for n in (1, 2, 2)])
+
+    parked = answers([])
+    assert parked == answers(["--no-park"])
+    assert int(parked[1]) > at

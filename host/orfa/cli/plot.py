@@ -411,22 +411,32 @@ def cmd_plot(args) -> int:
     def changing():
         return [n for n in names
                 if found[n].edges and not _idle_servo(namer, n, found[n], f_cpu)]
+
+    frames: Dict[str, List[decode.Frame]] = {}
+
+    def frames_of(rows):
+        """decoded() of ROWS, each row read once: the window below is
+        widened by the frames, and the rows chosen again in it are drawn
+        with theirs."""
+        frames.update(decoded(namer, whole, [n for n in rows if n not in frames], f_cpu,
+                              args.baud))
+        return {n: frames[n] for n in rows if n in frames}
+
     chosen, more = select(namer, names, changing(), patterns)
     if chosen and args.start is None and args.stop is None:
         # no window asked for: the one where the rows' activity is, and
         # the default rows those that change in it
         window = _activity(found, chosen, f_cpu)
         if window is not None:
-            window = _frames_whole(window, decoded(namer, whole, chosen, f_cpu, args.baud),
-                                   found[chosen[0]])
+            window = _frames_whole(window, frames_of(chosen), found[chosen[0]])
             found = _clip_all(found, window)
             if not patterns:
                 chosen, more = select(namer, names, changing(), patterns)
     if not chosen:
         # nothing moved: the servo rows, flat, rather than an empty picture
         chosen = [n for n in names if namer.rank(n) == 0][:4] or names[:4]
-    frames = decoded(namer, whole, chosen, f_cpu, args.baud)
-    rows = [drawing.Row(found[n], namer.label(n), namer.periodic(n), frames.get(n, ()))
+    shown = frames_of(chosen)
+    rows = [drawing.Row(found[n], namer.label(n), namer.periodic(n), shown.get(n, ()))
             for n in chosen]
     try:
         notes = drawing.render(rows, f_cpu, args.output, title=source)
