@@ -1,5 +1,7 @@
 #include "firmware/uart.h"
 
+#include <stdbool.h>
+
 #include <avr/interrupt.h>
 #include <avr/wdt.h>
 #include <util/atomic.h>
@@ -268,14 +270,15 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 
 /* The transmit side's rule, which uart_putc() and this interrupt keep:
  * UDRIE is on whenever the ring holds a byte. Only this interrupt turns it
- * off, in the same run that sends the ring's last byte; only uart_putc()
- * turns it on, and only after its byte is in the ring (head stored) and
- * while UDRIE is off, so while no UDRE interrupt can run: then the tail it
- * compares with stands still. So the main loop that finds UDRIE off knows
- * the ring empty and UDR its own, and the interrupt never runs over an
- * empty ring (which sent a stale byte and ran the tail past the head:
- * replies garbled now and then at 460800). Nothing else changes UCSRB but
- * uart_init() and autobaud (with interrupts off, keeping UDRIE).
+ * off, in the same run that sends the ring's last byte; only tx_publish()
+ * (uart_putc, uart_put2) turns it on, and only after its bytes are in the
+ * ring (head stored) and while UDRIE is off, so while no UDRE interrupt can
+ * run: then the tail it compares with stands still. So the main loop that
+ * finds UDRIE off knows the ring empty and UDR its own (tx_direct()), and
+ * the interrupt never runs over an empty ring (which sent a stale byte and
+ * ran the tail past the head: replies garbled now and then at 460800).
+ * Nothing else changes UCSRB but uart_init() and autobaud (with interrupts
+ * off, keeping UDRIE).
  *
  * The interrupt: the ring's next byte into UDR, UDRIE off when the ring is
  * empty. In assembly with two registers and SREG saved: the compiler's
@@ -324,13 +327,35 @@ ISR(MCU_UART_UDRE_vect, ISR_NAKED)
 		[head] "i" (&uart.tx_head), [buf] "i" (uart.tx), [mask] "n" (UART_TX_SIZE - 1));
 }
 
-void uart_putc(uint8_t c)
+/* The ring's new head stored, the bytes before it in place. UDRIE still
+ * on: the interrupt sees the new head before it could find the ring empty.
+ * Off: the ring was empty, or the interrupt emptied it since, before the
+ * head was stored (the bytes wait) or after (they were sent); no interrupt
+ * runs now to move the tail, so the tail tells which. No atomic block:
+ * every byte but a reply's first two takes this path. */
+static inline __attribute__((always_inline)) void tx_publish(uint8_t head)
 {
-	/* UDRIE off: the ring is empty and UDR is the main loop's. A reply's
-	 * first two bytes go straight into it (the shift register takes the
-	 * first at once, the buffer the second). */
+	uart.tx_head = head;
+	if (!(MCU_UCSRB & _BV(UDRIE)) && uart.tx_tail != head) {
+		MCU_UCSRB |= _BV(UDRIE);
+	}
+}
+
+/* UDRIE off (the ring is empty and UDR the main loop's) and UDR free: C
+ * goes straight into it (true). A reply's first two bytes do (the shift
+ * register takes the first at once, the buffer the second). */
+static inline __attribute__((always_inline)) bool tx_direct(uint8_t c)
+{
 	if (!(MCU_UCSRB & _BV(UDRIE)) && (MCU_UCSRA & _BV(UDRE))) {
 		MCU_UDR = c;
+		return true;
+	}
+	return false;
+}
+
+void uart_putc(uint8_t c)
+{
+	if (tx_direct(c)) {
 		return;
 	}
 	uint8_t head = uart.tx_head;
@@ -344,14 +369,31 @@ void uart_putc(uint8_t c)
 		wdt_reset();
 	}
 	uart.tx[head] = c;
-	uart.tx_head = next;
-	/* UDRIE still on: the interrupt sees the new head before it could
-	 * find the ring empty. Off: the ring was empty (above), or the
-	 * interrupt emptied it since, before the head was stored (the byte
-	 * waits) or after (it was sent); no interrupt runs now to move the
-	 * tail, so the tail tells which. No atomic block: every byte but a
-	 * reply's first few takes this path. */
-	if (!(MCU_UCSRB & _BV(UDRIE)) && uart.tx_tail != next) {
-		MCU_UCSRB |= _BV(UDRIE);
+	tx_publish(next);
+}
+
+/* Apart, so that uart_put2()'s own path keeps no register. */
+static __attribute__((noinline)) void put2_each(uint8_t a, uint8_t b)
+{
+	uart_putc(a);
+	uart_putc(b);
+}
+
+void uart_put2(uint8_t a, uint8_t b)
+{
+	if (tx_direct(a)) {
+		uart_putc(b);
+		return;
 	}
+	uint8_t head = uart.tx_head;
+
+	/* Both into the ring when it has room for two; else one at a time. */
+	if ((uint8_t)((uart.tx_tail - head - 1) & (UART_TX_SIZE - 1)) >= 2) {
+		uart.tx[head] = a;
+		head = (uint8_t)((head + 1) & (UART_TX_SIZE - 1));
+		uart.tx[head] = b;
+		tx_publish((uint8_t)((head + 1) & (UART_TX_SIZE - 1)));
+		return;
+	}
+	put2_each(a, b);
 }
