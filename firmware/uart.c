@@ -335,6 +335,10 @@ ISR(MCU_UART_UDRE_vect, ISR_NAKED)
  * every byte but a reply's first two takes this path. */
 static inline __attribute__((always_inline)) void tx_publish(uint8_t head)
 {
+	/* the bytes stored before the head that tells of them: the ring's
+	 * bytes are not volatile, so the compiler is told (it was the atomic
+	 * block's barrier) */
+	__asm__ __volatile__("" : : : "memory");
 	uart.tx_head = head;
 	if (!(MCU_UCSRB & _BV(UDRIE)) && uart.tx_tail != head) {
 		MCU_UCSRB |= _BV(UDRIE);
