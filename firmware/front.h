@@ -34,9 +34,13 @@ void front_poll(void);
  * budget for the others that run before it. */
 #ifdef BOARD_RX_OUTRANKED
 #define FRONT_ISR_LETS_RX ISR_NOBLOCK
+#define FRONT_ISR_LETS_RX_ASM "sei\n\t"
 #else
 #define FRONT_ISR_LETS_RX ISR_BLOCK
+#define FRONT_ISR_LETS_RX_ASM ""
 #endif
+/* FRONT_ISR_LETS_RX_ASM: the same for an ISR_NAKED handler, its first
+ * instruction(s). */
 
 void front_rx_hold(void);
 void front_rx_poll(uint8_t most);

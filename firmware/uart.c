@@ -1,5 +1,7 @@
 #include "firmware/uart.h"
 
+#include <stdbool.h>
+
 #include <avr/interrupt.h>
 #include <avr/wdt.h>
 #include <util/atomic.h>
@@ -304,58 +306,103 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 #endif
 }
 
-/* The transmit interrupt: the ring's next byte into UDR, UDRIE off when the
- * ring is empty. In assembly with three registers saved: the compiler's
- * handler also saved r0, r1 and r25 and cleared r1, ~12 cycles of the ~60
- * a byte of a reply cost at 460800 (docs/protocol.md, The line). UCSRB's
- * read-modify-write is safe: the main loop changes it with interrupts off
- * (uart_putc, autobaud). */
+/* The transmit side's rule, which uart_putc() and this interrupt keep:
+ * UDRIE is on whenever the ring holds a byte. Only this interrupt turns it
+ * off, in the same run that sends the ring's last byte; only tx_publish()
+ * (uart_putc, uart_put2) turns it on, and only after its bytes are in the
+ * ring (head stored) and while UDRIE is off, so while no UDRE interrupt can
+ * run: then the tail it compares with stands still. So the main loop that
+ * finds UDRIE off knows the ring empty and UDR its own (tx_direct()), and
+ * the interrupt never runs over an empty ring (which sent a stale byte and
+ * ran the tail past the head: replies garbled now and then at 460800).
+ * Nothing else changes UCSRB but uart_init() and autobaud (with interrupts
+ * off, keeping UDRIE).
+ *
+ * The interrupt: the ring's next byte into UDR, UDRIE off when the ring is
+ * empty. In assembly with two registers and SREG saved: the compiler's
+ * handler also saved r0, r1, r24 and r25 and cleared r1. UCSRB's
+ * read-modify-write (the M128-S's UCSR1B is beyond cbi's reach) is safe:
+ * the main loop changes it only while UDRIE is off or with interrupts off. */
+/* `out`/`cbi` where the register is in I/O space (the M32-D's, the M128-S's
+ * USART0), else `sts`/`lds`: assembler conditions on the memory address. */
+#define TX_IO_STORE(sfr, reg) \
+	".if " sfr " < 0x60\n\tout " sfr " - 0x20, " reg "\n\t.else\n\tsts " sfr ", " reg "\n\t.endif\n\t"
+
 ISR(MCU_UART_UDRE_vect, ISR_NAKED)
 {
 	__asm__ __volatile__(
-		"push r24\n\t"
-		"in r24, __SREG__\n\t"
-		"push r24\n\t"
+		"push r30\n\t"
+		"in r30, __SREG__\n\t"
 		"push r30\n\t"
 		"push r31\n\t"
-		"lds r24, %[tail]\n\t"
-		"mov r30, r24\n\t"
+		"lds r30, %[tail]\n\t"
 		"ldi r31, 0\n\t"
 		"subi r30, lo8(-(%[buf]))\n\t"
 		"sbci r31, hi8(-(%[buf]))\n\t"
-		"ld r30, Z\n\t"
-		"sts %[udr], r30\n\t"
-		"subi r24, 0xFF\n\t"
-		"andi r24, %[mask]\n\t"
-		"sts %[tail], r24\n\t"
-		"lds r30, %[head]\n\t"
-		"cp r24, r30\n\t"
+		"ld r31, Z\n\t"
+		TX_IO_STORE("%[udr]", "r31")
+		"subi r30, lo8(%[buf] - 1)\n\t"	/* the tail + 1 */
+		"andi r30, %[mask]\n\t"
+		"sts %[tail], r30\n\t"
+		"lds r31, %[head]\n\t"
+		"cp r30, r31\n\t"
 		"brne 1f\n\t"
+		".if %[ucsrb] < 0x40\n\t"
+		"cbi %[ucsrb] - 0x20, %[udrie]\n\t"
+		".else\n\t"
 		"lds r30, %[ucsrb]\n\t"
-		"andi r30, %[no_udrie]\n\t"
-		"sts %[ucsrb], r30\n"
+		"andi r30, ~(1 << %[udrie])\n\t"
+		"sts %[ucsrb], r30\n\t"
+		".endif\n"
 		"1:\n\t"
 		"pop r31\n\t"
 		"pop r30\n\t"
-		"pop r24\n\t"
-		"out __SREG__, r24\n\t"
-		"pop r24\n\t"
+		"out __SREG__, r30\n\t"
+		"pop r30\n\t"
 		"reti\n"
 		: : [udr] "n" (_SFR_MEM_ADDR(MCU_UDR)), [ucsrb] "n" (_SFR_MEM_ADDR(MCU_UCSRB)),
-		[no_udrie] "n" ((uint8_t)~_BV(UDRIE)), [tail] "i" (&uart.tx_tail),
+		[udrie] "n" (UDRIE), [tail] "i" (&uart.tx_tail),
 		[head] "i" (&uart.tx_head), [buf] "i" (uart.tx), [mask] "n" (UART_TX_SIZE - 1));
+}
+
+/* The ring's new head stored, the bytes before it in place. UDRIE still
+ * on: the interrupt sees the new head before it could find the ring empty.
+ * Off: the ring was empty, or the interrupt emptied it since, before the
+ * head was stored (the bytes wait) or after (they were sent); no interrupt
+ * runs now to move the tail, so the tail tells which. No atomic block:
+ * every byte but a reply's first two takes this path. */
+static inline __attribute__((always_inline)) void tx_publish(uint8_t head)
+{
+	/* the bytes stored before the head that tells of them: the ring's
+	 * bytes are not volatile, so the compiler is told (it was the atomic
+	 * block's barrier) */
+	__asm__ __volatile__("" : : : "memory");
+	uart.tx_head = head;
+	if (!(MCU_UCSRB & _BV(UDRIE)) && uart.tx_tail != head) {
+		MCU_UCSRB |= _BV(UDRIE);
+	}
+}
+
+/* UDRIE off (the ring is empty and UDR the main loop's) and UDR free: C
+ * goes straight into it (true). A reply's first two bytes do (the shift
+ * register takes the first at once, the buffer the second). */
+static inline __attribute__((always_inline)) bool tx_direct(uint8_t c)
+{
+	if (!(MCU_UCSRB & _BV(UDRIE)) && (MCU_UCSRA & _BV(UDRE))) {
+		MCU_UDR = c;
+		return true;
+	}
+	return false;
 }
 
 void uart_putc(uint8_t c)
 {
-	/* Fast path for the first byte of a reply: straight into UDR. */
-	if (uart.tx_head == uart.tx_tail && (MCU_UCSRA & _BV(UDRE))) {
-		MCU_UDR = c;
+	if (tx_direct(c)) {
 		return;
 	}
 	uint8_t head = uart.tx_head;
 	uint8_t next = (uint8_t)((head + 1) & (UART_TX_SIZE - 1));
-	if (next == uart.tx_tail) {
+	if (__builtin_expect(next == uart.tx_tail, 0)) {
 		/* Full: the UDRE interrupt frees a slot per byte sent. The
 		 * watchdog is fed only when one did (progress): a stuck UDRE
 		 * interrupt must end in a reset, not spin here fed. */
@@ -364,14 +411,31 @@ void uart_putc(uint8_t c)
 		wdt_reset();
 	}
 	uart.tx[head] = c;
-	/* The byte joins the ring and UDRIE goes on in one piece: a UDRE
-	 * interrupt in between could send the byte, find the ring empty and
-	 * turn UDRIE off, and then UDRIE went on over an empty ring: a stale
-	 * byte sent and the tail run past the head (replies garbled now and
-	 * then at 460800). The M128-S's UCSR1B is beyond sbi's reach, so its
-	 * |= (a load and a store) made that window three instructions wide. */
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		uart.tx_head = next;
-		MCU_UCSRB |= _BV(UDRIE);
+	tx_publish(next);
+}
+
+/* Apart, so that uart_put2()'s own path keeps no register. */
+static __attribute__((noinline)) void put2_each(uint8_t a, uint8_t b)
+{
+	uart_putc(a);
+	uart_putc(b);
+}
+
+void uart_put2(uint8_t a, uint8_t b)
+{
+	if (tx_direct(a)) {
+		uart_putc(b);
+		return;
 	}
+	uint8_t head = uart.tx_head;
+
+	/* Both into the ring when it has room for two; else one at a time. */
+	if ((uint8_t)((uart.tx_tail - head - 1) & (UART_TX_SIZE - 1)) >= 2) {
+		uart.tx[head] = a;
+		head = (uint8_t)((head + 1) & (UART_TX_SIZE - 1));
+		uart.tx[head] = b;
+		tx_publish((uint8_t)((head + 1) & (UART_TX_SIZE - 1)));
+		return;
+	}
+	put2_each(a, b);
 }

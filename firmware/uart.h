@@ -49,4 +49,7 @@ void uart_rx_flush(void);
 /* Queue one byte for sending; waits only while the transmit ring is full. */
 void uart_putc(uint8_t c);
 
+/* Two bytes, A first (a reply's hex digits, its line end): one call. */
+void uart_put2(uint8_t a, uint8_t b);
+
 #endif

@@ -12,21 +12,20 @@ static struct {
 	uint16_t khz;   /* bus clock actually set */
 } gate;
 
-static void out_digit(uint8_t d)
+static inline uint8_t hex_digit(uint8_t d)
 {
-	sg_out((uint8_t)(d < 10 ? '0' + d : 'A' - 10 + d));
+	return (uint8_t)(d < 10 ? '0' + d : 'A' - 10 + d);
 }
 
+/* A byte's two digits in one call: a read's reply is mostly these. */
 static void out_hex(uint8_t b)
 {
-	out_digit(b >> 4);
-	out_digit(b & 0x0F);
+	sg_out2(hex_digit(b >> 4), hex_digit(b & 0x0F));
 }
 
 static void out_end(void)
 {
-	sg_out('\r');
-	sg_out('\n');
+	sg_out2('\r', '\n');
 }
 
 static void out_error(uint8_t err)
@@ -146,7 +145,11 @@ static void run_i2c(sg_parser_t *p)
 			}
 		} else {
 			sg_out('W');
-			for (uint8_t k = 0; k < n; k++) {
+			uint8_t k = n;
+			for (; k > 1; k -= 2) {
+				sg_out2('A', 'A');
+			}
+			if (k) {
 				sg_out('A');
 			}
 		}

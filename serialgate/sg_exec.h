@@ -16,6 +16,9 @@
 /* Sends one reply character (provided by the front end or a test). */
 void sg_out(uint8_t c);
 
+/* Two reply characters, A first. */
+void sg_out2(uint8_t a, uint8_t b);
+
 /* Local address AA, bus clock as for C0064. */
 void sg_exec_init(void);
 

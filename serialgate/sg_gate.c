@@ -20,6 +20,11 @@ void sg_out(uint8_t c)
 	uart_putc(c);
 }
 
+void sg_out2(uint8_t a, uint8_t b)
+{
+	uart_put2(a, b);
+}
+
 void uart_received(uint8_t c)
 {
 	sg_rx_put(c);

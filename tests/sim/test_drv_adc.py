@@ -6,6 +6,8 @@ import pytest
 BAD_LENGTH, BAD_VALUE, PIN_BUSY, NOT_WRITABLE = 0x01, 0x02, 0x03, 0x04
 #: 10 ms: values valid by then (docs/registers.md, "ADC").
 VALID = 73728
+#: CPU cycles a conversion: 13 clocks of the ADC's F_CPU / 128 (docs/registers.md).
+ADC_CONVERSION = 13 * 128
 INPUTS = [0, 250, 1000, 1234, 2000, 2500, 3300, 4999]        # mV on inputs 0-7
 
 
@@ -91,6 +93,22 @@ def test_values_follow_the_inputs(analog):
         drv.wait(VALID)
         got = int.from_bytes(drv.rd(rd_reg(drv), 2), "big")
         assert abs(got - expected(mv, 5000)) <= 2, (mv, got)
+
+
+def test_a_reading_is_at_most_a_round_and_a_conversion_old(analog):
+    """docs/registers.md, "ADC": 1664 cycles a conversion, every one of the 8
+    channels refreshed within 8 x 1664 cycles; a change on any input shows
+    within a round and the conversion under way (the read's request comes on
+    top)."""
+    drv = analog
+    drv.wr(rc(drv), bytes([0x05, 0xFF]))
+    drv.wait(VALID)
+    for ch, mv in ((7, 1000), (0, 4000), (3, 2222)):
+        drv.ctl.adc(ch, mv)
+        drv.wait(9 * ADC_CONVERSION)
+        data = drv.rd(rd_reg(drv), 16)
+        got = int.from_bytes(data[2 * ch:2 * ch + 2], "big")
+        assert abs(got - expected(mv, 5000)) <= 2, (ch, mv, got)
 
 
 def test_enabled_lines_are_taken_from_gpio(analog):

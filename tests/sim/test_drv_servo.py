@@ -277,7 +277,7 @@ def test_m32d_close_edges_keep_their_widths(drv):
 
 
 def test_widths_while_the_adc_converts(drv):
-    """The ADC's conversions (an interrupt every 832 cycles) must not move
+    """The ADC's conversions (an interrupt every 1664 cycles) must not move
     servo edges (docs: widths exact to a CPU cycle / a timer tick)."""
     if drv.board == "m32d":
         drv.wr(drv.lay["adc"], b"\x01\x03")              # ADC 0-1 = PA0-PA1
@@ -380,7 +380,7 @@ def test_m128s_counter_clocks_meet_cd4017_timing(drv):
 
 
 def test_m32d_widths_exact_while_the_adc_converts(drv):
-    """M32-D: the ADC interrupt (a conversion every 832 cycles on port A
+    """M32-D: the ADC interrupt (a conversion every 1664 cycles on port A
     line 0; one channel is the longest search for the next) never delays a
     servo edge: every other channel, on the same port and elsewhere, keeps
     its width within 1.1 us."""

@@ -41,6 +41,12 @@ void sg_out(uint8_t c)
 	}
 }
 
+void sg_out2(uint8_t a, uint8_t b)
+{
+	sg_out(a);
+	sg_out(b);
+}
+
 /* Devices: 0xA0 EEPROM; 0x50 acknowledges its address, refuses data;
  * 0x60 hangs the bus (every step fails); 0x62 takes everything, then holds
  * SCL so that no STOP can be made (the transaction is abandoned). */
