@@ -77,11 +77,11 @@ void front_poll(void)
 	}
 	uint8_t c = sg_rx.buf[tail];
 	/* c >= ' ' first: a line's end (the latency's character) goes to
-	 * sg_parse_char() at once. Inside a request, what the ring holds of
-	 * its common run (spaces, digits, a frame's S and P) is taken in one
-	 * loop (sg_parse_run()); the character it stops at, or anything else,
-	 * goes through sg_parse_char(). */
-	if (c >= ' ' && sg_parse_in_run(&parser)) {
+	 * sg_parse_char() at once. An I2C request's first S and its common
+	 * run (spaces, digits, a frame's S and P), what the ring holds of
+	 * them, are taken in one loop (sg_parse_run()); the character it
+	 * stops at, or anything else, goes through sg_parse_char(). */
+	if (c >= ' ') {
 		uint8_t to = sg_parse_run(&parser, sg_rx.buf, tail, sg_rx.head);
 		if (to != tail) {
 			sg_rx.tail = to;

@@ -257,7 +257,21 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 	/* not in a lost run's record, within the line's room, a state the
 	 * run takes characters in (it may leave it only where a byte or a
 	 * frame ends: the state is looked at there) */
-	if (p->lost_info || len >= SG_LINE_MAX || !sg_parse_in_run(p)) {
+	if (p->lost_info || len >= SG_LINE_MAX) {
+		return tail;
+	}
+	if (state == SG_ST_BEGIN && tail != head && (ring[tail] | 0x20) == 's') {
+		/* an I2C request's first character, as sg_parse_char() takes it */
+		sg_parse_init(p);
+		p->cmd = SG_CMD_I2C;
+		p->reply_len = 1;  /* the closing "P" */
+		sg_parse_frame(p);
+		state = p->state;
+		len = 1;
+		p->len = len;
+		tail++;
+	}
+	if (!sg_parse_in_run(p)) {
 		return tail;
 	}
 	uint8_t n = (uint8_t)(head - tail);
