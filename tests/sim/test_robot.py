@@ -433,7 +433,7 @@ def test_longest_write_stretches_within_the_gateways_wait(rb, addr):
 WRITE_PHASES = [k * SERVO_FRAME // 32 for k in range(32)]
 #: The longest an SPI exchange's clock may stand still between two bytes,
 #: cycles: ~90 when nothing comes between, and the M32-D servo interrupt's
-#: ~220 from its last look at the exchange to the edge (drivers/servo_pins.c).
+#: ~150-210 from its last look at the exchange to the edge (drivers/servo_pins.c).
 SPI_IDLE_MAX = 400
 
 
