@@ -17,6 +17,7 @@
 #define DRV_servo_MINOR 0
 /* The link-loss failsafe turns every channel off (limp). */
 #define DRV_servo_SAFE() drv_servo_safe()
+#define DRV_servo_WAIT() ((void)0)
 
 REGMAP_DRIVER_API(servo);
 /* Every channel's width 0 (no pulses, line low), as a host's writes of

@@ -2,6 +2,7 @@
 #ifndef DRV_SPI_H
 #define DRV_SPI_H
 
+#include "drivers/spi_hw.h"
 #include "firmware/regmap.h"
 
 #define DRV_spi_NREGS 2
@@ -21,6 +22,8 @@
 #define DRV_spi_MINOR 1
 /* The link-loss failsafe leaves it as it is. */
 #define DRV_spi_SAFE() ((void)0)
+/* An exchange goes on while an interrupt waits (spi_hw.h). */
+#define DRV_spi_WAIT() spi_hw_pump()
 
 REGMAP_DRIVER_API(spi);
 

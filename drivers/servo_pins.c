@@ -20,7 +20,7 @@
 #include <util/atomic.h>
 
 #include "board.h"
-#include "drivers/drv_servo.h"
+#include "drivers/drivers.h"
 #include "drivers/servo_plan.h"
 #include "firmware/board_pins.h"
 #include "firmware/clock.h"
@@ -76,6 +76,25 @@ _Static_assert(SERVO_LEAD >= SERVO_RX_ISR + SERVO_ENTRY, "the lead allows a rece
  * between frames (servo_arm()).
  */
 #define SERVO_HOLD_TICKS 3
+
+/* What the others cannot wait for while the interrupt keeps interrupts
+ * off, done where it takes received characters into the hold: in the
+ * gateway, that; in the I2C slave (no receiver), each driver's
+ * DRV_name_WAIT(): the SPI exchange's next byte (spi_hw.h). The slave's
+ * longest write (docs/protocol.md), an exchange of 57 bytes at F_CPU/128,
+ * stood still for the rest of each wait that came as a byte ended, up to
+ * ~700 cycles an edge: its stretch came out 60500-68600 cycles, by where
+ * the edges fell among the bytes, against the gateway's wait of 69632. */
+#ifdef ORFA_MODE_slave
+#define X(name) DRV_##name##_WAIT();
+static inline void servo_hold(void)
+{
+	ORFA_DRIVER_LIST
+}
+#undef X
+#else
+#define servo_hold front_rx_hold
+#endif
 
 static struct {
 	servo_sched_t sched[2];
@@ -190,7 +209,7 @@ static void servo_rx_release(void)
 
 ISR(TIMER2_COMP_vect)
 {
-	front_rx_hold();
+	servo_hold();
 	if (!pulses.running || servo_ticks_left() > SERVO_NEAR / 8) {
 		servo_rx_release();
 		return;  /* an earlier wrap, or a stale flag */
@@ -213,7 +232,7 @@ ISR(TIMER2_COMP_vect)
 		if (left > -(SERVO_FINE / 8)) {
 			while (left > 0) {
 				if (left > SERVO_HOLD_TICKS) {
-					front_rx_hold();
+					servo_hold();
 				}
 				left = (int16_t)(servo_ticks_left() - SERVO_FINE / 8);
 			}
@@ -229,7 +248,7 @@ ISR(TIMER2_COMP_vect)
 		/* The same instructions for a rise and a fall: both come equally
 		 * long after the wait. */
 		*reg = (uint8_t)((*reg & and_mask) | or_mask);
-		front_rx_hold();
+		servo_hold();
 
 		if (++edge == pulses.end) {
 			/* Frame done: take a newer schedule over, start the next. */
@@ -261,9 +280,9 @@ ISR(TIMER2_COMP_vect)
 		 * now and then at 460800 (tests/sim/test_fast_rates.py's
 		 * flow-rule test, 2 runs in 10). */
 		servo_aim(edge);
-		front_rx_hold();
+		servo_hold();
 		servo_rx_release();
-		front_rx_hold();
+		servo_hold();
 		if (servo_arm()) {
 			return;
 		}

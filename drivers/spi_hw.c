@@ -1,6 +1,7 @@
 #include "drivers/spi_hw.h"
 
 #include <avr/io.h>
+#include <util/atomic.h>
 
 #include "firmware/board_pins.h"
 #include "firmware/mcu.h"
@@ -57,14 +58,60 @@ void spi_hw_config(uint8_t divider, uint8_t mode, uint8_t lsb_first)
 	spi_pin(board_pin_at(BF_SPI_SCK, 0), 1, (uint8_t)(mode & 2));
 }
 
+/* The exchange under way: where the byte on the wire comes back to (the
+ * next one to send follows it) and how many are still to come back. */
+static struct {
+	uint8_t *at;
+	volatile uint8_t left;
+} run;
+
+/* Its byte done (SPIF): the next one sent, then the one received stored
+ * (SPDR keeps it for reading until the next one has come in: the receive
+ * side is double buffered). Interrupts off. */
+static inline __attribute__((always_inline)) void spi_step(void)
+{
+	uint8_t *p = run.at;
+	uint8_t left = (uint8_t)(run.left - 1);
+	if (left) {
+		SPDR = p[1];
+	}
+	run.left = left;
+	*p++ = SPDR;
+	run.at = p;
+}
+
+void spi_hw_pump(void)
+{
+	if (run.left && (SPSR & _BV(SPIF))) {
+		spi_step();
+	}
+}
+
 void spi_hw_exchange(uint8_t *buf, uint8_t n)
 {
-	for (uint8_t i = 0; i < n; i++) {
-		SPDR = buf[i];
-		/* Master clocks the byte itself: at most 8 * 128 cycles. */
-		uint16_t guard = 0;
-		while (!(SPSR & _BV(SPIF)) && ++guard) {
+	if (!n) {
+		return;
+	}
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		run.at = buf;
+		run.left = n;
+		SPDR = *buf;
+	}
+	/* Each byte goes on where its end is seen first: here, or in an
+	 * interrupt that waits with interrupts off (spi_hw_pump()). The master
+	 * clocks a byte itself, at most 8 * 128 cycles: one that never ends
+	 * (the SPI off, or made a slave) ends the exchange after 65536 looks. */
+	uint16_t guard = 0;
+	while (run.left) {
+		if (SPSR & _BV(SPIF)) {
+			ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+				if (SPSR & _BV(SPIF)) {  /* not taken by an interrupt meanwhile */
+					spi_step();
+				}
+			}
+			guard = 0;
+		} else if (!++guard) {
+			run.left = 0;  /* nothing more for the interrupt either */
 		}
-		buf[i] = SPDR;
 	}
 }

@@ -64,6 +64,12 @@ typedef enum {
  *       as if the host had written it (drv_name_safe() for motors and
  *       servos), or ((void)0) for a driver that has none. Every driver
  *       says which, so none is forgotten.
+ *   DRV_name_WAIT()
+ *       a statement-like macro, called with interrupts off by an interrupt
+ *       that waits with them off (the M32-D slave's servo edges,
+ *       drivers/servo_pins.c): a few cycles of the driver's work that
+ *       must not stand still meanwhile (spi_hw_pump(): the SPI exchange's
+ *       next byte), or ((void)0).
  * `reg` is the register's offset inside the driver's range.
  */
 #define REGMAP_DRIVER_API(name) \
