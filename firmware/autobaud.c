@@ -63,57 +63,152 @@ _Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart
  * and of the step from one run to the next in ab_record. */
 #define AB_LOOP_CYCLES 6
 #define AB_STEP_CYCLES 12
+/* Iterations above which a run is longer than any run of a 0x0D (4 bit
+ * times at 2400 baud are 2048). */
+#define AB_LONG 4000
 
-/* The rates: bit time in cycles and UBRR, exact at 7.3728 MHz. */
-#define AB_RATE(r) { (uint16_t)(F_CPU / (r)), (uint8_t)(F_CPU / (16UL * (r)) - 1) },
-#define AB_EXACT(r) _Static_assert(F_CPU % (16UL * (r)) == 0 && F_CPU / (16UL * (r)) <= 256, \
+/* The rates as UBRR + 1 (F_CPU / 16 / rate): a bit lasts 16 times that
+ * many cycles; all exact at 7.3728 MHz. */
+#define AB_RATE(r) (uint8_t)(F_CPU / (16UL * (r))),
+#define AB_EXACT(r) _Static_assert(F_CPU % (16UL * (r)) == 0 && F_CPU / (16UL * (r)) <= 255, \
 				   "UBRR exact and 8-bit for " #r);
 ORFA_BAUD_RATES(AB_EXACT)
 
-typedef struct {
-	uint16_t bit;
-	uint8_t ubrr;
-} ab_rate_t;
-
-static const ORFA_FLASH ab_rate_t ab_rates[] = { ORFA_BAUD_RATES(AB_RATE) };
+static const ORFA_FLASH uint8_t ab_rates[] = { ORFA_BAUD_RATES(AB_RATE) };
 #define AB_NRATES (sizeof(ab_rates) / sizeof(ab_rates[0]))
 
-/* 0x0D from its start bit, runs in bit times; and the runs of two frames
- * with the high run between them (stop bit and any gap). */
-static const ORFA_FLASH uint8_t ab_pattern[5] = { 1, 1, 1, 2, 4 };
+/* The runs of two frames with the high run between them (stop bit and
+ * any gap). */
 #define AB_PAIR 11
-
-/* Why a record ended. */
-enum { AB_END_QUIET = 1, AB_END_BREAK };
-
 enum { AB_DETECT, AB_FRESH, AB_TALK };
 
 static struct {
 	uint8_t state;
-	uint8_t rate;		/* index + 1 of the rate in use */
+	uint8_t rate;		/* UBRR + 1 of the rate in use */
 	volatile uint8_t lost;	/* set by the receive interrupt */
 	uint8_t fe_run;
 } autobaud;
 
-/* Wait up to 65535 iterations (53 ms) for RXD to fall, then count the
- * iterations of runs, low and high in turn, into the ring RUN of
- * AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations (the line is
- * quiet: that high run is not stored) or low for 65535 (a break). A high
- * run's counter starts at -AB_QUIET so that its overflow is the quiet. The
- * ring keeps the last AB_MAX_RUNS runs before the end, however long the
- * line was busy. Returns *WHY the end; *LEFT the free slots before the
- * next write position, *WRAPPED whether the ring went round. One block of
- * assembly so that every step from one run to the next costs the same
- * (AB_STEP_CYCLES). */
-static void __attribute__((noinline)) ab_record(uint16_t *run, uint8_t *why,
-						uint8_t *left_out, uint8_t *wrapped_out)
+/* Run I of the ring RUN (any I: the ring's index wraps). */
+#define AB_AT(run, i) ((run)[(uint8_t)(i) & (AB_MAX_RUNS - 1)])
+
+/* The rate (UBRR + 1) whose 0x0D the five runs from I are (in cycles,
+ * RUN[I] low), by their total of nine bit times within 1/8; or 0. */
+static uint8_t ab_frame(const uint16_t *run, uint8_t i)
 {
+	uint16_t total = 0;
+
+	for (uint8_t j = 0; j < 5; j++) {
+		uint16_t c = AB_AT(run, i + j);
+
+		if (c == 0xFFFF) {
+			return 0;
+		}
+		total += c;
+	}
+	for (uint8_t r = 0; r < AB_NRATES; r++) {
+		uint8_t k = ab_rates[r];
+		uint16_t nine = (uint16_t)(9 * 16 * k);
+		uint16_t diff = total > nine ? total - nine : nine - total;
+
+		if (diff <= nine / 8) {
+			return k;
+		}
+	}
+	return 0;
+}
+
+/* The five runs from I match 0x0D's 1 1 1 2 4 bit times at BIT, each
+ * within a third of a bit and half a counting iteration: a run is measured
+ * to an iteration (6 cycles), which at 460800 (16 cycles a bit) is more than
+ * a third of a bit. */
+static uint8_t ab_shape(const uint16_t *run, uint8_t i, uint16_t bit)
+{
+	uint16_t want = bit;
+	uint16_t tol = (uint16_t)(bit / 3 + AB_LOOP_CYCLES / 2);
+
+	for (uint8_t j = 0; j < 5; j++) {
+		uint16_t c = AB_AT(run, i + j);
+
+		if (j >= 3) {
+			want += want;
+		}
+		if ((c > want ? c - want : want - c) > tol) {
+			return 0;
+		}
+	}
+	return 1;
+}
+
+/*
+ * Two frames in a row from I last 9 bit times (start bit to stop bit) of
+ * the same rate, with at least half a bit between them, and one of them
+ * has 0x0D's shape: that rate (UBRR + 1), or 0. One frame may be bent: an
+ * interrupt that runs while a run is timed shortens it (the drivers'
+ * interrupts stay on), which the 1/8 tolerance of a frame's length absorbs
+ * but a single run's may not.
+ */
+static uint8_t ab_check(const uint16_t *run, uint8_t i)
+{
+	uint8_t k = ab_frame(run, i);
+
+	if (k == 0 || ab_frame(run, i + 6) != k) {
+		return 0;
+	}
+	uint16_t bit = (uint16_t)(16 * k);
+
+	if (AB_AT(run, i + 5) < bit / 2) {
+		return 0;
+	}
+	return (ab_shape(run, i, bit) || ab_shape(run, i + 6, bit)) ? k : 0;
+}
+
+static void ab_listen(uint8_t ubrr)
+{
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		MCU_UBRRH = 0;
+		MCU_UBRRL = ubrr;
+		/* |=: the transmitter's UDRIE may be set (a reply going out). */
+		MCU_UCSRB |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
+		/* Framing errors seen so far were at the old rate. */
+		autobaud.lost = 0;
+		autobaud.fe_run = 0;
+	}
+}
+
+static void ab_deaf(void)
+{
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		MCU_UCSRB &= (uint8_t)~(_BV(RXEN) | _BV(RXCIE));
+		autobaud.lost = 0;
+	}
+	autobaud.state = AB_DETECT;
+}
+
+/*
+ * Record the line once: wait up to 65535 iterations (53 ms) for RXD to
+ * fall, then count the iterations of runs, low and high in turn, into the
+ * ring RUN of AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations
+ * (the line is quiet: that high run is not stored) or low for 65535 (a
+ * break). A high run's counter starts at -AB_QUIET so that its overflow is
+ * the quiet. The ring keeps the last AB_MAX_RUNS runs before the end,
+ * however long the line was busy. One block of assembly so that every step
+ * from one run to the next costs the same (AB_STEP_CYCLES).
+ *
+ * If the runs before the quiet hold two 0x0D in a row at one rate, that
+ * rate (UBRR + 1); the last such pair wins (a fresh run at another rate
+ * replaces an earlier one). 0: no rate; *HEARD 0: no edge in 53 ms.
+ */
+static uint8_t __attribute__((noinline)) ab_scan(uint8_t *heard)
+{
+	uint16_t run[AB_MAX_RUNS];
 	uint16_t *p = run;
 	uint8_t left = AB_MAX_RUNS;
 	uint8_t wrapped = 0;
 	uint8_t end;
 	uint16_t n;
 
+	wdt_reset();
 	asm volatile("	clr %A[n]\n\t"
 		     "	clr %B[n]\n"
 		     "0:	sbis %[pin], %[bit]\n\t"
@@ -150,157 +245,38 @@ static void __attribute__((noinline)) ab_record(uint16_t *run, uint8_t *why,
 		     "	ldi %[left], %[max]\n\t"
 		     "	ldi %[wr], 1\n\t"
 		     "	rjmp 1b\n"
-		     "8:	ldi %[end], %[quiet]\n\t"
+		     "8:	ldi %[end], 1\n\t"
 		     "	rjmp 10f\n"
-		     "9:	ldi %[end], %[brk]\n"
+		     "9:	ldi %[end], 0\n"
 		     "10:\n"
-		     : [n] "=&w" (n), [p] "+e" (p), [left] "+d" (left), [wr] "+d" (wrapped),
+		     : [n] "=&w" (n), [p] "+&e" (p), [left] "+d" (left), [wr] "+d" (wrapped),
 		       [end] "=&d" (end)
 		     : [base] "r" (run), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
-		       [q] "i" (0x10000L - AB_QUIET), [max] "M" (AB_MAX_RUNS),
-		       [quiet] "M" (AB_END_QUIET), [brk] "M" (AB_END_BREAK)
+		       [q] "i" (0x10000L - AB_QUIET), [max] "M" (AB_MAX_RUNS)
 		     : "memory");
-	*why = end;
-	*left_out = left;
-	*wrapped_out = wrapped;
-}
-
-static void ab_reverse(uint16_t *a, uint8_t n)
-{
-	for (uint8_t i = 0, j = (uint8_t)(n - 1); i < j; i++, j--) {
-		uint16_t t = a[i];
-
-		a[i] = a[j];
-		a[j] = t;
-	}
-}
-
-/* A run's length in cycles (the step to the next run included) from its
- * iterations; 0xFFFF for one longer than any run of a 0x0D. */
-static uint16_t ab_cycles(uint16_t count)
-{
-	return count > 4000 ? 0xFFFF : (uint16_t)(count * AB_LOOP_CYCLES + AB_STEP_CYCLES);
-}
-
-/* The rate whose 0x0D the five runs from RUN (RUN[0] low) are: its
- * index + 1, or 0. */
-static uint8_t ab_frame(const uint16_t *run)
-{
-	uint16_t total = 0;
-
-	for (uint8_t i = 0; i < 5; i++) {
-		uint16_t c = ab_cycles(run[i]);
-
-		if (c == 0xFFFF) {
-			return 0;
-		}
-		total += c;
-	}
-	for (uint8_t r = 0; r < AB_NRATES; r++) {
-		uint16_t nine = (uint16_t)(9 * ab_rates[r].bit);
-		uint16_t diff = total > nine ? total - nine : nine - total;
-
-		if (diff <= nine / 8) {
-			return (uint8_t)(r + 1);
-		}
-	}
-	return 0;
-}
-
-/* The five runs from RUN match 0x0D's 1 1 1 2 4 bit times at BIT, each
- * within a third of a bit and half a counting iteration: a run is measured
- * to an iteration (6 cycles), which at 460800 (16 cycles a bit) is more than
- * a third of a bit. */
-static uint8_t ab_shape(const uint16_t *run, uint16_t bit)
-{
-	for (uint8_t i = 0; i < 5; i++) {
-		uint16_t want = (uint16_t)(ab_pattern[i] * bit);
-		uint16_t c = ab_cycles(run[i]);
-
-		if ((c > want ? c - want : want - c) > bit / 3 + AB_LOOP_CYCLES / 2) {
-			return 0;
-		}
-	}
-	return 1;
-}
-
-/*
- * Two frames in a row last 9 bit times (start bit to stop bit) of the same
- * rate, with at least half a bit between them, and one of them has 0x0D's
- * shape: that rate's index + 1, or 0. One frame may be bent: an interrupt
- * that runs while a run is timed shortens it (the drivers' interrupts stay
- * on), which the 1/8 tolerance of a frame's length absorbs but a single
- * run's may not.
- */
-static uint8_t ab_check(const uint16_t *run)
-{
-	uint8_t r = ab_frame(run);
-
-	if (r == 0 || ab_frame(run + 6) != r) {
-		return 0;
-	}
-	uint16_t bit = ab_rates[r - 1].bit;
-
-	if (ab_cycles(run[5]) < bit / 2) {
-		return 0;
-	}
-	return (ab_shape(run, bit) || ab_shape(run + 6, bit)) ? r : 0;
-}
-
-static void ab_listen(uint8_t ubrr)
-{
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		MCU_UBRRH = 0;
-		MCU_UBRRL = ubrr;
-		/* |=: the transmitter's UDRIE may be set (a reply going out). */
-		MCU_UCSRB |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
-		/* Framing errors seen so far were at the old rate. */
-		autobaud.lost = 0;
-		autobaud.fe_run = 0;
-	}
-}
-
-static void ab_deaf(void)
-{
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		MCU_UCSRB &= (uint8_t)~(_BV(RXEN) | _BV(RXCIE));
-		autobaud.lost = 0;
-	}
-	autobaud.state = AB_DETECT;
-}
-
-/* Record the line once, until it is quiet (AB_QUIET), or 53 ms without an
- * edge (*HEARD = 0). If the last AB_MAX_RUNS runs before the quiet hold two
- * 0x0D in a row at one rate, that rate (index + 1); the last such pair wins
- * (a fresh run at another rate replaces an earlier one). 0: no rate. */
-static uint8_t ab_scan(uint8_t *heard)
-{
-	uint16_t run[AB_MAX_RUNS];
-	uint8_t why, left, wrapped, n, first;
+	uint8_t count = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
+	uint8_t oldest = 0;
 	uint8_t found = 0;
 
-	wdt_reset();
-	ab_record(run, &why, &left, &wrapped);
-	n = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
-	*heard = n || wrapped;
-	if (why != AB_END_QUIET) {
-		return 0;
+	*heard = count || wrapped;
+	if (!end) {
+		return 0;	/* a break */
 	}
-	/* High runs (odd positions) counted from -AB_QUIET. */
-	for (uint8_t i = 1; i < (wrapped ? AB_MAX_RUNS : n); i += 2) {
-		run[i] = (uint16_t)(run[i] + AB_QUIET);
-	}
-	first = 0;
 	if (wrapped) {
-		/* oldest first: rotate the ring left by n */
-		ab_reverse(run, n);
-		ab_reverse(run + n, (uint8_t)(AB_MAX_RUNS - n));
-		ab_reverse(run, AB_MAX_RUNS);
-		first = n & 1;		/* a frame starts on a low run */
-		n = AB_MAX_RUNS;
+		oldest = count;
+		count = AB_MAX_RUNS;
 	}
-	for (uint8_t i = first; i + AB_PAIR <= n; i += 2) {
-		uint8_t r = ab_check(run + i);
+	/* In cycles, the step to the next run included; 0xFFFF for one
+	 * longer than any run of a 0x0D. High runs (odd positions) were
+	 * counted from -AB_QUIET. */
+	for (uint8_t i = 0; i < count; i++) {
+		uint16_t c = (uint16_t)(run[i] + ((i & 1) ? AB_QUIET : 0));
+
+		run[i] = c > AB_LONG ? 0xFFFF : (uint16_t)(c * AB_LOOP_CYCLES + AB_STEP_CYCLES);
+	}
+	/* From the oldest low run (even positions), oldest first. */
+	for (uint8_t i = oldest & 1; i + AB_PAIR <= count; i += 2) {
+		uint8_t r = ab_check(run, (uint8_t)(oldest + i));
 
 		if (r) {
 			found = r;
@@ -325,26 +301,26 @@ uint8_t uart_line_poll(void)
 	if (autobaud.state == AB_TALK) {
 		return 0;
 	}
-	if (autobaud.state == AB_FRESH) {
-		/* Until a request proves the rate, the pin is still watched
-		 * (the receiver runs on): a preamble at another rate after a
-		 * wrong lock (noise that looked like one) moves the rate. The
-		 * bytes the receiver takes meanwhile wait in the ring. */
+	do {
 		r = ab_scan(&heard);
-		if (r == 0 || r == autobaud.rate) {
-			return 0;
+		if (autobaud.state == AB_FRESH) {
+			/* Until a request proves the rate, the pin is still
+			 * watched (the receiver runs on): a preamble at another
+			 * rate after a wrong lock (noise that looked like one)
+			 * moves the rate. The bytes the receiver takes meanwhile
+			 * wait in the ring. One record a call. */
+			if (r == 0 || r == autobaud.rate) {
+				return 0;
+			}
+			break;
 		}
-	} else {
-		do {
-			r = ab_scan(&heard);
-		} while (r == 0 && heard);
-	}
+	} while (r == 0 && heard);
 	if (r == 0) {
 		return 1;	/* quiet for 53 ms: round the main loop */
 	}
 	autobaud.rate = r;
 	autobaud.state = AB_FRESH;
-	ab_listen(ab_rates[r - 1].ubrr);
+	ab_listen((uint8_t)(r - 1));
 	return 1;
 }
 
