@@ -29,6 +29,7 @@
 #include "firmware/uart_line.h"
 
 #include <avr/io.h>
+#include <string.h>
 #include <avr/wdt.h>
 #include <util/atomic.h>
 
@@ -64,8 +65,10 @@ _Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart
 #define AB_LOOP_CYCLES 6
 #define AB_STEP_CYCLES 12
 /* Iterations above which a run is longer than any run of a 0x0D (4 bit
- * times at 2400 baud are 2048). */
+ * times at 2400 baud are 2048), and its mark in cycles (any shorter run is
+ * less than 0x8000 cycles). */
 #define AB_LONG 4000
+#define AB_TOO_LONG 0x8000
 
 /* The rates as UBRR + 1 (F_CPU / 16 / rate): a bit lasts 16 times that
  * many cycles; all exact at 7.3728 MHz. */
@@ -89,51 +92,44 @@ static struct {
 	uint8_t fe_run;
 } autobaud;
 
-/* Run I of the ring RUN (any I: the ring's index wraps). */
-#define AB_AT(run, i) ((run)[(uint8_t)(i) & (AB_MAX_RUNS - 1)])
-
-/* The rate (UBRR + 1) whose 0x0D the five runs from I are (in cycles,
- * RUN[I] low), by their total of nine bit times within 1/8; or 0. */
-static uint8_t ab_frame(const uint16_t *run, uint8_t i)
+/* The rate (UBRR + 1) whose 0x0D the five runs from P are (in cycles,
+ * P[0] low), by their total of nine bit times within 1/8: (144 - 18) k
+ * <= total <= (144 + 18) k, the twelve rates' ranges apart; or 0. */
+static uint8_t ab_frame(const uint16_t *p)
 {
 	uint16_t total = 0;
 
 	for (uint8_t j = 0; j < 5; j++) {
-		uint16_t c = AB_AT(run, i + j);
-
-		if (c == 0xFFFF) {
+		if (p[j] & AB_TOO_LONG) {
 			return 0;
 		}
-		total += c;
+		total += p[j];
 	}
 	for (uint8_t r = 0; r < AB_NRATES; r++) {
 		uint8_t k = ab_rates[r];
-		uint16_t nine = (uint16_t)(9 * 16 * k);
-		uint16_t diff = total > nine ? total - nine : nine - total;
 
-		if (diff <= nine / 8) {
+		if ((uint16_t)(total - 126 * k) <= (uint16_t)(36 * k)) {
 			return k;
 		}
 	}
 	return 0;
 }
 
-/* The five runs from I match 0x0D's 1 1 1 2 4 bit times at BIT, each
+/* The five runs from P match 0x0D's 1 1 1 2 4 bit times at rate K, each
  * within a third of a bit and half a counting iteration: a run is measured
  * to an iteration (6 cycles), which at 460800 (16 cycles a bit) is more than
- * a third of a bit. */
-static uint8_t ab_shape(const uint16_t *run, uint8_t i, uint16_t bit)
+ * a third of a bit. No run is AB_TOO_LONG here (ab_check took them). */
+static uint8_t ab_shape(const uint16_t *p, uint8_t k)
 {
-	uint16_t want = bit;
-	uint16_t tol = (uint16_t)(bit / 3 + AB_LOOP_CYCLES / 2);
+	uint16_t want = (uint16_t)(16 * k);
+	uint16_t tol = (uint16_t)(want / 3 + AB_LOOP_CYCLES / 2);
 
 	for (uint8_t j = 0; j < 5; j++) {
-		uint16_t c = AB_AT(run, i + j);
-
 		if (j >= 3) {
 			want += want;
 		}
-		if ((c > want ? c - want : want - c) > tol) {
+		/* want - tol <= p[j] <= want + tol */
+		if ((uint16_t)(p[j] - want + tol) > (uint16_t)(2 * tol)) {
 			return 0;
 		}
 	}
@@ -141,26 +137,21 @@ static uint8_t ab_shape(const uint16_t *run, uint8_t i, uint16_t bit)
 }
 
 /*
- * Two frames in a row from I last 9 bit times (start bit to stop bit) of
- * the same rate, with at least half a bit between them, and one of them
- * has 0x0D's shape: that rate (UBRR + 1), or 0. One frame may be bent: an
- * interrupt that runs while a run is timed shortens it (the drivers'
- * interrupts stay on), which the 1/8 tolerance of a frame's length absorbs
- * but a single run's may not.
+ * Two frames in a row from P (P[0] low) last 9 bit times (start bit to
+ * stop bit) of the same rate, with at least half a bit between them, and
+ * one of them has 0x0D's shape: that rate (UBRR + 1), or 0. One frame may
+ * be bent: an interrupt that runs while a run is timed shortens it (the
+ * drivers' interrupts stay on), which the 1/8 tolerance of a frame's length
+ * absorbs but a single run's may not.
  */
-static uint8_t ab_check(const uint16_t *run, uint8_t i)
+static uint8_t __attribute__((noinline)) ab_check(const uint16_t *p)
 {
-	uint8_t k = ab_frame(run, i);
+	uint8_t k = ab_frame(p);
 
-	if (k == 0 || ab_frame(run, i + 6) != k) {
+	if (k == 0 || ab_frame(p + 6) != k || p[5] < (uint16_t)(8 * k)) {
 		return 0;
 	}
-	uint16_t bit = (uint16_t)(16 * k);
-
-	if (AB_AT(run, i + 5) < bit / 2) {
-		return 0;
-	}
-	return (ab_shape(run, i, bit) || ab_shape(run, i + 6, bit)) ? k : 0;
+	return (ab_shape(p, k) || ab_shape(p + 6, k)) ? k : 0;
 }
 
 static void ab_listen(uint8_t ubrr)
@@ -201,7 +192,9 @@ static void ab_deaf(void)
  */
 static uint8_t __attribute__((noinline)) ab_scan(uint8_t *heard)
 {
-	uint16_t run[AB_MAX_RUNS];
+	/* the ring, and its first AB_PAIR - 1 runs again after it: a pair
+	 * across its end is read in one piece */
+	uint16_t run[AB_MAX_RUNS + AB_PAIR - 1];
 	uint16_t *p = run;
 	uint8_t left = AB_MAX_RUNS;
 	uint8_t wrapped = 0;
@@ -256,7 +249,6 @@ static uint8_t __attribute__((noinline)) ab_scan(uint8_t *heard)
 		     : "memory");
 	uint8_t count = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
 	uint8_t oldest = 0;
-	uint8_t found = 0;
 
 	*heard = count || wrapped;
 	if (!end) {
@@ -266,23 +258,31 @@ static uint8_t __attribute__((noinline)) ab_scan(uint8_t *heard)
 		oldest = count;
 		count = AB_MAX_RUNS;
 	}
-	/* In cycles, the step to the next run included; 0xFFFF for one
-	 * longer than any run of a 0x0D. High runs (odd positions) were
+	/* In cycles, the step to the next run included; AB_TOO_LONG for
+	 * one longer than any run of a 0x0D. High runs (odd positions) were
 	 * counted from -AB_QUIET. */
 	for (uint8_t i = 0; i < count; i++) {
-		uint16_t c = (uint16_t)(run[i] + ((i & 1) ? AB_QUIET : 0));
+		uint16_t c = run[i];
 
-		run[i] = c > AB_LONG ? 0xFFFF : (uint16_t)(c * AB_LOOP_CYCLES + AB_STEP_CYCLES);
+		if (i & 1) {
+			c += AB_QUIET;
+		}
+		run[i] = c > AB_LONG ? AB_TOO_LONG : (uint16_t)(c * AB_LOOP_CYCLES + AB_STEP_CYCLES);
 	}
-	/* From the oldest low run (even positions), oldest first. */
-	for (uint8_t i = oldest & 1; i + AB_PAIR <= count; i += 2) {
-		uint8_t r = ab_check(run, (uint8_t)(oldest + i));
+	memcpy(run + AB_MAX_RUNS, run, (AB_PAIR - 1) * sizeof(run[0]));
+	/* From the newest low run (even positions) back: the last pair wins. */
+	for (int8_t i = (int8_t)(count - AB_PAIR); i >= 0; i--) {
+		uint8_t at = (uint8_t)(oldest + i) & (AB_MAX_RUNS - 1);
 
-		if (r) {
-			found = r;
+		if (!(at & 1)) {
+			uint8_t r = ab_check(run + at);
+
+			if (r) {
+				return r;
+			}
 		}
 	}
-	return found;
+	return 0;
 }
 
 void uart_init(void)
