@@ -40,7 +40,8 @@
 
 /* The preamble is over when RXD stays high this long (iterations of 6
  * cycles: 6.7 ms, 16 bit times at 2400 baud; a host waits at least 20 ms),
- * so the USART starts on an idle line, in step with the next start bit. */
+ * so the USART starts on an idle line, in step with the next start bit.
+ * Low this long is a break (a 0x00 at 2400 baud is 4608 iterations). */
 #define AB_QUIET 8192
 /* Runs kept of a record (up to five per character; stack bytes x2): the
  * eight 0x0D of a preamble are 47. */
@@ -65,10 +66,13 @@ _Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart
 #define AB_LOOP_CYCLES 6
 #define AB_STEP_CYCLES 12
 /* Iterations above which a run is longer than any run of a 0x0D (4 bit
- * times at 2400 baud are 2048), and its mark in cycles (any shorter run is
- * less than 0x8000 cycles). */
+ * times at 2400 baud are 2048). */
 #define AB_LONG 4000
-#define AB_TOO_LONG 0x8000
+/* A run's iterations from what ab_scan stored: its counter started at
+ * -AB_QUIET. */
+#define AB_ITER(stored) ((uint16_t)((stored) + AB_QUIET))
+/* ... and its length in cycles, the step to the next run included. */
+#define AB_CYCLES(stored) ((uint16_t)(AB_ITER(stored) * AB_LOOP_CYCLES + AB_STEP_CYCLES))
 
 /* The rates as UBRR + 1 (F_CPU / 16 / rate): a bit lasts 16 times that
  * many cycles; all exact at 7.3728 MHz. */
@@ -92,23 +96,32 @@ static struct {
 	uint8_t fe_run;
 } autobaud;
 
-/* The rate (UBRR + 1) whose 0x0D the five runs from P are (in cycles,
- * P[0] low), by their total of nine bit times within 1/8: (144 - 18) k
- * <= total <= (144 + 18) k, the twelve rates' ranges apart; or 0. */
+/*
+ * The rate (UBRR + 1) whose 0x0D the five runs from P are (P[0] low), by
+ * their total of nine bit times within 1/8: (144 - 18) k <= cycles <=
+ * (144 + 18) k, the twelve rates' ranges apart; or 0. In iterations:
+ * cycles are 6 its + 5 steps, each bound a multiple of 6.
+ */
+#define AB_NINE_LO(k) ((126 * (k) - 5 * AB_STEP_CYCLES) / AB_LOOP_CYCLES)
+#define AB_NINE_SPAN(k) (36 * (k) / AB_LOOP_CYCLES)
+_Static_assert(126 % AB_LOOP_CYCLES == 0 && 36 % AB_LOOP_CYCLES == 0 &&
+	       5 * AB_STEP_CYCLES % AB_LOOP_CYCLES == 0, "the bounds in whole iterations");
 static uint8_t ab_frame(const uint16_t *p)
 {
-	uint16_t total = 0;
+	uint16_t its = 0;
 
 	for (uint8_t j = 0; j < 5; j++) {
-		if (p[j] & AB_TOO_LONG) {
+		uint16_t n = AB_ITER(p[j]);
+
+		if (n > AB_LONG) {
 			return 0;
 		}
-		total += p[j];
+		its += n;
 	}
 	for (uint8_t r = 0; r < AB_NRATES; r++) {
 		uint8_t k = ab_rates[r];
 
-		if ((uint16_t)(total - 126 * k) <= (uint16_t)(36 * k)) {
+		if ((uint16_t)(its - AB_NINE_LO(k)) <= (uint16_t)AB_NINE_SPAN(k)) {
 			return k;
 		}
 	}
@@ -118,7 +131,8 @@ static uint8_t ab_frame(const uint16_t *p)
 /* The five runs from P match 0x0D's 1 1 1 2 4 bit times at rate K, each
  * within a third of a bit and half a counting iteration: a run is measured
  * to an iteration (6 cycles), which at 460800 (16 cycles a bit) is more than
- * a third of a bit. No run is AB_TOO_LONG here (ab_check took them). */
+ * a third of a bit. No run is longer than AB_LONG here (ab_frame took
+ * them). */
 static uint8_t ab_shape(const uint16_t *p, uint8_t k)
 {
 	uint16_t want = (uint16_t)(16 * k);
@@ -128,8 +142,8 @@ static uint8_t ab_shape(const uint16_t *p, uint8_t k)
 		if (j >= 3) {
 			want += want;
 		}
-		/* want - tol <= p[j] <= want + tol */
-		if ((uint16_t)(p[j] - want + tol) > (uint16_t)(2 * tol)) {
+		/* want - tol <= cycles <= want + tol */
+		if ((uint16_t)(AB_CYCLES(p[j]) - want + tol) > (uint16_t)(2 * tol)) {
 			return 0;
 		}
 	}
@@ -148,7 +162,8 @@ static uint8_t __attribute__((noinline)) ab_check(const uint16_t *p)
 {
 	uint8_t k = ab_frame(p);
 
-	if (k == 0 || ab_frame(p + 6) != k || p[5] < (uint16_t)(8 * k)) {
+	/* P[5], a high run, is below AB_QUIET iterations: its cycles fit */
+	if (k == 0 || ab_frame(p + 6) != k || AB_CYCLES(p[5]) < (uint16_t)(8 * k)) {
 		return 0;
 	}
 	return (ab_shape(p, k) || ab_shape(p + 6, k)) ? k : 0;
@@ -180,9 +195,9 @@ static void ab_deaf(void)
  * Record the line once: wait up to 65535 iterations (53 ms) for RXD to
  * fall, then count the iterations of runs, low and high in turn, into the
  * ring RUN of AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations
- * (the line is quiet: that high run is not stored) or low for 65535 (a
- * break). A high run's counter starts at -AB_QUIET so that its overflow is
- * the quiet. The ring keeps the last AB_MAX_RUNS runs before the end,
+ * (the line is quiet: that high run is not stored) or low as long (a
+ * break). Every run's counter starts at -AB_QUIET so that its overflow is
+ * the quiet or the break. The ring keeps the last AB_MAX_RUNS runs before the end,
  * however long the line was busy. One block of assembly so that every step
  * from one run to the next costs the same (AB_STEP_CYCLES).
  *
@@ -209,8 +224,8 @@ static uint8_t __attribute__((noinline)) ab_scan(uint8_t *heard)
 		     "	adiw %[n], 1\n\t"
 		     "	brne 0b\n\t"
 		     "	rjmp 8f\n"
-		     "1:	clr %A[n]\n\t"
-		     "	clr %B[n]\n"
+		     "1:	ldi %A[n], lo8(%[q])\n\t"
+		     "	ldi %B[n], hi8(%[q])\n"
 		     "2:	sbic %[pin], %[bit]\n\t"
 		     "	rjmp 3f\n\t"
 		     "	adiw %[n], 1\n\t"
@@ -257,17 +272,6 @@ static uint8_t __attribute__((noinline)) ab_scan(uint8_t *heard)
 	if (wrapped) {
 		oldest = count;
 		count = AB_MAX_RUNS;
-	}
-	/* In cycles, the step to the next run included; AB_TOO_LONG for
-	 * one longer than any run of a 0x0D. High runs (odd positions) were
-	 * counted from -AB_QUIET. */
-	for (uint8_t i = 0; i < count; i++) {
-		uint16_t c = run[i];
-
-		if (i & 1) {
-			c += AB_QUIET;
-		}
-		run[i] = c > AB_LONG ? AB_TOO_LONG : (uint16_t)(c * AB_LOOP_CYCLES + AB_STEP_CYCLES);
 	}
 	memcpy(run + AB_MAX_RUNS, run, (AB_PAIR - 1) * sizeof(run[0]));
 	/* From the newest low run (even positions) back: the last pair wins. */
