@@ -87,11 +87,13 @@ static const ORFA_FLASH uint8_t ab_rates[] = { ORFA_BAUD_RATES(AB_RATE) };
 /* The runs of two frames with the high run between them (stop bit and
  * any gap). */
 #define AB_PAIR 11
-enum { AB_DETECT, AB_FRESH, AB_TALK };
+/* The states, each the number of frames with FE in a row that send it
+ * back to detection (the receiver is off in AB_DETECT). */
+enum { AB_DETECT = 0, AB_FRESH = 1, AB_TALK = AB_FE_RUN };
 
 static struct {
 	uint8_t state;
-	uint8_t rate;		/* UBRR + 1 of the rate in use */
+	uint8_t rate;		/* UBRR + 1 of the rate in use, 0 in AB_DETECT */
 	volatile uint8_t lost;	/* set by the receive interrupt */
 	uint8_t fe_run;
 } autobaud;
@@ -189,6 +191,7 @@ static void ab_deaf(void)
 		autobaud.lost = 0;
 	}
 	autobaud.state = AB_DETECT;
+	autobaud.rate = 0;
 }
 
 /*
@@ -203,9 +206,10 @@ static void ab_deaf(void)
  *
  * If the runs before the quiet hold two 0x0D in a row at one rate, that
  * rate (UBRR + 1); the last such pair wins (a fresh run at another rate
- * replaces an earlier one). 0: no rate; *HEARD 0: no edge in 53 ms.
+ * replaces an earlier one). 0: no rate (also after 53 ms without an
+ * edge).
  */
-static uint8_t __attribute__((noinline)) ab_scan(uint8_t *heard)
+static uint8_t __attribute__((noinline)) ab_scan(void)
 {
 	/* the ring, and its first AB_PAIR - 1 runs again after it: a pair
 	 * across its end is read in one piece */
@@ -265,7 +269,6 @@ static uint8_t __attribute__((noinline)) ab_scan(uint8_t *heard)
 	uint8_t count = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
 	uint8_t oldest = 0;
 
-	*heard = count || wrapped;
 	if (!end) {
 		return 0;	/* a break */
 	}
@@ -296,31 +299,21 @@ void uart_init(void)
 
 uint8_t uart_line_poll(void)
 {
-	uint8_t r;
-	uint8_t heard;
-
 	if (autobaud.lost) {
 		ab_deaf();
 	}
 	if (autobaud.state == AB_TALK) {
 		return 0;
 	}
-	do {
-		r = ab_scan(&heard);
-		if (autobaud.state == AB_FRESH) {
-			/* Until a request proves the rate, the pin is still
-			 * watched (the receiver runs on): a preamble at another
-			 * rate after a wrong lock (noise that looked like one)
-			 * moves the rate. The bytes the receiver takes meanwhile
-			 * wait in the ring. One record a call. */
-			if (r == 0 || r == autobaud.rate) {
-				return 0;
-			}
-			break;
-		}
-	} while (r == 0 && heard);
-	if (r == 0) {
-		return 1;	/* quiet for 53 ms: round the main loop */
+	/* One record a call. While the rate is fresh the pin is still
+	 * watched (the receiver runs on): a preamble at another rate after a
+	 * wrong lock (noise that looked like one) moves the rate. The bytes
+	 * the receiver takes meanwhile wait in the ring. */
+	uint8_t r = ab_scan();
+
+	if (r == 0 || r == autobaud.rate) {
+		/* no rate yet: round the main loop (nothing received to drop) */
+		return autobaud.state == AB_DETECT;
 	}
 	autobaud.rate = r;
 	autobaud.state = AB_FRESH;
@@ -332,7 +325,7 @@ void uart_line_rx(void)
 {
 	if (!(MCU_UCSRA & _BV(FE))) {
 		autobaud.fe_run = 0;
-	} else if (autobaud.state != AB_TALK || ++autobaud.fe_run >= AB_FE_RUN) {
+	} else if (++autobaud.fe_run >= autobaud.state) {
 		autobaud.lost = 1;
 	}
 }
