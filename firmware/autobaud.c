@@ -174,7 +174,7 @@ static uint8_t __attribute__((noinline)) ab_check(const uint16_t *p)
 static void ab_listen(uint8_t ubrr)
 {
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		MCU_UBRRH = 0;
+		/* UBRRH: 0 from reset (every rate's UBRR is 8-bit) */
 		MCU_UBRRL = ubrr;
 		/* |=: the transmitter's UDRIE may be set (a reply going out). */
 		MCU_UCSRB |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
@@ -292,9 +292,11 @@ static uint8_t __attribute__((noinline)) ab_scan(void)
 	return 0;
 }
 
+/* After reset the receiver is off and the state AB_DETECT: zero, as
+ * static storage starts. */
+_Static_assert(AB_DETECT == 0, "the state at reset is the zeroed one");
 void uart_init(void)
 {
-	autobaud.state = AB_DETECT;
 }
 
 uint8_t uart_line_poll(void)
