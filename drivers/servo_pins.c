@@ -294,12 +294,12 @@ void servo_hw_init(void)
 
 bool servo_hw_can_claim(uint8_t ch)
 {
-	return pins_can_claim(board_pin(BF_SERVO, ch), PIN_SERVO);
+	return pins_can_claim(servo_pin[ch], PIN_SERVO);
 }
 
 bool servo_hw_claim(uint8_t ch)
 {
-	uint8_t pin = board_pin(BF_SERVO, ch);
+	uint8_t pin = servo_pin[ch];
 	if (!pins_claim(pin, PIN_SERVO)) {
 		return false;
 	}
@@ -310,7 +310,7 @@ bool servo_hw_claim(uint8_t ch)
 
 void servo_hw_release(uint8_t ch)
 {
-	pins_release(board_pin(BF_SERVO, ch), PIN_SERVO);
+	pins_release(servo_pin[ch], PIN_SERVO);
 }
 
 void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
