@@ -303,8 +303,7 @@ bool servo_hw_claim(uint8_t ch)
 	if (!pins_claim(pin, PIN_SERVO)) {
 		return false;
 	}
-	port_io_write(PIN_PORT(pin), PIN_MASK(pin), 0);
-	port_io_dir(PIN_PORT(pin), PIN_MASK(pin), PIN_MASK(pin));
+	pins_drive(pin, false);  /* output, low */
 	return true;
 }
 
