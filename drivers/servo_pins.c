@@ -90,8 +90,12 @@ static struct {
 	uint8_t t0_offset;           /* TCNT0 - 8 * TCNT2, measured at start */
 } pulses;
 
-/* Each channel's pin (PIN_ID), from the board's pin map. */
+/* Each channel's pin (PIN_ID), from the board's pin map, which has
+ * channels 0..SERVO_CHANNELS-1 once each. */
 static uint8_t servo_pin[SERVO_CHANNELS];
+#define SERVO_PIN_ROW(port, line, fn, index) +(BF_##fn == BF_SERVO && (index) < SERVO_CHANNELS)
+_Static_assert((0 BOARD_PINS(SERVO_PIN_ROW)) == SERVO_CHANNELS, "a pin for every servo channel");
+#undef SERVO_PIN_ROW
 
 static const __flash uint8_t port_addr[] = {
 	_SFR_MEM_ADDR(PORTA), _SFR_MEM_ADDR(PORTB), _SFR_MEM_ADDR(PORTC), _SFR_MEM_ADDR(PORTD),
@@ -272,9 +276,7 @@ ISR(TIMER2_COMP_vect)
 
 void servo_hw_init(void)
 {
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		servo_pin[ch] = board_pin(BF_SERVO, ch);
-	}
+	board_pins_of(BF_SERVO, servo_pin);
 	pulses.running = 0;
 	pulses.pending = 0;
 	pulses.active = 0;
