@@ -131,15 +131,18 @@ uint8_t drv_servo_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
 	uint8_t n = 0;
 	if (reg == SERVO_REG_RS) {
-		for (uint8_t i = 0; i < SERVO_CHANNELS / 8 && n < max; i++, n++) {
-			uint8_t bits = 0;
-			uint8_t base = (uint8_t)(SERVO_CHANNELS - 8 * (i + 1));
-			for (uint8_t b = 0; b < 8; b++) {
-				if (servo.width[base + b]) {
-					bits |= (uint8_t)(1u << b);
-				}
+		/* from the last channel down, each shifted in at bit 0: a byte
+		 * is done at a channel that is a multiple of 8 */
+		_Static_assert(SERVO_CHANNELS % 8 == 0, "whole bytes of the mask");
+		uint8_t bits = 0;
+		for (uint8_t ch = SERVO_CHANNELS; ch-- && n < max;) {
+			bits = (uint8_t)(bits << 1);
+			if (servo.width[ch]) {
+				bits |= 1;
 			}
-			dst[n] = bits;
+			if (!(ch & 7)) {
+				dst[n++] = bits;
+			}
 		}
 		return n;
 	}

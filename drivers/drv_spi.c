@@ -1,5 +1,7 @@
 #include "drivers/drv_spi.h"
 
+#include <string.h>
+
 #include "board.h"
 #include "drivers/spi_hw.h"
 #include "firmware/board_pins.h"
@@ -98,9 +100,7 @@ static reg_status_t spi_data(const uint8_t *data, uint8_t len)
 		return REG_NOT_BOUND;
 	}
 	uint8_t n = (uint8_t)(len - 1);
-	for (uint8_t i = 0; i < n; i++) {
-		spi.rx[i] = data[1 + i];
-	}
+	memcpy(spi.rx, data + 1, n);
 	pins_level(pin, false);
 	spi_hw_exchange(spi.rx, n);
 	pins_level(pin, true);

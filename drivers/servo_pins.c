@@ -109,8 +109,12 @@ static struct {
 	uint8_t t0_offset;           /* TCNT0 - 8 * TCNT2, measured at start */
 } pulses;
 
-/* Each channel's pin (PIN_ID), from the board's pin map. */
+/* Each channel's pin (PIN_ID), from the board's pin map, which has
+ * channels 0..SERVO_CHANNELS-1 once each. */
 static uint8_t servo_pin[SERVO_CHANNELS];
+#define SERVO_PIN_ROW(port, line, fn, index) +(BF_##fn == BF_SERVO && (index) < SERVO_CHANNELS)
+_Static_assert((0 BOARD_PINS(SERVO_PIN_ROW)) == SERVO_CHANNELS, "a pin for every servo channel");
+#undef SERVO_PIN_ROW
 
 static const __flash uint8_t port_addr[] = {
 	_SFR_MEM_ADDR(PORTA), _SFR_MEM_ADDR(PORTB), _SFR_MEM_ADDR(PORTC), _SFR_MEM_ADDR(PORTD),
@@ -291,9 +295,7 @@ ISR(TIMER2_COMP_vect)
 
 void servo_hw_init(void)
 {
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		servo_pin[ch] = board_pin(BF_SERVO, ch);
-	}
+	board_pins_of(BF_SERVO, servo_pin);
 	pulses.running = 0;
 	pulses.pending = 0;
 	pulses.active = 0;
@@ -313,23 +315,22 @@ void servo_hw_init(void)
 
 bool servo_hw_can_claim(uint8_t ch)
 {
-	return pins_can_claim(board_pin(BF_SERVO, ch), PIN_SERVO);
+	return pins_can_claim(servo_pin[ch], PIN_SERVO);
 }
 
 bool servo_hw_claim(uint8_t ch)
 {
-	uint8_t pin = board_pin(BF_SERVO, ch);
+	uint8_t pin = servo_pin[ch];
 	if (!pins_claim(pin, PIN_SERVO)) {
 		return false;
 	}
-	port_io_write(PIN_PORT(pin), PIN_MASK(pin), 0);
-	port_io_dir(PIN_PORT(pin), PIN_MASK(pin), PIN_MASK(pin));
+	pins_drive(pin, false);  /* output, low */
 	return true;
 }
 
 void servo_hw_release(uint8_t ch)
 {
-	pins_release(board_pin(BF_SERVO, ch), PIN_SERVO);
+	pins_release(servo_pin[ch], PIN_SERVO);
 }
 
 void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)

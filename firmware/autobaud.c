@@ -29,6 +29,7 @@
 #include "firmware/uart_line.h"
 
 #include <avr/io.h>
+#include <string.h>
 #include <avr/wdt.h>
 #include <util/atomic.h>
 
@@ -39,7 +40,8 @@
 
 /* The preamble is over when RXD stays high this long (iterations of 6
  * cycles: 6.7 ms, 16 bit times at 2400 baud; a host waits at least 20 ms),
- * so the USART starts on an idle line, in step with the next start bit. */
+ * so the USART starts on an idle line, in step with the next start bit.
+ * Low this long is a break (a 0x00 at 2400 baud is 4608 iterations). */
 #define AB_QUIET 8192
 /* Runs kept of a record (up to five per character; stack bytes x2): the
  * eight 0x0D of a preamble are 47. */
@@ -63,57 +65,162 @@ _Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart
  * and of the step from one run to the next in ab_record. */
 #define AB_LOOP_CYCLES 6
 #define AB_STEP_CYCLES 12
+/* Iterations above which a run is longer than any run of a 0x0D (4 bit
+ * times at 2400 baud are 2048). */
+#define AB_LONG 4000
+/* A run's iterations from what ab_scan stored: its counter started at
+ * -AB_QUIET. */
+#define AB_ITER(stored) ((uint16_t)((stored) + AB_QUIET))
+/* ... and its length in cycles, the step to the next run included. */
+#define AB_CYCLES(stored) ((uint16_t)(AB_ITER(stored) * AB_LOOP_CYCLES + AB_STEP_CYCLES))
 
-/* The rates: bit time in cycles and UBRR, exact at 7.3728 MHz. */
-#define AB_RATE(r) { (uint16_t)(F_CPU / (r)), (uint8_t)(F_CPU / (16UL * (r)) - 1) },
-#define AB_EXACT(r) _Static_assert(F_CPU % (16UL * (r)) == 0 && F_CPU / (16UL * (r)) <= 256, \
+/* The rates as UBRR + 1 (F_CPU / 16 / rate): a bit lasts 16 times that
+ * many cycles; all exact at 7.3728 MHz. */
+#define AB_RATE(r) (uint8_t)(F_CPU / (16UL * (r))),
+#define AB_EXACT(r) _Static_assert(F_CPU % (16UL * (r)) == 0 && F_CPU / (16UL * (r)) <= 255, \
 				   "UBRR exact and 8-bit for " #r);
 ORFA_BAUD_RATES(AB_EXACT)
 
-typedef struct {
-	uint16_t bit;
-	uint8_t ubrr;
-} ab_rate_t;
-
-static const ORFA_FLASH ab_rate_t ab_rates[] = { ORFA_BAUD_RATES(AB_RATE) };
+static const ORFA_FLASH uint8_t ab_rates[] = { ORFA_BAUD_RATES(AB_RATE) };
 #define AB_NRATES (sizeof(ab_rates) / sizeof(ab_rates[0]))
 
-/* 0x0D from its start bit, runs in bit times; and the runs of two frames
- * with the high run between them (stop bit and any gap). */
-static const ORFA_FLASH uint8_t ab_pattern[5] = { 1, 1, 1, 2, 4 };
+/* The runs of two frames with the high run between them (stop bit and
+ * any gap). */
 #define AB_PAIR 11
-
-/* Why a record ended. */
-enum { AB_END_QUIET = 1, AB_END_BREAK };
-
-enum { AB_DETECT, AB_FRESH, AB_TALK };
+/* The states, each the number of frames with FE in a row that send it
+ * back to detection (the receiver is off in AB_DETECT). */
+enum { AB_DETECT = 0, AB_FRESH = 1, AB_TALK = AB_FE_RUN };
 
 static struct {
 	uint8_t state;
-	uint8_t rate;		/* index + 1 of the rate in use */
+	uint8_t rate;		/* UBRR + 1 of the rate in use, 0 in AB_DETECT */
 	volatile uint8_t lost;	/* set by the receive interrupt */
 	uint8_t fe_run;
 } autobaud;
 
-/* Wait up to 65535 iterations (53 ms) for RXD to fall, then count the
- * iterations of runs, low and high in turn, into the ring RUN of
- * AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations (the line is
- * quiet: that high run is not stored) or low for 65535 (a break). A high
- * run's counter starts at -AB_QUIET so that its overflow is the quiet. The
- * ring keeps the last AB_MAX_RUNS runs before the end, however long the
- * line was busy. Returns *WHY the end; *LEFT the free slots before the
- * next write position, *WRAPPED whether the ring went round. One block of
- * assembly so that every step from one run to the next costs the same
- * (AB_STEP_CYCLES). */
-static void __attribute__((noinline)) ab_record(uint16_t *run, uint8_t *why,
-						uint8_t *left_out, uint8_t *wrapped_out)
+/*
+ * The rate (UBRR + 1) whose 0x0D the five runs from P are (P[0] low), by
+ * their total of nine bit times within 1/8: (144 - 18) k <= cycles <=
+ * (144 + 18) k, the twelve rates' ranges apart; or 0. In iterations:
+ * cycles are 6 its + 5 steps, each bound a multiple of 6.
+ */
+#define AB_NINE_LO(k) ((126 * (k) - 5 * AB_STEP_CYCLES) / AB_LOOP_CYCLES)
+#define AB_NINE_SPAN(k) (36 * (k) / AB_LOOP_CYCLES)
+_Static_assert(126 % AB_LOOP_CYCLES == 0 && 36 % AB_LOOP_CYCLES == 0 &&
+	       5 * AB_STEP_CYCLES % AB_LOOP_CYCLES == 0, "the bounds in whole iterations");
+static uint8_t ab_frame(const uint16_t *p)
 {
+	uint16_t its = 0;
+
+	for (uint8_t j = 0; j < 5; j++) {
+		uint16_t n = AB_ITER(p[j]);
+
+		if (n > AB_LONG) {
+			return 0;
+		}
+		its += n;
+	}
+	for (uint8_t r = 0; r < AB_NRATES; r++) {
+		uint8_t k = ab_rates[r];
+
+		if ((uint16_t)(its - AB_NINE_LO(k)) <= (uint16_t)AB_NINE_SPAN(k)) {
+			return k;
+		}
+	}
+	return 0;
+}
+
+/* The five runs from P match 0x0D's 1 1 1 2 4 bit times at rate K, each
+ * within a third of a bit and half a counting iteration: a run is measured
+ * to an iteration (6 cycles), which at 460800 (16 cycles a bit) is more than
+ * a third of a bit. No run is longer than AB_LONG here (ab_frame took
+ * them). */
+static uint8_t ab_shape(const uint16_t *p, uint8_t k)
+{
+	uint16_t want = (uint16_t)(16 * k);
+	uint16_t tol = (uint16_t)(want / 3 + AB_LOOP_CYCLES / 2);
+
+	for (uint8_t j = 0; j < 5; j++) {
+		if (j >= 3) {
+			want += want;
+		}
+		/* want - tol <= cycles <= want + tol */
+		if ((uint16_t)(AB_CYCLES(p[j]) - want + tol) > (uint16_t)(2 * tol)) {
+			return 0;
+		}
+	}
+	return 1;
+}
+
+/*
+ * Two frames in a row from P (P[0] low) last 9 bit times (start bit to
+ * stop bit) of the same rate, with at least half a bit between them, and
+ * one of them has 0x0D's shape: that rate (UBRR + 1), or 0. One frame may
+ * be bent: an interrupt that runs while a run is timed shortens it (the
+ * drivers' interrupts stay on), which the 1/8 tolerance of a frame's length
+ * absorbs but a single run's may not.
+ */
+static uint8_t __attribute__((noinline)) ab_check(const uint16_t *p)
+{
+	uint8_t k = ab_frame(p);
+
+	/* P[5], a high run, is below AB_QUIET iterations: its cycles fit */
+	if (k == 0 || ab_frame(p + 6) != k || AB_CYCLES(p[5]) < (uint16_t)(8 * k)) {
+		return 0;
+	}
+	return (ab_shape(p, k) || ab_shape(p + 6, k)) ? k : 0;
+}
+
+static void ab_listen(uint8_t ubrr)
+{
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		/* UBRRH: 0 from reset (every rate's UBRR is 8-bit) */
+		MCU_UBRRL = ubrr;
+		/* |=: the transmitter's UDRIE may be set (a reply going out). */
+		MCU_UCSRB |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
+		/* Framing errors seen so far were at the old rate. */
+		autobaud.lost = 0;
+		autobaud.fe_run = 0;
+	}
+}
+
+static void ab_deaf(void)
+{
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		MCU_UCSRB &= (uint8_t)~(_BV(RXEN) | _BV(RXCIE));
+		autobaud.lost = 0;
+	}
+	autobaud.state = AB_DETECT;
+	autobaud.rate = 0;
+}
+
+/*
+ * Record the line once: wait up to 65535 iterations (53 ms) for RXD to
+ * fall, then count the iterations of runs, low and high in turn, into the
+ * ring RUN of AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations
+ * (the line is quiet: that high run is not stored) or low as long (a
+ * break). Every run's counter starts at -AB_QUIET so that its overflow is
+ * the quiet or the break. The ring keeps the last AB_MAX_RUNS runs before the end,
+ * however long the line was busy. One block of assembly so that every step
+ * from one run to the next costs the same (AB_STEP_CYCLES).
+ *
+ * If the runs before the quiet hold two 0x0D in a row at one rate, that
+ * rate (UBRR + 1); the last such pair wins (a fresh run at another rate
+ * replaces an earlier one). 0: no rate (also after 53 ms without an
+ * edge).
+ */
+static uint8_t __attribute__((noinline)) ab_scan(void)
+{
+	/* the ring, and its first AB_PAIR - 1 runs again after it: a pair
+	 * across its end is read in one piece */
+	uint16_t run[AB_MAX_RUNS + AB_PAIR - 1];
 	uint16_t *p = run;
 	uint8_t left = AB_MAX_RUNS;
 	uint8_t wrapped = 0;
 	uint8_t end;
 	uint16_t n;
 
+	wdt_reset();
 	asm volatile("	clr %A[n]\n\t"
 		     "	clr %B[n]\n"
 		     "0:	sbis %[pin], %[bit]\n\t"
@@ -121,8 +228,8 @@ static void __attribute__((noinline)) ab_record(uint16_t *run, uint8_t *why,
 		     "	adiw %[n], 1\n\t"
 		     "	brne 0b\n\t"
 		     "	rjmp 8f\n"
-		     "1:	clr %A[n]\n\t"
-		     "	clr %B[n]\n"
+		     "1:	ldi %A[n], lo8(%[q])\n\t"
+		     "	ldi %B[n], hi8(%[q])\n"
 		     "2:	sbic %[pin], %[bit]\n\t"
 		     "	rjmp 3f\n\t"
 		     "	adiw %[n], 1\n\t"
@@ -150,201 +257,69 @@ static void __attribute__((noinline)) ab_record(uint16_t *run, uint8_t *why,
 		     "	ldi %[left], %[max]\n\t"
 		     "	ldi %[wr], 1\n\t"
 		     "	rjmp 1b\n"
-		     "8:	ldi %[end], %[quiet]\n\t"
+		     "8:	ldi %[end], 1\n\t"
 		     "	rjmp 10f\n"
-		     "9:	ldi %[end], %[brk]\n"
+		     "9:	ldi %[end], 0\n"
 		     "10:\n"
-		     : [n] "=&w" (n), [p] "+e" (p), [left] "+d" (left), [wr] "+d" (wrapped),
+		     : [n] "=&w" (n), [p] "+&e" (p), [left] "+d" (left), [wr] "+d" (wrapped),
 		       [end] "=&d" (end)
 		     : [base] "r" (run), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
-		       [q] "i" (0x10000L - AB_QUIET), [max] "M" (AB_MAX_RUNS),
-		       [quiet] "M" (AB_END_QUIET), [brk] "M" (AB_END_BREAK)
+		       [q] "i" (0x10000L - AB_QUIET), [max] "M" (AB_MAX_RUNS)
 		     : "memory");
-	*why = end;
-	*left_out = left;
-	*wrapped_out = wrapped;
-}
+	uint8_t count = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
+	uint8_t oldest = 0;
 
-static void ab_reverse(uint16_t *a, uint8_t n)
-{
-	for (uint8_t i = 0, j = (uint8_t)(n - 1); i < j; i++, j--) {
-		uint16_t t = a[i];
-
-		a[i] = a[j];
-		a[j] = t;
+	if (!end) {
+		return 0;	/* a break */
 	}
-}
-
-/* A run's length in cycles (the step to the next run included) from its
- * iterations; 0xFFFF for one longer than any run of a 0x0D. */
-static uint16_t ab_cycles(uint16_t count)
-{
-	return count > 4000 ? 0xFFFF : (uint16_t)(count * AB_LOOP_CYCLES + AB_STEP_CYCLES);
-}
-
-/* The rate whose 0x0D the five runs from RUN (RUN[0] low) are: its
- * index + 1, or 0. */
-static uint8_t ab_frame(const uint16_t *run)
-{
-	uint16_t total = 0;
-
-	for (uint8_t i = 0; i < 5; i++) {
-		uint16_t c = ab_cycles(run[i]);
-
-		if (c == 0xFFFF) {
-			return 0;
-		}
-		total += c;
+	if (wrapped) {
+		oldest = count;
+		count = AB_MAX_RUNS;
 	}
-	for (uint8_t r = 0; r < AB_NRATES; r++) {
-		uint16_t nine = (uint16_t)(9 * ab_rates[r].bit);
-		uint16_t diff = total > nine ? total - nine : nine - total;
+	memcpy(run + AB_MAX_RUNS, run, (AB_PAIR - 1) * sizeof(run[0]));
+	/* From the newest low run (even positions) back: the last pair wins. */
+	for (int8_t i = (int8_t)(count - AB_PAIR); i >= 0; i--) {
+		uint8_t at = (uint8_t)(oldest + i) & (AB_MAX_RUNS - 1);
 
-		if (diff <= nine / 8) {
-			return (uint8_t)(r + 1);
+		if (!(at & 1)) {
+			uint8_t r = ab_check(run + at);
+
+			if (r) {
+				return r;
+			}
 		}
 	}
 	return 0;
 }
 
-/* The five runs from RUN match 0x0D's 1 1 1 2 4 bit times at BIT, each
- * within a third of a bit and half a counting iteration: a run is measured
- * to an iteration (6 cycles), which at 460800 (16 cycles a bit) is more than
- * a third of a bit. */
-static uint8_t ab_shape(const uint16_t *run, uint16_t bit)
-{
-	for (uint8_t i = 0; i < 5; i++) {
-		uint16_t want = (uint16_t)(ab_pattern[i] * bit);
-		uint16_t c = ab_cycles(run[i]);
-
-		if ((c > want ? c - want : want - c) > bit / 3 + AB_LOOP_CYCLES / 2) {
-			return 0;
-		}
-	}
-	return 1;
-}
-
-/*
- * Two frames in a row last 9 bit times (start bit to stop bit) of the same
- * rate, with at least half a bit between them, and one of them has 0x0D's
- * shape: that rate's index + 1, or 0. One frame may be bent: an interrupt
- * that runs while a run is timed shortens it (the drivers' interrupts stay
- * on), which the 1/8 tolerance of a frame's length absorbs but a single
- * run's may not.
- */
-static uint8_t ab_check(const uint16_t *run)
-{
-	uint8_t r = ab_frame(run);
-
-	if (r == 0 || ab_frame(run + 6) != r) {
-		return 0;
-	}
-	uint16_t bit = ab_rates[r - 1].bit;
-
-	if (ab_cycles(run[5]) < bit / 2) {
-		return 0;
-	}
-	return (ab_shape(run, bit) || ab_shape(run + 6, bit)) ? r : 0;
-}
-
-static void ab_listen(uint8_t ubrr)
-{
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		MCU_UBRRH = 0;
-		MCU_UBRRL = ubrr;
-		/* |=: the transmitter's UDRIE may be set (a reply going out). */
-		MCU_UCSRB |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
-		/* Framing errors seen so far were at the old rate. */
-		autobaud.lost = 0;
-		autobaud.fe_run = 0;
-	}
-}
-
-static void ab_deaf(void)
-{
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		MCU_UCSRB &= (uint8_t)~(_BV(RXEN) | _BV(RXCIE));
-		autobaud.lost = 0;
-	}
-	autobaud.state = AB_DETECT;
-}
-
-/* Record the line once, until it is quiet (AB_QUIET), or 53 ms without an
- * edge (*HEARD = 0). If the last AB_MAX_RUNS runs before the quiet hold two
- * 0x0D in a row at one rate, that rate (index + 1); the last such pair wins
- * (a fresh run at another rate replaces an earlier one). 0: no rate. */
-static uint8_t ab_scan(uint8_t *heard)
-{
-	uint16_t run[AB_MAX_RUNS];
-	uint8_t why, left, wrapped, n, first;
-	uint8_t found = 0;
-
-	wdt_reset();
-	ab_record(run, &why, &left, &wrapped);
-	n = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
-	*heard = n || wrapped;
-	if (why != AB_END_QUIET) {
-		return 0;
-	}
-	/* High runs (odd positions) counted from -AB_QUIET. */
-	for (uint8_t i = 1; i < (wrapped ? AB_MAX_RUNS : n); i += 2) {
-		run[i] = (uint16_t)(run[i] + AB_QUIET);
-	}
-	first = 0;
-	if (wrapped) {
-		/* oldest first: rotate the ring left by n */
-		ab_reverse(run, n);
-		ab_reverse(run + n, (uint8_t)(AB_MAX_RUNS - n));
-		ab_reverse(run, AB_MAX_RUNS);
-		first = n & 1;		/* a frame starts on a low run */
-		n = AB_MAX_RUNS;
-	}
-	for (uint8_t i = first; i + AB_PAIR <= n; i += 2) {
-		uint8_t r = ab_check(run + i);
-
-		if (r) {
-			found = r;
-		}
-	}
-	return found;
-}
-
+/* After reset the receiver is off and the state AB_DETECT: zero, as
+ * static storage starts. */
+_Static_assert(AB_DETECT == 0, "the state at reset is the zeroed one");
 void uart_init(void)
 {
-	autobaud.state = AB_DETECT;
 }
 
 uint8_t uart_line_poll(void)
 {
-	uint8_t r;
-	uint8_t heard;
-
 	if (autobaud.lost) {
 		ab_deaf();
 	}
 	if (autobaud.state == AB_TALK) {
 		return 0;
 	}
-	if (autobaud.state == AB_FRESH) {
-		/* Until a request proves the rate, the pin is still watched
-		 * (the receiver runs on): a preamble at another rate after a
-		 * wrong lock (noise that looked like one) moves the rate. The
-		 * bytes the receiver takes meanwhile wait in the ring. */
-		r = ab_scan(&heard);
-		if (r == 0 || r == autobaud.rate) {
-			return 0;
-		}
-	} else {
-		do {
-			r = ab_scan(&heard);
-		} while (r == 0 && heard);
-	}
-	if (r == 0) {
-		return 1;	/* quiet for 53 ms: round the main loop */
+	/* One record a call. While the rate is fresh the pin is still
+	 * watched (the receiver runs on): a preamble at another rate after a
+	 * wrong lock (noise that looked like one) moves the rate. The bytes
+	 * the receiver takes meanwhile wait in the ring. */
+	uint8_t r = ab_scan();
+
+	if (r == 0 || r == autobaud.rate) {
+		/* no rate yet: round the main loop (nothing received to drop) */
+		return autobaud.state == AB_DETECT;
 	}
 	autobaud.rate = r;
 	autobaud.state = AB_FRESH;
-	ab_listen(ab_rates[r - 1].ubrr);
+	ab_listen((uint8_t)(r - 1));
 	return 1;
 }
 
@@ -352,7 +327,7 @@ void uart_line_rx(void)
 {
 	if (!(MCU_UCSRA & _BV(FE))) {
 		autobaud.fe_run = 0;
-	} else if (autobaud.state != AB_TALK || ++autobaud.fe_run >= AB_FE_RUN) {
+	} else if (++autobaud.fe_run >= autobaud.state) {
 		autobaud.lost = 1;
 	}
 }

@@ -26,3 +26,12 @@ uint8_t board_pin(board_fn_t fn, uint8_t index)
 	}
 	return BOARD_PIN_NONE;
 }
+
+void board_pins_of(board_fn_t fn, uint8_t *pins)
+{
+	for (uint8_t i = 0; i < BOARD_NPINS; i++) {
+		if (board_pins[i].fn == fn) {
+			pins[board_pins[i].index] = board_pins[i].pin;
+		}
+	}
+}

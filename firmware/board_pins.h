@@ -17,6 +17,11 @@
 /* The pin with function `fn` and index `index`, or BOARD_PIN_NONE. */
 uint8_t board_pin(board_fn_t fn, uint8_t index);
 
+/* Every pin with function `fn`: pins[index] = its pin, in one walk of the
+ * map (a board_pin() per index walks it each time). Indices not in the map
+ * are left as they were. */
+void board_pins_of(board_fn_t fn, uint8_t *pins);
+
 /* The same for `fn` and `index` known when compiling: the pin map as tests
  * of constants, which the compiler folds to the pin's number (no code, no
  * table walked; board_pin() searches 28 rows on the M32-D). A variable
