@@ -35,7 +35,7 @@ static inline __attribute__((always_inline)) uint8_t end_run(uint8_t head)
 	return head;
 }
 
-/* A line end, or any character while the ring is full or nearly. */
+/* A character the receive interrupt's fast path leaves (sg_rx_put()). */
 static inline __attribute__((always_inline)) void put_slow(uint8_t c, uint8_t head)
 {
 	uint8_t room = (uint8_t)(sg_rx.tail - head - 1);
@@ -89,39 +89,10 @@ static inline __attribute__((always_inline)) void put_slow(uint8_t c, uint8_t he
 
 void sg_rx_put(uint8_t c)
 {
-	uint8_t head = sg_rx.head;
-
-#ifndef ORFA_BAUD
-	/* A fixed rate's receive interrupt stores these itself (its fast path,
-	 * firmware/uart.c, sg_rx.h's rule) and brings put_slow() the rest;
-	 * autobaud's brings every character here. */
-	uint8_t line = sg_rx.line;
-
-	/* The common cases first, room to spare: a character inside a line,
-	 * and the end of a line that lost nothing (on the latency path of
-	 * every request). */
-	if (!sg_rx.losing && (uint8_t)(sg_rx.tail - head - 1) > SG_RX_RECORD) {
-		if (c == '\r' || c == '\n') {
-			if (!(line & LINE_LOST)) {
-				sg_rx.line = 0;
-				sg_rx.buf[head] = c;
-				sg_rx.head = (uint8_t)(head + 1);
-				return;
-			}
-		} else if (line & LINE_STARTED) {
-			if (c != ' ') {
-				sg_rx.line = line | LINE_CONTENT;
-			}
-			if (c >= SG_RX_MARK_LOST) {
-				c = 0x7F;
-			}
-			sg_rx.buf[head] = c;
-			sg_rx.head = (uint8_t)(head + 1);
-			return;
-		}
-	}
-#endif
-	put_slow(c, head);
+	/* A fixed rate's receive interrupt stores a request's common
+	 * characters itself (its fast path, firmware/uart.c, sg_rx.h's rule)
+	 * and brings the rest here; autobaud's brings every character. */
+	put_slow(c, sg_rx.head);
 }
 
 int16_t sg_rx_get(void)
