@@ -1013,6 +1013,8 @@ def bench_control_loop(board, rate, steps=LOOP_STEPS, steps_one=LOOP_STEPS_ONE):
 #: line back to back, as many as the flow rule lets a host have unanswered.
 BURST_REQUEST = b"S AA 00 00 S AB 01 P\n"
 BURST_COUNT = 11
+#: The cycle the burst's first start bit is put at (2 s into the run).
+BURST_START = 2 * F_CPU
 
 
 def bench_burst(board, rate):
@@ -1027,7 +1029,13 @@ def bench_burst(board, rate):
     with SimBoard(board, control=True, trace=True, firmware=cl.firmware_at(board, rate)) as sim, \
             serial.Serial(sim.port, rate, timeout=10):  # the PC's end open: the line is up
         ctl = sim.control
-        start = ctl.time() + F_CPU // 2
+        # a fixed cycle, not one after whenever the PC got here: the same
+        # phase of the board's clock every run
+        start = BURST_START
+        if ctl.time() >= start:
+            raise SystemExit("bench: the %s simulator was at cycle %d before the burst (it "
+                             "must start at %d); is the machine very busy?"
+                             % (board, ctl.time(), start))
         ctl.rx(start, BURST_REQUEST * BURST_COUNT)
         ctl.wait(start - ctl.time() + 4 * BURST_COUNT * len(BURST_REQUEST) * byte)
         tx = sim.trace_events(kinds=["uart tx"])
