@@ -33,6 +33,15 @@ static uint16_t servo_clamp(uint16_t us)
 	return us > SERVO_MAX_US ? SERVO_MAX_US : us;
 }
 
+/* at / 3 for every at up to 3 * SERVO_MAX_TRIPLES, as a multiply: no
+ * division in a TWI interrupt (drv_servo_check()), none linked at all (a
+ * write's length). */
+_Static_assert(3 * SERVO_MAX_TRIPLES <= 48, "at * 43 >> 7 == at / 3 up to 48");
+static uint8_t servo_third(uint8_t at)
+{
+	return (uint8_t)((uint16_t)(at * 43u) >> 7);
+}
+
 /* SP: [channel] selects the first channel for reads; [channel][hi][lo]...
  * (up to 16) sets widths. The whole write applies or none of it. */
 static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
@@ -44,7 +53,7 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 		servo.first = data[0];
 		return REG_OK;
 	}
-	if (len % 3 != 0 || len > 3 * SERVO_MAX_TRIPLES) {
+	if (len > 3 * SERVO_MAX_TRIPLES || len != (uint8_t)(3 * servo_third(len))) {
 		return REG_BAD_LENGTH;
 	}
 	uint16_t next[SERVO_CHANNELS];
@@ -106,12 +115,9 @@ reg_status_t drv_servo_check(uint8_t reg, const uint8_t *data, uint8_t len)
 		return REG_BAD_LENGTH;
 	}
 	/* Every third byte names a channel (a 1-byte write too): bytes 0, 3,
-	 * 6, ... A multiply instead of a division, which has no place in a
-	 * TWI interrupt: at * 43 >> 7 is at / 3 for every at below 48. */
-	_Static_assert(3 * SERVO_MAX_TRIPLES <= 48, "at * 43 >> 7 == at / 3 up to 47");
+	 * 6, ... */
 	uint8_t at = (uint8_t)(len - 1);
-	uint8_t third = (uint8_t)((uint16_t)(at * 43u) >> 7);
-	if (at == (uint8_t)(3 * third) && data[at] >= SERVO_CHANNELS) {
+	if (at == (uint8_t)(3 * servo_third(at)) && data[at] >= SERVO_CHANNELS) {
 		return REG_BAD_VALUE;
 	}
 	return REG_OK;

@@ -4,20 +4,23 @@
 
 #include "firmware/mcu.h"
 
+/* The bits of `mask` in register r set to value's: one body for a port's
+ * output and direction registers. */
+static __attribute__((noinline)) void port_io_set(volatile uint8_t *r, uint8_t mask, uint8_t value)
+{
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		*r = (uint8_t)((*r & ~mask) | (value & mask));
+	}
+}
+
 void port_io_write(uint8_t port, uint8_t mask, uint8_t value)
 {
-	mcu_port_t p = mcu_port(port);
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		*p.port = (uint8_t)((*p.port & ~mask) | (value & mask));
-	}
+	port_io_set(mcu_port(port).port, mask, value);
 }
 
 void port_io_dir(uint8_t port, uint8_t mask, uint8_t value)
 {
-	mcu_port_t p = mcu_port(port);
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		*p.ddr = (uint8_t)((*p.ddr & ~mask) | (value & mask));
-	}
+	port_io_set(mcu_port(port).ddr, mask, value);
 }
 
 uint8_t port_io_pins(uint8_t port)

@@ -2,7 +2,6 @@
 
 #include <avr/io.h>
 #include <avr/wdt.h>
-#include <util/delay.h>
 #include <util/twi.h>
 
 #include "board.h"
@@ -226,6 +225,15 @@ static inline __attribute__((always_inline)) void line_release(const mcu_port_t 
 	*p->port |= bit;
 }
 
+/* Half an SCL period of the clearing (5 us), the call's 7 cycles (rcall,
+ * ret) included: one call, not a delay loop inlined at each of six places
+ * (26 bytes). */
+#define TWI_HALF_CLOCK_CYCLES ((uint16_t)((F_CPU * 5 + 999999UL) / 1000000UL))
+static __attribute__((noinline)) void twi_half_clock(void)
+{
+	__builtin_avr_delay_cycles(TWI_HALF_CLOCK_CYCLES - 7);
+}
+
 bool twi_clear_bus(void)
 {
 	const mcu_port_t port = mcu_port_at(BOARD_TWI_PORT - 'A');
@@ -238,12 +246,12 @@ bool twi_clear_bus(void)
 	TWCR = 0;  /* the pins become ordinary port pins */
 	line_release(p, scl);
 	line_release(p, sda);
-	_delay_us(5);
+	twi_half_clock();
 	for (uint8_t i = 0; i < 9 && !(*p->pin & sda); i++) {
 		line_low(p, scl);
-		_delay_us(5);
+		twi_half_clock();
 		line_release(p, scl);
-		_delay_us(5);
+		twi_half_clock();
 	}
 	/* SDA still low after nine clocks: no STOP can be made. */
 	bool free = false;
@@ -251,11 +259,11 @@ bool twi_clear_bus(void)
 		/* STOP: SDA rises while SCL is high. */
 		line_low(p, scl);
 		line_low(p, sda);
-		_delay_us(5);
+		twi_half_clock();
 		line_release(p, scl);
-		_delay_us(5);
+		twi_half_clock();
 		line_release(p, sda);
-		_delay_us(5);
+		twi_half_clock();
 		/* SDA was free; is SCL? */
 		free = *p->pin & scl;
 	}

@@ -30,12 +30,22 @@ void uart_received(uint8_t c)
 	sg_rx_put(c);
 }
 
+/* Nothing received, no line begun: at start-up, and at a new autobaud
+ * rate (what the ring and the parser hold came at the old one). One
+ * function for both: 10 bytes less than inlined twice. */
+static void front_line_reset(void)
+{
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+		sg_rx_init();
+	}
+	sg_parse_init(&parser);
+}
+
 void front_init(void)
 {
-	sg_rx_init();
 	uart_init();
 	twi_init();
-	sg_parse_init(&parser);
+	front_line_reset();  /* interrupts are still off (main()) */
 	sg_exec_init();
 }
 
@@ -54,12 +64,7 @@ void front_poll(void)
 		uart_rx_flush();
 		if (!sg_rx_losing()) {
 			if (uart_line_poll()) {
-				/* The line's rate changed (autobaud): what the ring
-				 * and the parser hold came at the old one. */
-				ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-					sg_rx_init();
-				}
-				sg_parse_init(&parser);
+				front_line_reset();  /* a new rate (autobaud) */
 			}
 			/* Idle: the failsafe's turn. Not on the busy path, where
 			 * the M32-D's streamed servo writes have no cycle to spare
