@@ -280,10 +280,15 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 	if (n > (uint8_t)(SG_LINE_MAX - len)) {
 		n = (uint8_t)(SG_LINE_MAX - len);
 	}
+	if (tail && n > (uint8_t)-tail) {
+		n = (uint8_t)-tail;  /* up to the ring's end: the next run goes on from buf[0] */
+	}
 	uint8_t hi = p->hi;
-	uint8_t from = tail;
-	for (; n; n--, tail++) {
-		uint8_t c = ring[tail];
+	const uint8_t *const from = ring + tail;
+	const uint8_t *const end = from + n;
+	const uint8_t *q = from;
+	for (; q != end; q++) {
+		uint8_t c = *q;
 
 		if (c == ' ') {
 			if (hi != SG_NO_DIGIT) {
@@ -323,7 +328,7 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 				sg_parse_byte(p, b);
 				state = p->state;
 				if (!sg_parse_in_run(p)) {
-					tail++;  /* taken: an error ends the run */
+					q++;  /* taken: an error ends the run */
 					break;
 				}
 			}
@@ -340,7 +345,7 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 			sg_parse_frame(p);
 			state = p->state;
 			if (!sg_parse_in_run(p)) {
-				tail++;  /* taken: no room for the frame */
+				q++;  /* taken: no room for the frame */
 				break;
 			}
 		} else {
@@ -348,7 +353,8 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 		}
 	}
 	/* each character taken is one of the line's */
-	p->len = (uint8_t)(len + (uint8_t)(tail - from));
+	uint8_t taken = (uint8_t)(q - from);
+	p->len = (uint8_t)(len + taken);
 	p->hi = hi;
-	return tail;
+	return (uint8_t)(tail + taken);
 }
