@@ -211,7 +211,7 @@ static void servo_rx_release(void)
 	}
 }
 
-ISR(TIMER2_COMP_vect)
+static inline __attribute__((always_inline)) void servo_interrupt(void)
 {
 	servo_hold();
 	if (!pulses.running || servo_ticks_left() > SERVO_NEAR / 8) {
@@ -291,6 +291,12 @@ ISR(TIMER2_COMP_vect)
 			return;
 		}
 	}
+}
+
+ISR(TIMER2_COMP_vect)
+{
+	servo_interrupt();
+	front_rx_held();  /* what it left in the hold, for the receive interrupt */
 }
 
 void servo_hw_init(void)

@@ -44,5 +44,9 @@ void front_poll(void);
 
 void front_rx_hold(void);
 void front_rx_poll(uint8_t most);
+/* Before such an interrupt returns, after its last front_rx_hold(): what
+ * the hold keeps is told to the receive interrupt's fast path (a few
+ * cycles; nothing in the I2C slave). */
+void front_rx_held(void);
 
 #endif

@@ -69,6 +69,22 @@ static inline __attribute__((always_inline)) void uart_hold(void)
 	}
 }
 
+/* The hold's state in the ring's line byte (SG_RX_LINE_HELD), where the
+ * receive interrupt's fast path tests it with the line's: one compare for
+ * both. Told where the hold may have changed before interrupts are on
+ * again: at the end of uart_rx_all() and as the servo interrupt returns
+ * (front_rx_held()); not in uart_hold(), whose cycles in the servo
+ * interrupt's wait for an edge are counted (a mark there made an edge
+ * late at 460800). */
+static inline __attribute__((always_inline)) void held_tell(void)
+{
+	if (held.tail == held.head) {
+		sg_rx.line &= (uint8_t)~SG_RX_LINE_HELD;
+	} else {
+		sg_rx.line |= SG_RX_LINE_HELD;
+	}
+}
+
 /* Hands on the held characters, oldest first, then UDR's, BOARD_RX_BURST
  * at most; while it drains the hold, what arrives goes into the hold too,
  * so UDR never fills behind it. A character left in UDR brings the
@@ -94,6 +110,7 @@ RX_ALL_HANDLER
 		}
 		uart_received(c);
 	} while (--budget);
+	held_tell();  /* sg_rx_put() may have rewritten the line byte */
 }
 
 /* BOARD_RX_BURST at a time, as the receive interrupt: interrupts are off
@@ -112,6 +129,11 @@ void uart_rx_flush(void)
 void front_rx_hold(void)
 {
 	uart_hold();
+}
+
+void front_rx_held(void)
+{
+	held_tell();
 }
 
 void front_rx_poll(uint8_t most)
@@ -141,6 +163,10 @@ void front_rx_hold(void)
 {
 }
 
+void front_rx_held(void)
+{
+}
+
 void front_rx_poll(uint8_t most)
 {
 	(void)most;
@@ -156,7 +182,8 @@ void front_rx_poll(uint8_t most)
  * three registers (the vector runs only while UDR holds a character: no
  * other code calls it): one inside a line, a request's first letter, a
  * line's CR or LF (sg_rx.h's rule), the ring not losing and with room, the
- * M32-D's hold empty. Anything else goes to
+ * M32-D's hold empty (SG_RX_LINE_HELD, in the same byte as the line's
+ * state: one test for both). Anything else goes to
  * uart_rx_all(), which on the M32-D finds a character already read from
  * UDR in the hold, first in line; on the M128-S such a character goes to
  * uart_received() with the call-clobbered registers saved. A rate found
@@ -174,12 +201,6 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"push r24\n\t"
 		"push r30\n\t"
 		"push r31\n\t"
-#ifdef BOARD_RX_BURST
-		"lds r30, %[hhead]\n\t"
-		"lds r31, %[htail]\n\t"
-		"cp r30, r31\n\t"
-		"brne 10f\n\t"
-#endif
 		"lds r24, %[line]\n\t"
 		"cpi r24, %[plain]\n\t"
 		"brne 8f\n\t"
@@ -295,7 +316,7 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		[losing] "i" (&sg_rx.losing), [record] "n" (SG_RX_RECORD), [buf] "i" (sg_rx.buf),
 		[all] "i" (uart_rx_all),
 #ifdef BOARD_RX_BURST
-		[hhead] "i" (&held.head), [htail] "i" (&held.tail), [hbuf] "i" (held.c),
+		[hhead] "i" (&held.head), [hbuf] "i" (held.c),
 		[hmask] "n" (UART_HOLD - 1)
 #else
 		[recv] "i" (uart_received)

@@ -187,3 +187,7 @@ void front_rx_poll(uint8_t most)
 {
 	(void)most;
 }
+
+void front_rx_held(void)
+{
+}

@@ -57,6 +57,12 @@ struct sg_rx {
  * then 0. Anything else: sg_rx_put(). */
 extern struct sg_rx sg_rx;
 #define SG_RX_LINE_PLAIN 0x03
+/* In line while a board's hold keeps received characters (firmware/uart.c,
+ * BOARD_RX_BURST): the fast path's tests of line then fail, and the
+ * character goes to the interrupt's whole handler, which hands the hold on
+ * first. uart.c sets and clears it with interrupts off, before they are on
+ * again after the hold changed; sg_rx.c neither looks at it nor keeps it. */
+#define SG_RX_LINE_HELD 0x80
 
 void sg_rx_init(void);
 
