@@ -78,11 +78,13 @@ static inline __attribute__((always_inline)) void uart_hold(void)
  * late at 460800). */
 static inline __attribute__((always_inline)) void held_tell(void)
 {
+#ifdef ORFA_BAUD  /* autobaud's receive interrupt has no fast path to tell */
 	if (held.tail == held.head) {
 		sg_rx.line &= (uint8_t)~SG_RX_LINE_HELD;
 	} else {
 		sg_rx.line |= SG_RX_LINE_HELD;
 	}
+#endif
 }
 
 /* Hands on the held characters, oldest first, then UDR's, BOARD_RX_BURST
