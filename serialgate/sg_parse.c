@@ -16,6 +16,28 @@ static __attribute__((noinline)) bool room(sg_parser_t *p, uint16_t bytes, uint1
 	return p->nbytes + bytes <= SG_BUF_SIZE && p->reply_len + reply_chars <= SG_REPLY_MAX;
 }
 
+/* A write frame's data byte at buf[at] (at: nbytes), with room for it. */
+static inline __attribute__((always_inline)) void take_data(sg_parser_t *p, uint8_t at, uint8_t b)
+{
+	p->buf[at] = b;
+	p->nbytes = (uint8_t)(at + 1);
+	p->buf[p->frame + 1]++;
+	p->reply_len++;
+}
+
+/* A frame's address byte: a read frame's count or a write's data next. */
+static inline __attribute__((always_inline)) uint8_t take_address(sg_parser_t *p, uint8_t b)
+{
+	uint8_t at = p->frame;
+	uint8_t state = (b & 1) ? SG_ST_RCOUNT : SG_ST_WDATA;
+
+	p->buf[at] = b;
+	p->buf[at + 1] = 0;
+	p->nbytes = (uint8_t)(at + 2);
+	p->state = state;
+	return state;
+}
+
 sg_event_t sg_parse_frame(sg_parser_t *p)
 {
 	if (!room(p, 2, 2)) {
@@ -45,18 +67,13 @@ sg_event_t sg_parse_byte(sg_parser_t *p, uint8_t b)
 		}
 		return SG_MORE;
 	case SG_ST_ADDR:
-		p->buf[p->frame] = b;
-		p->buf[p->frame + 1] = 0;
-		p->nbytes = (uint8_t)(p->frame + 2);
-		p->state = (b & 1) ? SG_ST_RCOUNT : SG_ST_WDATA;
+		take_address(p, b);
 		return SG_MORE;
 	case SG_ST_WDATA:
 		if (!room(p, 1, 1)) {
 			return fail(p, SG_ERR_DATA);
 		}
-		p->buf[p->nbytes++] = b;
-		p->buf[p->frame + 1]++;
-		p->reply_len++;
+		take_data(p, p->nbytes, b);
 		return SG_MORE;
 	case SG_ST_RCOUNT:
 		if (b == 0 || !room(p, b, 2u * b)) {
@@ -88,6 +105,14 @@ static sg_event_t take_digit(sg_parser_t *p, uint8_t d)
 	return sg_parse_byte(p, b);
 }
 
+/* An I2C request's S: its first frame. */
+static inline __attribute__((always_inline)) sg_event_t begin_i2c(sg_parser_t *p)
+{
+	p->cmd = SG_CMD_I2C;
+	p->reply_len = 1;  /* the closing "P" */
+	return sg_parse_frame(p);
+}
+
 /* A one-letter command: V and X take nothing more (SG_ST_DONE), L and C
  * optional bytes (SG_ST_ARGS). */
 static sg_event_t begin_line_command(sg_parser_t *p, uint8_t cmd, uint8_t state)
@@ -109,9 +134,7 @@ static sg_event_t begin_command(sg_parser_t *p, uint8_t c)
 	case 'c':
 		return begin_line_command(p, SG_CMD_CLOCK, SG_ST_ARGS);
 	case 's':
-		p->cmd = SG_CMD_I2C;
-		p->reply_len = 1;  /* the closing "P" */
-		return sg_parse_frame(p);
+		return begin_i2c(p);
 	default:
 		return fail(p, SG_ERR_COMMAND);
 	}
@@ -265,9 +288,7 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 	if (state == SG_ST_BEGIN && tail != head && (ring[tail] | 0x20) == 's') {
 		/* an I2C request's first character, as sg_parse_char() takes it */
 		sg_parse_init(p);
-		p->cmd = SG_CMD_I2C;
-		p->reply_len = 1;  /* the closing "P" */
-		sg_parse_frame(p);
+		begin_i2c(p);
 		state = p->state;
 		len = 1;
 		p->len = len;
@@ -309,20 +330,13 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 			uint8_t at = p->nbytes;
 
 			hi = SG_NO_DIGIT;
-			/* sg_parse_byte()'s common cases in place: a write frame's
-			 * data byte, a frame's address */
+			/* sg_parse_byte()'s common cases in place (room(p, 1, 1)
+			 * without its call): a write frame's data byte, a frame's
+			 * address */
 			if (state == SG_ST_WDATA && at < SG_BUF_SIZE && p->reply_len < SG_REPLY_MAX) {
-				p->buf[at] = b;
-				p->nbytes = (uint8_t)(at + 1);
-				p->buf[p->frame + 1]++;
-				p->reply_len++;
+				take_data(p, at, b);
 			} else if (state == SG_ST_ADDR) {
-				at = p->frame;
-				p->buf[at] = b;
-				p->buf[at + 1] = 0;
-				p->nbytes = (uint8_t)(at + 2);
-				state = (b & 1) ? SG_ST_RCOUNT : SG_ST_WDATA;
-				p->state = state;
+				state = take_address(p, b);
 			} else {
 				/* it uses neither len nor hi */
 				sg_parse_byte(p, b);
