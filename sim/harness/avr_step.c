@@ -9,6 +9,7 @@
 
 #include "sim_core.h"
 #include "sim_interrupts.h"
+#include "simavr16/interrupt.h"
 
 static inline int avr_step_timer_due(const avr_t *avr)
 {
@@ -36,6 +37,7 @@ static void avr_step_slow(avr_t *avr, avr_flashaddr_t new_pc)
 		avr->cycle += 1 + sleep;
 	}
 	if ((avr->state == cpu_Running || avr->state == cpu_Sleeping) && avr->interrupt_state) {
+		simavr16_interrupt_latency(avr);
 		avr_service_interrupts(avr);
 	}
 }
@@ -48,6 +50,7 @@ static inline void avr_step_after_inline(avr_t *avr, avr_flashaddr_t new_pc)
 	}
 	avr->pc = new_pc;
 	if (avr->interrupt_state && avr->state == cpu_Running) {
+		simavr16_interrupt_latency(avr);
 		avr_service_interrupts(avr);
 	}
 }
