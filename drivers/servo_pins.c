@@ -3,7 +3,9 @@
  * schedule servo_plan.c makes. The Timer2 compare interrupt writes every
  * edge at its exact CPU cycle, in three steps: Timer2 (clk/8) wakes it
  * about SERVO_LEAD cycles early, more than any other interrupt plus this
- * one's entry can delay it; it waits on Timer2 until the edge is SERVO_FINE
+ * one's entry can delay it (the main loop's one long section with
+ * interrupts off, uart_rx_flush(), does not start while the compare
+ * waits: it would add to an interrupt's delay); it waits on Timer2 until the edge is SERVO_FINE
  * cycles away; then it waits on Timer0 (clk/1, free running) for the edge's
  * cycle. An edge is off by no more than the few cycles of that last loop,
  * whatever else the firmware is doing.

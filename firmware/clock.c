@@ -31,6 +31,11 @@ void clock_compare_cancel(void)
 	compare_armed = 0;
 }
 
+bool clock_compare_pending(void)
+{
+	return (TIFR & MCU_CLOCK_OCF) && (TIMSK & MCU_CLOCK_OCIE);
+}
+
 /* The next overflow is 2048 cycles away: it cannot come again before its
  * end. The compare is turned on at its wrap or, if an overflow was counted
  * by the servo interrupt instead (servo_pins.c), at the next one: "at or
@@ -45,6 +50,11 @@ ISR(MCU_CLOCK_OVF_vect, FRONT_ISR_LETS_RX)
 	}
 }
 #else
+bool clock_compare_pending(void)
+{
+	return false;
+}
+
 /* No driver's compare on the time base (board.h): only the count. */
 ISR(MCU_CLOCK_OVF_vect, FRONT_ISR_LETS_RX)
 {

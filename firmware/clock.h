@@ -8,6 +8,7 @@
 #ifndef ORFA_CLOCK_H
 #define ORFA_CLOCK_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #define CLOCK_TICK_CYCLES 2048UL
@@ -30,6 +31,14 @@ void clock_init(void);
  * BOARD_CLOCK_COMPARE. */
 void clock_compare_from(uint8_t wrap);
 void clock_compare_cancel(void);
+
+/* The compare interrupt is on and flagged, waiting for interrupts: a
+ * section with interrupts off that may wait starts after it instead. On
+ * the AVR the one instruction after an interrupt's RETI may be that
+ * section's CLI: the compare would wait for the section as well as the
+ * interrupt, more than its lead allows for (uart_rx_flush()). Interrupts
+ * off. false on boards without BOARD_CLOCK_COMPARE. */
+bool clock_compare_pending(void);
 
 /* Ticks since clock_init, wrapping every 65536 (18.2 s): differences of
  * two readings are exact up to that. Interrupts stay on. */

@@ -6,6 +6,7 @@
 #include <avr/wdt.h>
 #include <util/atomic.h>
 
+#include "firmware/clock.h"
 #include "firmware/front.h"
 #include "firmware/mcu.h"
 #include "serialgate/sg_rx.h"
@@ -118,12 +119,17 @@ RX_ALL_HANDLER
 /* BOARD_RX_BURST at a time, as the receive interrupt: interrupts are off
  * while it runs, and the servo interrupt's lead allows for that many (all
  * sixteen the hold can keep, ~1400 cycles, made an edge 8-11 cycles late
- * at 460800). The main loop comes back for the rest. */
+ * at 460800). Not while the servo's compare waits: a receive interrupt
+ * that returns to the CLI here runs it as its one instruction, and the
+ * compare would wait for both (an edge ~90 cycles late at 115200). The
+ * main loop comes back for the rest. */
 void uart_rx_flush(void)
 {
 	if (held.head != held.tail) {
 		cli();
-		front_rx_poll(BOARD_RX_BURST);
+		if (!clock_compare_pending()) {
+			front_rx_poll(BOARD_RX_BURST);
+		}
 		sei();
 	}
 }
