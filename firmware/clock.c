@@ -31,9 +31,12 @@ void clock_compare_cancel(void)
 	compare_armed = 0;
 }
 
+/* TIFR's flag and TIMSK's enable have the same bit: one AND for both. */
+_Static_assert(MCU_CLOCK_OCF == MCU_CLOCK_OCIE, "OCFn and OCIEn share a bit");
+
 bool clock_compare_pending(void)
 {
-	return (TIFR & MCU_CLOCK_OCF) && (TIMSK & MCU_CLOCK_OCIE);
+	return TIFR & TIMSK & MCU_CLOCK_OCF;
 }
 
 /* The next overflow is 2048 cycles away: it cannot come again before its
