@@ -61,18 +61,21 @@ enum {
 _Static_assert(AB_RX_PORT >= 'A' && AB_RX_PORT <= 'D', "RXD on ports A-D");
 _Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart");
 
-/* Cycles of one counting iteration (sbic/sbis skipping 2, adiw 2, brne 2)
- * and of the step from one run to the next in ab_record. */
+/* Cycles of one counting iteration (sbic/sbis skipping 2, adiw 2, brcc 2)
+ * and of the step from one run to the next in ab_scan. */
 #define AB_LOOP_CYCLES 6
 #define AB_STEP_CYCLES 12
-/* Iterations above which a run is longer than any run of a 0x0D (4 bit
- * times at 2400 baud are 2048). */
-#define AB_LONG 4000
-/* A run's iterations from what ab_scan stored: its counter started at
- * -AB_QUIET. */
-#define AB_ITER(stored) ((uint16_t)((stored) + AB_QUIET))
-/* ... and its length in cycles, the step to the next run included. */
-#define AB_CYCLES(stored) ((uint16_t)(AB_ITER(stored) * AB_LOOP_CYCLES + AB_STEP_CYCLES))
+/* A run's counter counts its cycles (AB_LOOP_CYCLES an iteration) from
+ * AB_START, where AB_QUIET iterations carry out of 16 bits: a stored run
+ * is AB_START + its cycles but the step to the next. */
+#define AB_START (0x10000L - AB_QUIET * (long)AB_LOOP_CYCLES)
+_Static_assert(AB_START > 0, "AB_QUIET iterations carry out of 16 bits");
+/* A run's length in cycles from what ab_scan stored, the step to the next
+ * run included. */
+#define AB_CYCLES(stored) ((uint16_t)((stored) - AB_START + AB_STEP_CYCLES))
+/* Cycles above which a run is longer than any run of a 0x0D (4 bit times
+ * at 2400 baud are 12288): 4000 iterations. */
+#define AB_LONG (4000 * AB_LOOP_CYCLES + AB_STEP_CYCLES)
 
 /* The rates as UBRR + 1 (F_CPU / 16 / rate): a bit lasts 16 times that
  * many cycles; all exact at 7.3728 MHz. */
@@ -99,44 +102,43 @@ static struct {
 } autobaud;
 
 /*
- * The rate (UBRR + 1) whose 0x0D the five runs from P are (P[0] low), by
- * their total of nine bit times within 1/8: (144 - 18) k <= cycles <=
- * (144 + 18) k, the twelve rates' ranges apart; or 0. In iterations:
- * cycles are 6 its + 5 steps, each bound a multiple of 6.
+ * The frame of five runs from P (P[0] low): its rate (UBRR + 1) by its
+ * total of nine bit times within 1/8: (144 - 18) k <= cycles <=
+ * (144 + 18) k, the twelve rates' ranges apart; or 0 (also when a run is
+ * longer than AB_LONG). With AB_SHAPED when its runs also match 0x0D's
+ * 1 1 1 2 4 bit times at that rate, each within a third of a bit and half
+ * a counting iteration: a run is measured to an iteration (6 cycles),
+ * which at 460800 (16 cycles a bit) is more than a third of a bit.
  */
-#define AB_NINE_LO(k) ((126 * (k) - 5 * AB_STEP_CYCLES) / AB_LOOP_CYCLES)
-#define AB_NINE_SPAN(k) (36 * (k) / AB_LOOP_CYCLES)
-_Static_assert(126 % AB_LOOP_CYCLES == 0 && 36 % AB_LOOP_CYCLES == 0 &&
-	       5 * AB_STEP_CYCLES % AB_LOOP_CYCLES == 0, "the bounds in whole iterations");
-static uint8_t ab_frame(const uint16_t *p)
+#define AB_NINE_LO(k) (126U * (k))
+#define AB_NINE_SPAN(k) (36U * (k))
+/* Above any rate's frame (every UBRR + 1 is 8-bit); a run added to it
+ * still fits 16 bits. */
+#define AB_NINE_MAX (AB_NINE_LO(255) + AB_NINE_SPAN(255))
+_Static_assert(AB_NINE_MAX + (long)AB_LONG <= 0xFFFF, "a frame's total never wraps");
+#define AB_SHAPED 0x100
+static uint16_t __attribute__((noinline)) ab_frame(const uint16_t *p)
 {
-	uint16_t its = 0;
+	uint16_t cycles = 0;
+	uint8_t k;
 
 	for (uint8_t j = 0; j < 5; j++) {
-		uint16_t n = AB_ITER(p[j]);
+		uint16_t c = AB_CYCLES(p[j]);
 
-		if (n > AB_LONG) {
+		/* the total no frame's once it is above AB_NINE_MAX */
+		if (c > AB_LONG || (cycles += c) > AB_NINE_MAX) {
 			return 0;
 		}
-		its += n;
 	}
-	for (uint8_t r = 0; r < AB_NRATES; r++) {
-		uint8_t k = ab_rates[r];
-
-		if ((uint16_t)(its - AB_NINE_LO(k)) <= (uint16_t)AB_NINE_SPAN(k)) {
-			return k;
+	for (uint8_t r = 0; ; r++) {
+		if (r == AB_NRATES) {
+			return 0;
+		}
+		k = ab_rates[r];
+		if ((uint16_t)(cycles - AB_NINE_LO(k)) <= (uint16_t)AB_NINE_SPAN(k)) {
+			break;
 		}
 	}
-	return 0;
-}
-
-/* The five runs from P match 0x0D's 1 1 1 2 4 bit times at rate K, each
- * within a third of a bit and half a counting iteration: a run is measured
- * to an iteration (6 cycles), which at 460800 (16 cycles a bit) is more than
- * a third of a bit. No run is longer than AB_LONG here (ab_frame took
- * them). */
-static uint8_t ab_shape(const uint16_t *p, uint8_t k)
-{
 	uint16_t want = (uint16_t)(16 * k);
 	uint16_t tol = (uint16_t)(want / 3 + AB_LOOP_CYCLES / 2);
 
@@ -146,10 +148,10 @@ static uint8_t ab_shape(const uint16_t *p, uint8_t k)
 		}
 		/* want - tol <= cycles <= want + tol */
 		if ((uint16_t)(AB_CYCLES(p[j]) - want + tol) > (uint16_t)(2 * tol)) {
-			return 0;
+			return k;
 		}
 	}
-	return 1;
+	return k | AB_SHAPED;
 }
 
 /*
@@ -162,13 +164,16 @@ static uint8_t ab_shape(const uint16_t *p, uint8_t k)
  */
 static uint8_t __attribute__((noinline)) ab_check(const uint16_t *p)
 {
-	uint8_t k = ab_frame(p);
+	uint16_t a = ab_frame(p);
+	uint16_t b = ab_frame(p + 6);
+	uint8_t k = (uint8_t)a;
 
 	/* P[5], a high run, is below AB_QUIET iterations: its cycles fit */
-	if (k == 0 || ab_frame(p + 6) != k || AB_CYCLES(p[5]) < (uint16_t)(8 * k)) {
+	if (k == 0 || (uint8_t)b != k || AB_CYCLES(p[5]) < (uint16_t)(8 * k) ||
+	    !((a | b) & AB_SHAPED)) {
 		return 0;
 	}
-	return (ab_shape(p, k) || ab_shape(p + 6, k)) ? k : 0;
+	return k;
 }
 
 static void ab_listen(uint8_t ubrr)
@@ -232,8 +237,8 @@ static uint8_t __attribute__((noinline)) ab_scan(void)
 		     "	ldi %B[n], hi8(%[q])\n"
 		     "2:	sbic %[pin], %[bit]\n\t"
 		     "	rjmp 3f\n\t"
-		     "	adiw %[n], 1\n\t"
-		     "	brne 2b\n\t"
+		     "	adiw %[n], %[it]\n\t"
+		     "	brcc 2b\n\t"
 		     "	rjmp 9f\n"
 		     "3:	st %a[p]+, %A[n]\n\t"
 		     "	st %a[p]+, %B[n]\n\t"
@@ -246,8 +251,8 @@ static uint8_t __attribute__((noinline)) ab_scan(void)
 		     "	ldi %B[n], hi8(%[q])\n"
 		     "5:	sbis %[pin], %[bit]\n\t"
 		     "	rjmp 6f\n\t"
-		     "	adiw %[n], 1\n\t"
-		     "	brne 5b\n\t"
+		     "	adiw %[n], %[it]\n\t"
+		     "	brcc 5b\n\t"
 		     "	rjmp 8f\n"
 		     "6:	st %a[p]+, %A[n]\n\t"
 		     "	st %a[p]+, %B[n]\n\t"
@@ -264,7 +269,7 @@ static uint8_t __attribute__((noinline)) ab_scan(void)
 		     : [n] "=&w" (n), [p] "+&e" (p), [left] "+d" (left), [wr] "+d" (wrapped),
 		       [end] "=&d" (end)
 		     : [base] "r" (run), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
-		       [q] "i" (0x10000L - AB_QUIET), [max] "M" (AB_MAX_RUNS)
+		       [q] "i" (AB_START), [it] "I" (AB_LOOP_CYCLES), [max] "M" (AB_MAX_RUNS)
 		     : "memory");
 	uint8_t count = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
 	uint8_t oldest = 0;
