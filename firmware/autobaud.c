@@ -73,9 +73,10 @@ _Static_assert(AB_START > 0, "AB_QUIET iterations carry out of 16 bits");
 /* A run's length in cycles from what ab_scan stored, the step to the next
  * run included. */
 #define AB_CYCLES(stored) ((uint16_t)((stored) - AB_START + AB_STEP_CYCLES))
-/* Cycles above which a run is longer than any run of a 0x0D (4 bit times
- * at 2400 baud are 12288): 4000 iterations. */
-#define AB_LONG (4000 * AB_LOOP_CYCLES + AB_STEP_CYCLES)
+/* Cycles from which a run is longer than any run of a 0x0D (4 bit times
+ * at 2400 baud are 12288): about 4000 iterations, a whole high byte (one
+ * compare). */
+#define AB_LONG 0x5E00
 
 /* The rates as UBRR + 1 (F_CPU / 16 / rate): a bit lasts 16 times that
  * many cycles; all exact at 7.3728 MHz. */
@@ -102,77 +103,149 @@ static struct {
 } autobaud;
 
 /*
- * The frame of five runs from P (P[0] low): its rate (UBRR + 1) by its
- * total of nine bit times within 1/8: (144 - 18) k <= cycles <=
- * (144 + 18) k, the twelve rates' ranges apart; or 0 (also when a run is
- * longer than AB_LONG). With AB_SHAPED when its runs also match 0x0D's
- * 1 1 1 2 4 bit times at that rate, each within a third of a bit and half
- * a counting iteration: a run is measured to an iteration (6 cycles),
- * which at 460800 (16 cycles a bit) is more than a third of a bit.
- */
-#define AB_NINE_LO(k) (126U * (k))
-#define AB_NINE_SPAN(k) (36U * (k))
-/* Above any rate's frame (every UBRR + 1 is 8-bit); a run added to it
- * still fits 16 bits. */
-#define AB_NINE_MAX (AB_NINE_LO(255) + AB_NINE_SPAN(255))
-_Static_assert(AB_NINE_MAX + (long)AB_LONG <= 0xFFFF, "a frame's total never wraps");
-#define AB_SHAPED 0x100
-static uint16_t __attribute__((noinline)) ab_frame(const uint16_t *p)
-{
-	uint16_t cycles = 0;
-	uint8_t k;
-
-	for (uint8_t j = 0; j < 5; j++) {
-		uint16_t c = AB_CYCLES(p[j]);
-
-		/* the total no frame's once it is above AB_NINE_MAX */
-		if (c > AB_LONG || (cycles += c) > AB_NINE_MAX) {
-			return 0;
-		}
-	}
-	for (uint8_t r = 0; ; r++) {
-		if (r == AB_NRATES) {
-			return 0;
-		}
-		k = ab_rates[r];
-		if ((uint16_t)(cycles - AB_NINE_LO(k)) <= (uint16_t)AB_NINE_SPAN(k)) {
-			break;
-		}
-	}
-	uint16_t want = (uint16_t)(16 * k);
-	uint16_t tol = (uint16_t)(want / 3 + AB_LOOP_CYCLES / 2);
-
-	for (uint8_t j = 0; j < 5; j++) {
-		if (j >= 3) {
-			want += want;
-		}
-		/* want - tol <= cycles <= want + tol */
-		if ((uint16_t)(AB_CYCLES(p[j]) - want + tol) > (uint16_t)(2 * tol)) {
-			return k;
-		}
-	}
-	return k | AB_SHAPED;
-}
-
-/*
  * Two frames in a row from P (P[0] low) last 9 bit times (start bit to
  * stop bit) of the same rate, with at least half a bit between them, and
  * one of them has 0x0D's shape: that rate (UBRR + 1), or 0. One frame may
  * be bent: an interrupt that runs while a run is timed shortens it (the
  * drivers' interrupts stay on), which the 1/8 tolerance of a frame's length
- * absorbs but a single run's may not.
+ * absorbs but a single run's may not. In assembly for its size (about 170
+ * bytes less than the compiler's), as C:
+ *
+ *   k = rate(P), the table's rate whose window holds total(P), else 0;
+ *   if (!k || cycles(P[5]) < 8 k || !window(total(P + 6), k)) return 0;
+ *   return (shape(P, k) || shape(P + 6, k)) ? k : 0;
+ *
+ *   total(Q)     the five runs' cycles from Q; none when a run is AB_LONG
+ *                or more, or the sum so far AB_NINE_MAX or more (it never
+ *                wraps; no rate's frame is that long);
+ *   window(t, k) nine bit times within 1/8: 126 k <= t <= 162 k, the
+ *                rates' windows apart, so a frame in K's is of no other;
+ *   shape(Q, k)  each run within a third of a bit and half a counting
+ *                iteration (floor(16 k / 3) + 3 cycles) of 0x0D's 1 1 1 2
+ *                4 bits: a run is measured to an iteration (6 cycles),
+ *                which at 460800 (16 cycles a bit) is more than a third of
+ *                a bit.
  */
+#define AB_NINE_MAX 0xA200
+_Static_assert(AB_NINE_MAX > 162L * 255 && AB_NINE_MAX + (long)AB_LONG <= 0x10000L &&
+	       (AB_NINE_MAX & 0xFF) == 0 && (AB_LONG & 0xFF) == 0,
+	       "above every rate's frame, no wrap, one compare each");
 static uint8_t __attribute__((noinline)) ab_check(const uint16_t *p)
 {
-	uint16_t a = ab_frame(p);
-	uint16_t b = ab_frame(p + 6);
-	uint8_t k = (uint8_t)a;
+	uint8_t k;
+	uint8_t j;
+	uint16_t c;
+	uint16_t s;
+	uint16_t tol;
+	const ORFA_FLASH uint8_t *z;
 
-	/* P[5], a high run, is below AB_QUIET iterations: its cycles fit */
-	if (k == 0 || (uint8_t)b != k || AB_CYCLES(p[5]) < (uint16_t)(8 * k) ||
-	    !((a | b) & AB_SHAPED)) {
-		return 0;
-	}
+	asm("	rcall 20f\n\t"		/* s = total(P), X = P + 10 */
+	    "	brcc 9f\n\t"
+	    "	ldi %A[z], lo8(%[rates])\n\t"
+	    "	ldi %B[z], hi8(%[rates])\n"
+	    "1:	cpi %A[z], lo8(%[rates] + %[nrates])\n\t"
+	    "	breq 9f\n\t"
+	    "	lpm %[k], %a[z]+\n\t"
+	    "	rcall 30f\n\t"
+	    "	brcs 1b\n\t"
+	    /* P[5], the high run between the frames, at least half a bit */
+	    "	ld %A[c], %a[x]+\n\t"
+	    "	ld %B[c], %a[x]+\n\t"
+	    "	subi %A[c], lo8(%[off])\n\t"
+	    "	sbci %B[c], hi8(%[off])\n\t"
+	    "	ldi %[j], 8\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	cp %A[c], r0\n\t"
+	    "	cpc %B[c], r1\n\t"
+	    "	brlo 9f\n\t"
+	    "	rcall 20f\n\t"		/* s = total(P + 6), X = P + 22 */
+	    "	brcc 9f\n\t"
+	    "	rcall 30f\n\t"
+	    "	brcs 9f\n\t"
+	    "	sbiw %[x], 22\n\t"
+	    "	movw %[z], %[x]\n\t"
+	    "	rcall 40f\n\t"		/* shape(P, k) */
+	    "	brtc 10f\n\t"
+	    "	adiw %[z], 2\n\t"
+	    "	rcall 40f\n\t"		/* shape(P + 6, k) */
+	    "	brtc 10f\n"
+	    "9:	clr %[k]\n"
+	    "10:	clr __zero_reg__\n\t"
+	    "	rjmp 99f\n"
+	    /* total(X): into s, X past the five runs; C clear: none */
+	    "20:	ldi %[j], 5\n\t"
+	    "	clr %A[s]\n\t"
+	    "	clr %B[s]\n"
+	    "21:	ld %A[c], %a[x]+\n\t"
+	    "	ld %B[c], %a[x]+\n\t"
+	    "	subi %A[c], lo8(%[off])\n\t"
+	    "	sbci %B[c], hi8(%[off])\n\t"
+	    "	cpi %B[c], hi8(%[lng])\n\t"
+	    "	brsh 22f\n\t"
+	    "	add %A[s], %A[c]\n\t"
+	    "	adc %B[s], %B[c]\n\t"
+	    "	cpi %B[s], hi8(%[max])\n\t"
+	    "	brsh 22f\n\t"
+	    "	dec %[j]\n\t"
+	    "	brne 21b\n"
+	    "22:	ret\n"
+	    /* window(s, k): C set when out */
+	    "30:	ldi %[j], 126\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	movw %[c], %[s]\n\t"
+	    "	sub %A[c], r0\n\t"
+	    "	sbc %B[c], r1\n\t"
+	    "	ldi %[j], 36\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	cp r0, %A[c]\n\t"
+	    "	cpc r1, %B[c]\n\t"
+	    "	ret\n"
+	    /* shape(Z, k): T set when a run is off; Z past the five runs.
+	     * X: the run's bits, 16 k (doubled for the last two); tol:
+	     * 5 k + k / 3 + 3 (k / 3 as k * 171 >> 9, exact to 255); s: 2 tol */
+	    "40:	ldi %[j], 16\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	movw %[x], r0\n\t"
+	    "	ldi %[j], 171\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	mov %A[tol], r1\n\t"
+	    "	lsr %A[tol]\n\t"
+	    "	subi %A[tol], lo8(-%[half])\n\t"
+	    "	clr %B[tol]\n\t"
+	    "	ldi %[j], 5\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	add %A[tol], r0\n\t"
+	    "	adc %B[tol], r1\n\t"
+	    "	movw %[s], %[tol]\n\t"
+	    "	lsl %A[s]\n\t"
+	    "	rol %B[s]\n\t"
+	    "	clt\n"
+	    "41:	cpi %[j], 3\n\t"
+	    "	brsh 42f\n\t"
+	    "	lsl %A[x]\n\t"
+	    "	rol %B[x]\n"
+	    "42:	ld %A[c], %a[z]+\n\t"
+	    "	ld %B[c], %a[z]+\n\t"
+	    "	subi %A[c], lo8(%[off])\n\t"
+	    "	sbci %B[c], hi8(%[off])\n\t"
+	    "	sub %A[c], %A[x]\n\t"
+	    "	sbc %B[c], %B[x]\n\t"
+	    "	add %A[c], %A[tol]\n\t"
+	    "	adc %B[c], %B[tol]\n\t"
+	    "	cp %A[s], %A[c]\n\t"
+	    "	cpc %B[s], %B[c]\n\t"
+	    "	brcc 43f\n\t"
+	    "	set\n"
+	    "43:	dec %[j]\n\t"
+	    "	brne 41b\n\t"
+	    "	ret\n"
+	    "99:"
+	    : [x] "+x" (p), [z] "=&z" (z), [k] "=&r" (k), [j] "=&d" (j), [c] "=&d" (c),
+	      [s] "=&d" (s), [tol] "=&d" (tol)
+	    : [rates] "i" (ab_rates), [nrates] "n" (AB_NRATES),
+	      [off] "n" (AB_START - AB_STEP_CYCLES), [lng] "n" (AB_LONG),
+	      [max] "n" (AB_NINE_MAX), [half] "n" (AB_LOOP_CYCLES / 2)
+	    : "r0", "memory");
 	return k;
 }
 
