@@ -70,6 +70,7 @@ _Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart
  * is AB_START + its cycles but the step to the next. */
 #define AB_START (0x10000L - AB_QUIET * (long)AB_LOOP_CYCLES)
 _Static_assert(AB_START > 0, "AB_QUIET iterations carry out of 16 bits");
+_Static_assert(AB_MAX_RUNS % 2 == 0, "the ring wraps after a high run");
 /* A run's length in cycles from what ab_scan stored, the step to the next
  * run included. */
 #define AB_CYCLES(stored) ((uint16_t)((stored) - AB_START + AB_STEP_CYCLES))
@@ -274,11 +275,11 @@ static void ab_deaf(void)
 
 /*
  * Record the line once: wait up to 65535 iterations (53 ms) for RXD to
- * fall, then count the iterations of runs, low and high in turn, into the
+ * fall, then time the runs, low and high in turn, into the
  * ring RUN of AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations
  * (the line is quiet: that high run is not stored) or low as long (a
- * break). Every run's counter starts at -AB_QUIET so that its overflow is
- * the quiet or the break. The ring keeps the last AB_MAX_RUNS runs before the end,
+ * break). Every run's counter counts its cycles from AB_START, so that its
+ * carry is the quiet or the break. The ring keeps the last AB_MAX_RUNS runs before the end,
  * however long the line was busy. One block of assembly so that every step
  * from one run to the next costs the same (AB_STEP_CYCLES).
  *
@@ -295,7 +296,6 @@ static uint8_t __attribute__((noinline)) ab_scan(void)
 	uint16_t *p = run;
 	uint8_t left = AB_MAX_RUNS;
 	uint8_t wrapped = 0;
-	uint8_t end;
 	uint16_t n;
 
 	wdt_reset();
@@ -305,51 +305,50 @@ static uint8_t __attribute__((noinline)) ab_scan(void)
 		     "	rjmp 1f\n\t"
 		     "	adiw %[n], 1\n\t"
 		     "	brne 0b\n\t"
-		     "	rjmp 8f\n"
+		     "	rjmp 9f\n"
 		     "1:	ldi %A[n], lo8(%[q])\n\t"
 		     "	ldi %B[n], hi8(%[q])\n"
 		     "2:	sbic %[pin], %[bit]\n\t"
 		     "	rjmp 3f\n\t"
 		     "	adiw %[n], %[it]\n\t"
 		     "	brcc 2b\n\t"
+		     /* a break: no runs, nothing wrapped */
+		     "	ldi %[left], %[max]\n\t"
+		     "	clr %[wr]\n\t"
 		     "	rjmp 9f\n"
+		     /* a low run: the ring wraps only after a high one (it
+		      * holds an even number); lpm, three cycles in one word,
+		      * gives this step the high run's length (its subi and
+		      * brne) */
 		     "3:	st %a[p]+, %A[n]\n\t"
 		     "	st %a[p]+, %B[n]\n\t"
-		     "	dec %[left]\n\t"
-		     "	brne 4f\n\t"
-		     "	movw %[p], %[base]\n\t"
-		     "	ldi %[left], %[max]\n\t"
-		     "	ldi %[wr], 1\n"
-		     "4:	ldi %A[n], lo8(%[q])\n\t"
+		     "	lpm\n\t"
+		     "	ldi %A[n], lo8(%[q])\n\t"
 		     "	ldi %B[n], hi8(%[q])\n"
 		     "5:	sbis %[pin], %[bit]\n\t"
 		     "	rjmp 6f\n\t"
 		     "	adiw %[n], %[it]\n\t"
 		     "	brcc 5b\n\t"
-		     "	rjmp 8f\n"
+		     "	rjmp 9f\n"
 		     "6:	st %a[p]+, %A[n]\n\t"
 		     "	st %a[p]+, %B[n]\n\t"
-		     "	dec %[left]\n\t"
+		     "	subi %[left], 2\n\t"
 		     "	brne 1b\n\t"
 		     "	movw %[p], %[base]\n\t"
 		     "	ldi %[left], %[max]\n\t"
 		     "	ldi %[wr], 1\n\t"
 		     "	rjmp 1b\n"
-		     "8:	ldi %[end], 1\n\t"
-		     "	rjmp 10f\n"
-		     "9:	ldi %[end], 0\n"
-		     "10:\n"
-		     : [n] "=&w" (n), [p] "+&e" (p), [left] "+d" (left), [wr] "+d" (wrapped),
-		       [end] "=&d" (end)
+		     "9:\n"
+		     : [n] "=&w" (n), [p] "+&e" (p), [left] "+d" (left), [wr] "+d" (wrapped)
 		     : [base] "r" (run), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
 		       [q] "i" (AB_START), [it] "I" (AB_LOOP_CYCLES), [max] "M" (AB_MAX_RUNS)
-		     : "memory");
-	uint8_t count = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
+		     : "r0", "memory");
+	/* The next write position: the record ends after a low run (the
+	 * quiet is high), which left does not count; 1 after a break or 53
+	 * ms without an edge, where the ring holds no pair. */
+	uint8_t count = (uint8_t)(AB_MAX_RUNS + 1 - left);
 	uint8_t oldest = 0;
 
-	if (!end) {
-		return 0;	/* a break */
-	}
 	if (wrapped) {
 		oldest = count;
 		count = AB_MAX_RUNS;
