@@ -131,7 +131,7 @@ static struct {
 _Static_assert(AB_NINE_MAX > 162L * 255 && AB_NINE_MAX + (long)AB_LONG <= 0x10000L &&
 	       (AB_NINE_MAX & 0xFF) == 0 && (AB_LONG & 0xFF) == 0,
 	       "above every rate's frame, no wrap, one compare each");
-static uint8_t __attribute__((noinline)) ab_check(const uint16_t *p)
+static inline __attribute__((always_inline)) uint8_t ab_check(const uint16_t *p)
 {
 	uint8_t k;
 	uint8_t j;
