@@ -345,26 +345,22 @@ static uint8_t __attribute__((noinline)) ab_scan(void)
 		       [q] "i" (AB_START), [it] "I" (AB_LOOP_CYCLES), [max] "M" (AB_MAX_RUNS)
 		     : "r0", "memory");
 	/* The next write position: the record ends after a low run (the
-	 * quiet is high), which left does not count; 1 after a break or 53
-	 * ms without an edge, where the ring holds no pair. */
-	uint8_t count = (uint8_t)(AB_MAX_RUNS + 1 - left);
-	uint8_t oldest = 0;
+	 * quiet is high), which left does not count; so it is odd, and the
+	 * newest pair's first run, AB_PAIR before it, even: a low one, as
+	 * every second run back from there. 1 after a break or 53 ms
+	 * without an edge, where the ring holds no pair. */
+	uint8_t next = (uint8_t)(AB_MAX_RUNS + 1 - left);
+	/* the pairs: all of the ring's, or those before NEXT */
+	_Static_assert(AB_PAIR % 2 == 1, "a pair from a low run ends before a low one");
+	int8_t pairs = wrapped ? (AB_MAX_RUNS - AB_PAIR + 1) / 2 : (int8_t)(next - AB_PAIR + 2) >> 1;
 
-	if (wrapped) {
-		oldest = count;
-		count = AB_MAX_RUNS;
-	}
 	memcpy(run + AB_MAX_RUNS, run, (AB_PAIR - 1) * sizeof(run[0]));
-	/* From the newest low run (even positions) back: the last pair wins. */
-	for (int8_t i = (int8_t)(count - AB_PAIR); i >= 0; i--) {
-		uint8_t at = (uint8_t)(oldest + i) & (AB_MAX_RUNS - 1);
+	/* From the newest back: the last pair wins. */
+	for (uint8_t at = (uint8_t)(next - AB_PAIR); pairs > 0; pairs--, at -= 2) {
+		uint8_t r = ab_check(run + (at & (AB_MAX_RUNS - 1)));
 
-		if (!(at & 1)) {
-			uint8_t r = ab_check(run + at);
-
-			if (r) {
-				return r;
-			}
+		if (r) {
+			return r;
 		}
 	}
 	return 0;
