@@ -400,7 +400,7 @@ void uart_line_rx(void)
 	if (!(MCU_UCSRA & _BV(FE))) {
 		autobaud.fe_run = 0;
 	} else if (++autobaud.fe_run >= autobaud.state) {
-		autobaud.lost = 1;
+		autobaud.lost = autobaud.fe_run;  /* nonzero: one load less than 1 */
 	}
 }
 
