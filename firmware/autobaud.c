@@ -275,9 +275,10 @@ static void __attribute__((noinline)) ab_line(uint8_t r)
 }
 
 /*
- * Record the line once: wait up to 65535 iterations (53 ms) for RXD to
- * fall, then time the runs, low and high in turn, into the
- * ring RUN of AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations
+ * Record the line once: wait up to AB_QUIET iterations (6.7 ms, the main
+ * loop then comes round) for RXD to fall, then time the runs, low and
+ * high in turn, into the ring of AB_MAX_RUNS from RUN[1], until RXD stays
+ * high for AB_QUIET iterations
  * (the line is quiet: that high run is not stored) or low as long (a
  * break). Every run's counter counts its cycles from AB_START, so that its
  * carry is the quiet or the break. The ring keeps the last AB_MAX_RUNS runs before the end,
@@ -286,27 +287,38 @@ static void __attribute__((noinline)) ab_line(uint8_t r)
  *
  * If the runs before the quiet hold two 0x0D in a row at one rate, that
  * rate (UBRR + 1); the last such pair wins (a fresh run at another rate
- * replaces an earlier one). 0: no rate (also after 53 ms without an
+ * replaces an earlier one). 0: no rate (also after 6.7 ms without an
  * edge).
  */
 static uint8_t __attribute__((noinline)) ab_scan(void)
 {
 	/* the ring, and its first AB_PAIR - 1 runs again after it: a pair
-	 * across its end is read in one piece */
-	uint16_t run[AB_MAX_RUNS + AB_PAIR - 1];
+	 * across its end is read in one piece; before it, the slot of the
+	 * wait for the first edge */
+	uint16_t run[1 + AB_MAX_RUNS + AB_PAIR - 1];
 	uint16_t *p = run;
-	uint8_t left = AB_MAX_RUNS;
+	uint8_t left = AB_MAX_RUNS + 2;
 	uint8_t wrapped = 0;
 	uint16_t n;
 
 	wdt_reset();
-	asm volatile("	clr %A[n]\n\t"
-		     "	clr %B[n]\n"
-		     "0:	sbis %[pin], %[bit]\n\t"
-		     "	rjmp 1f\n\t"
-		     "	adiw %[n], 1\n\t"
-		     "	brne 0b\n\t"
+	/* The wait for the first edge is a high run's (its end stored in
+	 * run[0], left counting it): RXD high the quiet's length first ends
+	 * the record with no runs. */
+	asm volatile("4:	ldi %A[n], lo8(%[q])\n\t"
+		     "	ldi %B[n], hi8(%[q])\n"
+		     "5:	sbis %[pin], %[bit]\n\t"
+		     "	rjmp 6f\n\t"
+		     "	adiw %[n], %[it]\n\t"
+		     "	brcc 5b\n\t"
 		     "	rjmp 9f\n"
+		     "6:	st %a[p]+, %A[n]\n\t"
+		     "	st %a[p]+, %B[n]\n\t"
+		     "	subi %[left], 2\n\t"
+		     "	brne 1f\n\t"
+		     "	movw %[p], %[base]\n\t"
+		     "	ldi %[left], %[max]\n\t"
+		     "	ldi %[wr], 1\n"
 		     "1:	ldi %A[n], lo8(%[q])\n\t"
 		     "	ldi %B[n], hi8(%[q])\n"
 		     "2:	sbic %[pin], %[bit]\n\t"
@@ -318,46 +330,32 @@ static uint8_t __attribute__((noinline)) ab_scan(void)
 		     "	clr %[wr]\n\t"
 		     "	rjmp 9f\n"
 		     /* a low run: the ring wraps only after a high one (it
-		      * holds an even number); lpm, three cycles in one word,
-		      * gives this step the high run's length (its subi and
+		      * holds an even number); nop and rjmp, three cycles,
+		      * give this step the high run's length (its subi and
 		      * brne) */
 		     "3:	st %a[p]+, %A[n]\n\t"
 		     "	st %a[p]+, %B[n]\n\t"
-		     "	lpm\n\t"
-		     "	ldi %A[n], lo8(%[q])\n\t"
-		     "	ldi %B[n], hi8(%[q])\n"
-		     "5:	sbis %[pin], %[bit]\n\t"
-		     "	rjmp 6f\n\t"
-		     "	adiw %[n], %[it]\n\t"
-		     "	brcc 5b\n\t"
-		     "	rjmp 9f\n"
-		     "6:	st %a[p]+, %A[n]\n\t"
-		     "	st %a[p]+, %B[n]\n\t"
-		     "	subi %[left], 2\n\t"
-		     "	brne 1b\n\t"
-		     "	movw %[p], %[base]\n\t"
-		     "	ldi %[left], %[max]\n\t"
-		     "	ldi %[wr], 1\n\t"
-		     "	rjmp 1b\n"
+		     "	nop\n\t"
+		     "	rjmp 4b\n"
 		     "9:\n"
 		     : [n] "=&w" (n), [p] "+&e" (p), [left] "+d" (left), [wr] "+d" (wrapped)
-		     : [base] "r" (run), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
+		     : [base] "r" (run + 1), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
 		       [q] "i" (AB_START), [it] "I" (AB_LOOP_CYCLES), [max] "M" (AB_MAX_RUNS)
-		     : "r0", "memory");
+		     : "memory");
 	/* The next write position: the record ends after a low run (the
 	 * quiet is high), which left does not count; so it is odd, and the
 	 * newest pair's first run, AB_PAIR before it, even: a low one, as
-	 * every second run back from there. 1 after a break or 53 ms
-	 * without an edge, where the ring holds no pair. */
+	 * every second run back from there. 1 after a break, 255 (-1) after
+	 * a quiet without an edge: no pair. */
 	uint8_t next = (uint8_t)(AB_MAX_RUNS + 1 - left);
 	/* the pairs: all of the ring's, or those before NEXT */
 	_Static_assert(AB_PAIR % 2 == 1, "a pair from a low run ends before a low one");
 	int8_t pairs = wrapped ? (AB_MAX_RUNS - AB_PAIR + 1) / 2 : (int8_t)(next - AB_PAIR + 2) >> 1;
 
-	memcpy(run + AB_MAX_RUNS, run, (AB_PAIR - 1) * sizeof(run[0]));
+	memcpy(run + 1 + AB_MAX_RUNS, run + 1, (AB_PAIR - 1) * sizeof(run[0]));
 	/* From the newest back: the last pair wins. */
 	for (uint8_t at = (uint8_t)(next - AB_PAIR); pairs > 0; pairs--, at -= 2) {
-		uint8_t r = ab_check(run + (at & (AB_MAX_RUNS - 1)));
+		uint8_t r = ab_check(run + 1 + (at & (AB_MAX_RUNS - 1)));
 
 		if (r) {
 			return r;
