@@ -254,6 +254,8 @@ static inline __attribute__((always_inline)) uint8_t ab_check(const uint16_t *p)
  * detection. One body for both (10 B less than two). */
 static void __attribute__((noinline)) ab_line(uint8_t r)
 {
+	uint8_t state = AB_DETECT;
+
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 		/* the transmitter's bits kept: UDRIE may be set (a reply going
 		 * out) */
@@ -263,6 +265,7 @@ static void __attribute__((noinline)) ab_line(uint8_t r)
 			/* UBRRH: 0 from reset (every rate's UBRR is 8-bit) */
 			MCU_UBRRL = (uint8_t)(r - 1);
 			ucsrb |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
+			state = AB_FRESH;
 		}
 		MCU_UCSRB = ucsrb;
 		/* Framing errors seen so far were at the old rate. */
@@ -270,8 +273,7 @@ static void __attribute__((noinline)) ab_line(uint8_t r)
 		autobaud.fe_run = 0;
 	}
 	autobaud.rate = r;
-	_Static_assert(AB_FRESH == 1, "a rate's state is r != 0");
-	autobaud.state = (r != 0);
+	autobaud.state = state;
 }
 
 /*
