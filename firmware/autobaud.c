@@ -389,7 +389,7 @@ uint8_t uart_line_poll(void)
 
 	if (r == 0 || r == autobaud.rate) {
 		/* no rate yet: round the main loop (nothing received to drop) */
-		return autobaud.state == AB_DETECT;
+		return autobaud.rate == 0;  /* detecting */
 	}
 	ab_line(r);
 	return 1;
