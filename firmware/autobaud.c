@@ -93,8 +93,13 @@ static const ORFA_FLASH uint8_t ab_rates[] = { ORFA_BAUD_RATES(AB_RATE) };
  * any gap). */
 #define AB_PAIR 11
 /* The states, each the number of frames with FE in a row that send it
- * back to detection (the receiver is off in AB_DETECT). */
-enum { AB_DETECT = 0, AB_FRESH = 1, AB_TALK = AB_FE_RUN };
+ * back to detection (the receiver is off in AB_DETECT). A good request ORs
+ * AB_PROVEN in: AB_FRESH becomes AB_TALK; in detection, which rate 0
+ * tells, the state is not read (the receiver is off) until ab_line sets it
+ * again, and it never becomes AB_TALK. */
+enum { AB_DETECT = 0, AB_FRESH = 1, AB_PROVEN = 2, AB_TALK = AB_FE_RUN };
+_Static_assert(AB_TALK == (AB_FRESH | AB_PROVEN) && AB_TALK != (AB_DETECT | AB_PROVEN),
+	       "a proven fresh rate talks; detection does not");
 
 static struct {
 	uint8_t state;
@@ -406,8 +411,6 @@ void uart_line_rx(void)
 
 void uart_line_confirm(void)
 {
-	if (autobaud.state == AB_FRESH) {
-		autobaud.state = AB_TALK;
-	}
+	autobaud.state |= AB_PROVEN;
 }
 
