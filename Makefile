@@ -224,18 +224,23 @@ SIM_CFLAGS := -std=gnu99 -O2 -g -Wall -Wextra -Werror -I. -Isim -I/usr/include/s
 SIM_LIBS := -lsimavr -lelf -lutil -lpthread -lm
 
 sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf build/sim-fw/twi_slave_echo_m128.elf \
-	build/sim-fw/twi_arb_master.elf build/sim-fw/irq_latency.elf
+	build/sim-fw/twi_arb_master.elf build/sim-fw/irq_latency.elf build/sim-fw/autobaud_check.elf
 
 # Test firmware for the simulator's bus tests (tests/sim/fw), not ORFA: the
 # echo slave on an ATmega32 at 0x20 and on an ATmega128 at 0x22, a master
 # that loses arbitration (ATmega32), a count of the instructions run after
-# SEI and RETI before a pending interrupt (ATmega32).
+# SEI and RETI before a pending interrupt (ATmega32), autobaud's pair
+# analysis against its rule (the M32-D gateway's autobaud.c and rates).
 # Each runs on a board's MCU at its clock (board.h).
 SIM_FW_CFLAGS := -std=gnu99 -Os -Wall -Wextra -Werror
 build/sim-fw/%_m128.elf: tests/sim/fw/%.c
 	@mkdir -p $(dir $@)
 	avr-gcc -mmcu=$(call board_mcu,m128s) -DF_CPU=$(call board_f_cpu,m128s) -DECHO_ADDR=0x22 \
 		$(SIM_FW_CFLAGS) $< -o $@
+
+build/sim-fw/autobaud_check.elf: firmware/autobaud.c firmware/uart_line.h boards/m32d/board.h
+build/sim-fw/autobaud_check.elf: SIM_FW_CFLAGS += -I. -Iboards/m32d -fshort-enums \
+	'-DORFA_BAUD_RATES(X)=$(foreach r,$(AUTOBAUD_RATES),X($(r)))'
 
 build/sim-fw/%.elf: tests/sim/fw/%.c
 	@mkdir -p $(dir $@)

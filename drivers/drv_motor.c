@@ -1,5 +1,7 @@
 #include "drivers/drv_motor.h"
 
+#include <string.h>
+
 #include "drivers/motor_hw.h"
 #include "firmware/board_pins.h"
 #include "firmware/pins.h"
@@ -40,12 +42,10 @@ reg_status_t drv_motor_write(uint8_t reg, const uint8_t *data, uint8_t len)
 		return REG_BAD_LENGTH;
 	}
 	uint8_t next[DRV_motor_NREGS];
-	for (uint8_t i = 0; i < DRV_motor_NREGS; i++) {
-		next[i] = motor_reg[i];
-	}
-	for (uint8_t i = 0; i < len; i++) {
-		next[reg + i] = data[i];
-	}
+	/* memcpy (linked already): the compiler's copies were a load and a
+	 * store per byte */
+	memcpy(next, motor_reg, DRV_motor_NREGS);
+	memcpy(next + reg, data, len);
 	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
 		if (next[MOTOR_REG_DIR1 + m] > 1) {
 			return REG_BAD_VALUE;
@@ -65,9 +65,7 @@ reg_status_t drv_motor_write(uint8_t reg, const uint8_t *data, uint8_t len)
 		}
 	}
 	motor_hw_apply(&next[0], &next[MOTOR_REG_DIR1], lines);
-	for (uint8_t i = 0; i < DRV_motor_NREGS; i++) {
-		motor_reg[i] = next[i];
-	}
+	memcpy(motor_reg, next, DRV_motor_NREGS);
 	return REG_OK;
 }
 

@@ -126,31 +126,33 @@ reg_status_t drv_spi_write(uint8_t reg, const uint8_t *data, uint8_t len)
  * each channel's [port][line] (FF FF when unbound). */
 uint8_t drv_spi_read(uint8_t reg, uint8_t *dst, uint8_t max)
 {
-	uint8_t n = 0;
-	if (reg == SPI_REG_DATA) {
-		for (; n < spi.rx_len && n < max; n++) {
-			dst[n] = spi.rx[n];
-		}
-		return n;
-	}
 	uint8_t cfg[1 + 2 * SPI_CHANNELS];
-	cfg[0] = spi.settings;
-	for (uint8_t i = 0; i < SPI_CHANNELS; i++) {
-		uint8_t port = SPI_UNBOUND;
-		uint8_t line = SPI_UNBOUND;
-		if (spi.cs[i] != SPI_UNBOUND) {
-			for (uint8_t p = 0; p < SPI_NPORTS; p++) {
-				if (spi_ports[p] == PIN_PORT(spi.cs[i])) {
-					port = p;
+	const uint8_t *src = spi.rx;
+	uint8_t n = spi.rx_len;
+
+	if (reg != SPI_REG_DATA) {
+		cfg[0] = spi.settings;
+		for (uint8_t i = 0; i < SPI_CHANNELS; i++) {
+			uint8_t port = SPI_UNBOUND;
+			uint8_t line = SPI_UNBOUND;
+			if (spi.cs[i] != SPI_UNBOUND) {
+				for (uint8_t p = 0; p < SPI_NPORTS; p++) {
+					if (spi_ports[p] == PIN_PORT(spi.cs[i])) {
+						port = p;
+					}
 				}
+				line = spi.cs[i] & 7;
 			}
-			line = spi.cs[i] & 7;
+			cfg[1 + 2 * i] = port;
+			cfg[2 + 2 * i] = line;
 		}
-		cfg[1 + 2 * i] = port;
-		cfg[2 + 2 * i] = line;
+		src = cfg;
+		n = sizeof cfg;
 	}
-	for (; n < sizeof cfg && n < max; n++) {
-		dst[n] = cfg[n];
+	/* one copy for both */
+	if (n > max) {
+		n = max;
 	}
+	memcpy(dst, src, n);
 	return n;
 }

@@ -61,18 +61,23 @@ enum {
 _Static_assert(AB_RX_PORT >= 'A' && AB_RX_PORT <= 'D', "RXD on ports A-D");
 _Static_assert(_SFR_IO_ADDR(PIND) == _SFR_IO_ADDR(PINA) - 9, "PINA..PIND 3 apart");
 
-/* Cycles of one counting iteration (sbic/sbis skipping 2, adiw 2, brne 2)
- * and of the step from one run to the next in ab_record. */
+/* Cycles of one counting iteration (sbic/sbis skipping 2, adiw 2, brcc 2)
+ * and of the step from one run to the next in ab_scan. */
 #define AB_LOOP_CYCLES 6
 #define AB_STEP_CYCLES 12
-/* Iterations above which a run is longer than any run of a 0x0D (4 bit
- * times at 2400 baud are 2048). */
-#define AB_LONG 4000
-/* A run's iterations from what ab_scan stored: its counter started at
- * -AB_QUIET. */
-#define AB_ITER(stored) ((uint16_t)((stored) + AB_QUIET))
-/* ... and its length in cycles, the step to the next run included. */
-#define AB_CYCLES(stored) ((uint16_t)(AB_ITER(stored) * AB_LOOP_CYCLES + AB_STEP_CYCLES))
+/* A run's counter counts its cycles (AB_LOOP_CYCLES an iteration) from
+ * AB_START, where AB_QUIET iterations carry out of 16 bits: a stored run
+ * is AB_START + its cycles but the step to the next. */
+#define AB_START (0x10000L - AB_QUIET * (long)AB_LOOP_CYCLES)
+_Static_assert(AB_START > 0, "AB_QUIET iterations carry out of 16 bits");
+_Static_assert(AB_MAX_RUNS % 2 == 0, "the ring wraps after a high run");
+/* A run's length in cycles from what ab_scan stored, the step to the next
+ * run included. */
+#define AB_CYCLES(stored) ((uint16_t)((stored) - AB_START + AB_STEP_CYCLES))
+/* Cycles from which a run is longer than any run of a 0x0D (4 bit times
+ * at 2400 baud are 12288): about 4000 iterations, a whole high byte (one
+ * compare). */
+#define AB_LONG 0x5E00
 
 /* The rates as UBRR + 1 (F_CPU / 16 / rate): a bit lasts 16 times that
  * many cycles; all exact at 7.3728 MHz. */
@@ -88,8 +93,13 @@ static const ORFA_FLASH uint8_t ab_rates[] = { ORFA_BAUD_RATES(AB_RATE) };
  * any gap). */
 #define AB_PAIR 11
 /* The states, each the number of frames with FE in a row that send it
- * back to detection (the receiver is off in AB_DETECT). */
-enum { AB_DETECT = 0, AB_FRESH = 1, AB_TALK = AB_FE_RUN };
+ * back to detection (the receiver is off in AB_DETECT). A good request ORs
+ * AB_PROVEN in: AB_FRESH becomes AB_TALK; in detection, which rate 0
+ * tells, the state is not read (the receiver is off) until ab_line sets it
+ * again, and it never becomes AB_TALK. */
+enum { AB_DETECT = 0, AB_FRESH = 1, AB_PROVEN = 2, AB_TALK = AB_FE_RUN };
+_Static_assert(AB_TALK == (AB_FRESH | AB_PROVEN) && AB_TALK != (AB_DETECT | AB_PROVEN),
+	       "a proven fresh rate talks; detection does not");
 
 static struct {
 	uint8_t state;
@@ -99,194 +109,263 @@ static struct {
 } autobaud;
 
 /*
- * The rate (UBRR + 1) whose 0x0D the five runs from P are (P[0] low), by
- * their total of nine bit times within 1/8: (144 - 18) k <= cycles <=
- * (144 + 18) k, the twelve rates' ranges apart; or 0. In iterations:
- * cycles are 6 its + 5 steps, each bound a multiple of 6.
- */
-#define AB_NINE_LO(k) ((126 * (k) - 5 * AB_STEP_CYCLES) / AB_LOOP_CYCLES)
-#define AB_NINE_SPAN(k) (36 * (k) / AB_LOOP_CYCLES)
-_Static_assert(126 % AB_LOOP_CYCLES == 0 && 36 % AB_LOOP_CYCLES == 0 &&
-	       5 * AB_STEP_CYCLES % AB_LOOP_CYCLES == 0, "the bounds in whole iterations");
-static uint8_t ab_frame(const uint16_t *p)
-{
-	uint16_t its = 0;
-
-	for (uint8_t j = 0; j < 5; j++) {
-		uint16_t n = AB_ITER(p[j]);
-
-		if (n > AB_LONG) {
-			return 0;
-		}
-		its += n;
-	}
-	for (uint8_t r = 0; r < AB_NRATES; r++) {
-		uint8_t k = ab_rates[r];
-
-		if ((uint16_t)(its - AB_NINE_LO(k)) <= (uint16_t)AB_NINE_SPAN(k)) {
-			return k;
-		}
-	}
-	return 0;
-}
-
-/* The five runs from P match 0x0D's 1 1 1 2 4 bit times at rate K, each
- * within a third of a bit and half a counting iteration: a run is measured
- * to an iteration (6 cycles), which at 460800 (16 cycles a bit) is more than
- * a third of a bit. No run is longer than AB_LONG here (ab_frame took
- * them). */
-static uint8_t ab_shape(const uint16_t *p, uint8_t k)
-{
-	uint16_t want = (uint16_t)(16 * k);
-	uint16_t tol = (uint16_t)(want / 3 + AB_LOOP_CYCLES / 2);
-
-	for (uint8_t j = 0; j < 5; j++) {
-		if (j >= 3) {
-			want += want;
-		}
-		/* want - tol <= cycles <= want + tol */
-		if ((uint16_t)(AB_CYCLES(p[j]) - want + tol) > (uint16_t)(2 * tol)) {
-			return 0;
-		}
-	}
-	return 1;
-}
-
-/*
  * Two frames in a row from P (P[0] low) last 9 bit times (start bit to
  * stop bit) of the same rate, with at least half a bit between them, and
  * one of them has 0x0D's shape: that rate (UBRR + 1), or 0. One frame may
  * be bent: an interrupt that runs while a run is timed shortens it (the
  * drivers' interrupts stay on), which the 1/8 tolerance of a frame's length
- * absorbs but a single run's may not.
+ * absorbs but a single run's may not. In assembly for its size (about 170
+ * bytes less than the compiler's), as C:
+ *
+ *   k = rate(P), the table's rate whose window holds total(P), else 0;
+ *   if (!k || cycles(P[5]) < 8 k || !window(total(P + 6), k)) return 0;
+ *   return (shape(P, k) || shape(P + 6, k)) ? k : 0;
+ *
+ *   total(Q)     the five runs' cycles from Q; none when a run is AB_LONG
+ *                or more, or the sum so far AB_NINE_MAX or more (it never
+ *                wraps; no rate's frame is that long);
+ *   window(t, k) nine bit times within 1/8: 126 k <= t <= 162 k, the
+ *                rates' windows apart, so a frame in K's is of no other;
+ *   shape(Q, k)  each run within a third of a bit and half a counting
+ *                iteration (floor(16 k / 3) + 3 cycles) of 0x0D's 1 1 1 2
+ *                4 bits: a run is measured to an iteration (6 cycles),
+ *                which at 460800 (16 cycles a bit) is more than a third of
+ *                a bit.
  */
-static uint8_t __attribute__((noinline)) ab_check(const uint16_t *p)
+#define AB_NINE_MAX 0xA200
+_Static_assert(AB_NINE_MAX > 162L * 255 && AB_NINE_MAX + (long)AB_LONG <= 0x10000L &&
+	       (AB_NINE_MAX & 0xFF) == 0 && (AB_LONG & 0xFF) == 0,
+	       "above every rate's frame, no wrap, one compare each");
+static inline __attribute__((always_inline)) uint8_t ab_check(const uint16_t *p)
 {
-	uint8_t k = ab_frame(p);
+	uint8_t k;
+	uint8_t j;
+	uint16_t c;
+	uint16_t s;
+	uint16_t tol;
+	const ORFA_FLASH uint8_t *z;
 
-	/* P[5], a high run, is below AB_QUIET iterations: its cycles fit */
-	if (k == 0 || ab_frame(p + 6) != k || AB_CYCLES(p[5]) < (uint16_t)(8 * k)) {
-		return 0;
-	}
-	return (ab_shape(p, k) || ab_shape(p + 6, k)) ? k : 0;
+	asm("	rcall 20f\n\t"		/* s = total(P), X = P + 10 */
+	    "	brcc 9f\n\t"
+	    "	ldi %A[z], lo8(%[rates])\n\t"
+	    "	ldi %B[z], hi8(%[rates])\n"
+	    "1:	cpi %A[z], lo8(%[rates] + %[nrates])\n\t"
+	    "	breq 9f\n\t"
+	    "	lpm %[k], %a[z]+\n\t"
+	    "	rcall 30f\n\t"
+	    "	brcs 1b\n\t"
+	    /* P[5], the high run between the frames, at least half a bit */
+	    "	ld %A[c], %a[x]+\n\t"
+	    "	ld %B[c], %a[x]+\n\t"
+	    "	subi %A[c], lo8(%[off])\n\t"
+	    "	sbci %B[c], hi8(%[off])\n\t"
+	    "	ldi %[j], 8\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	cp %A[c], r0\n\t"
+	    "	cpc %B[c], r1\n\t"
+	    "	brlo 9f\n\t"
+	    "	rcall 20f\n\t"		/* s = total(P + 6), X = P + 22 */
+	    "	brcc 9f\n\t"
+	    "	rcall 30f\n\t"
+	    "	brcs 9f\n\t"
+	    "	sbiw %[x], 22\n\t"
+	    "	movw %[z], %[x]\n\t"
+	    "	rcall 40f\n\t"		/* shape(P, k) */
+	    "	brtc 10f\n\t"
+	    "	adiw %[z], 2\n\t"
+	    "	rcall 40f\n\t"		/* shape(P + 6, k) */
+	    "	brtc 10f\n"
+	    "9:	clr %[k]\n"
+	    "10:	clr __zero_reg__\n\t"
+	    "	rjmp 99f\n"
+	    /* total(X): into s, X past the five runs; C clear: none */
+	    "20:	ldi %[j], 5\n\t"
+	    "	clr %A[s]\n\t"
+	    "	clr %B[s]\n"
+	    "21:	ld %A[c], %a[x]+\n\t"
+	    "	ld %B[c], %a[x]+\n\t"
+	    "	subi %A[c], lo8(%[off])\n\t"
+	    "	sbci %B[c], hi8(%[off])\n\t"
+	    "	cpi %B[c], hi8(%[lng])\n\t"
+	    "	brsh 22f\n\t"
+	    "	add %A[s], %A[c]\n\t"
+	    "	adc %B[s], %B[c]\n\t"
+	    "	cpi %B[s], hi8(%[max])\n\t"
+	    "	brsh 22f\n\t"
+	    "	dec %[j]\n\t"
+	    "	brne 21b\n"
+	    "22:	ret\n"
+	    /* window(s, k): C set when out */
+	    "30:	ldi %[j], 126\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	movw %[c], %[s]\n\t"
+	    "	sub %A[c], r0\n\t"
+	    "	sbc %B[c], r1\n\t"
+	    "	ldi %[j], 36\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	cp r0, %A[c]\n\t"
+	    "	cpc r1, %B[c]\n\t"
+	    "	ret\n"
+	    /* shape(Z, k): T set when a run is off; Z past the five runs.
+	     * X: the run's bits, 16 k (doubled for the last two); tol:
+	     * 5 k + k / 3 + 3 (k / 3 as k * 171 >> 9, exact to 255); s: 2 tol */
+	    "40:	ldi %[j], 16\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	movw %[x], r0\n\t"
+	    "	ldi %[j], 171\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	mov %A[tol], r1\n\t"
+	    "	lsr %A[tol]\n\t"
+	    "	subi %A[tol], lo8(-%[half])\n\t"
+	    "	clr %B[tol]\n\t"
+	    "	ldi %[j], 5\n\t"
+	    "	mul %[k], %[j]\n\t"
+	    "	add %A[tol], r0\n\t"
+	    "	adc %B[tol], r1\n\t"
+	    "	movw %[s], %[tol]\n\t"
+	    "	lsl %A[s]\n\t"
+	    "	rol %B[s]\n\t"
+	    "	clt\n"
+	    "41:	cpi %[j], 3\n\t"
+	    "	brsh 42f\n\t"
+	    "	lsl %A[x]\n\t"
+	    "	rol %B[x]\n"
+	    "42:	ld %A[c], %a[z]+\n\t"
+	    "	ld %B[c], %a[z]+\n\t"
+	    "	subi %A[c], lo8(%[off])\n\t"
+	    "	sbci %B[c], hi8(%[off])\n\t"
+	    "	sub %A[c], %A[x]\n\t"
+	    "	sbc %B[c], %B[x]\n\t"
+	    "	add %A[c], %A[tol]\n\t"
+	    "	adc %B[c], %B[tol]\n\t"
+	    "	cp %A[s], %A[c]\n\t"
+	    "	cpc %B[s], %B[c]\n\t"
+	    "	brcc 43f\n\t"
+	    "	set\n"
+	    "43:	dec %[j]\n\t"
+	    "	brne 41b\n\t"
+	    "	ret\n"
+	    "99:"
+	    : [x] "+x" (p), [z] "=&z" (z), [k] "=&r" (k), [j] "=&d" (j), [c] "=&d" (c),
+	      [s] "=&d" (s), [tol] "=&d" (tol)
+	    : [rates] "i" (ab_rates), [nrates] "n" (AB_NRATES),
+	      [off] "n" (AB_START - AB_STEP_CYCLES), [lng] "n" (AB_LONG),
+	      [max] "n" (AB_NINE_MAX), [half] "n" (AB_LOOP_CYCLES / 2)
+	    : "r0", "memory");
+	return k;
 }
 
-static void ab_listen(uint8_t ubrr)
+/* The receiver on at rate R (UBRR + 1), the rate fresh; R 0: off, back to
+ * detection. One body for both (10 B less than two). */
+static void __attribute__((noinline)) ab_line(uint8_t r)
 {
+	uint8_t state = AB_DETECT;
+
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		/* UBRRH: 0 from reset (every rate's UBRR is 8-bit) */
-		MCU_UBRRL = ubrr;
-		/* |=: the transmitter's UDRIE may be set (a reply going out). */
-		MCU_UCSRB |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
+		/* the transmitter's bits kept: UDRIE may be set (a reply going
+		 * out) */
+		uint8_t ucsrb = MCU_UCSRB & (uint8_t)~(_BV(RXEN) | _BV(RXCIE));
+
+		if (r) {
+			/* UBRRH: 0 from reset (every rate's UBRR is 8-bit) */
+			MCU_UBRRL = (uint8_t)(r - 1);
+			ucsrb |= _BV(RXEN) | _BV(TXEN) | _BV(RXCIE);
+			state = AB_FRESH;
+		}
+		MCU_UCSRB = ucsrb;
 		/* Framing errors seen so far were at the old rate. */
 		autobaud.lost = 0;
 		autobaud.fe_run = 0;
 	}
-}
-
-static void ab_deaf(void)
-{
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		MCU_UCSRB &= (uint8_t)~(_BV(RXEN) | _BV(RXCIE));
-		autobaud.lost = 0;
-	}
-	autobaud.state = AB_DETECT;
-	autobaud.rate = 0;
+	autobaud.rate = r;
+	autobaud.state = state;
 }
 
 /*
- * Record the line once: wait up to 65535 iterations (53 ms) for RXD to
- * fall, then count the iterations of runs, low and high in turn, into the
- * ring RUN of AB_MAX_RUNS, until RXD stays high for AB_QUIET iterations
+ * Record the line once: wait up to AB_QUIET iterations (6.7 ms, the main
+ * loop then comes round) for RXD to fall, then time the runs, low and
+ * high in turn, into the ring of AB_MAX_RUNS from RUN[1], until RXD stays
+ * high for AB_QUIET iterations
  * (the line is quiet: that high run is not stored) or low as long (a
- * break). Every run's counter starts at -AB_QUIET so that its overflow is
- * the quiet or the break. The ring keeps the last AB_MAX_RUNS runs before the end,
+ * break). Every run's counter counts its cycles from AB_START, so that its
+ * carry is the quiet or the break. The ring keeps the last AB_MAX_RUNS runs before the end,
  * however long the line was busy. One block of assembly so that every step
  * from one run to the next costs the same (AB_STEP_CYCLES).
  *
  * If the runs before the quiet hold two 0x0D in a row at one rate, that
  * rate (UBRR + 1); the last such pair wins (a fresh run at another rate
- * replaces an earlier one). 0: no rate (also after 53 ms without an
+ * replaces an earlier one). 0: no rate (also after 6.7 ms without an
  * edge).
  */
 static uint8_t __attribute__((noinline)) ab_scan(void)
 {
 	/* the ring, and its first AB_PAIR - 1 runs again after it: a pair
-	 * across its end is read in one piece */
-	uint16_t run[AB_MAX_RUNS + AB_PAIR - 1];
+	 * across its end is read in one piece; before it, the slot of the
+	 * wait for the first edge */
+	uint16_t run[1 + AB_MAX_RUNS + AB_PAIR - 1];
 	uint16_t *p = run;
-	uint8_t left = AB_MAX_RUNS;
+	uint8_t left = AB_MAX_RUNS + 2;
 	uint8_t wrapped = 0;
-	uint8_t end;
 	uint16_t n;
 
 	wdt_reset();
-	asm volatile("	clr %A[n]\n\t"
-		     "	clr %B[n]\n"
-		     "0:	sbis %[pin], %[bit]\n\t"
-		     "	rjmp 1f\n\t"
-		     "	adiw %[n], 1\n\t"
-		     "	brne 0b\n\t"
-		     "	rjmp 8f\n"
+	/* The wait for the first edge is a high run's (its end stored in
+	 * run[0], left counting it): RXD high the quiet's length first ends
+	 * the record with no runs. */
+	asm volatile("4:	ldi %A[n], lo8(%[q])\n\t"
+		     "	ldi %B[n], hi8(%[q])\n"
+		     "5:	sbis %[pin], %[bit]\n\t"
+		     "	rjmp 6f\n\t"
+		     "	adiw %[n], %[it]\n\t"
+		     "	brcc 5b\n\t"
+		     "	rjmp 9f\n"
+		     "6:	st %a[p]+, %A[n]\n\t"
+		     "	st %a[p]+, %B[n]\n\t"
+		     "	subi %[left], 2\n\t"
+		     "	brne 1f\n\t"
+		     "	movw %[p], %[base]\n\t"
+		     "	ldi %[left], %[max]\n\t"
+		     "	ldi %[wr], 1\n"
 		     "1:	ldi %A[n], lo8(%[q])\n\t"
 		     "	ldi %B[n], hi8(%[q])\n"
 		     "2:	sbic %[pin], %[bit]\n\t"
 		     "	rjmp 3f\n\t"
-		     "	adiw %[n], 1\n\t"
-		     "	brne 2b\n\t"
+		     "	adiw %[n], %[it]\n\t"
+		     "	brcc 2b\n\t"
+		     /* a break: no runs, nothing wrapped */
+		     "	ldi %[left], %[max]\n\t"
+		     "	clr %[wr]\n\t"
 		     "	rjmp 9f\n"
+		     /* a low run: the ring wraps only after a high one (it
+		      * holds an even number); nop and rjmp, three cycles,
+		      * give this step the high run's length (its subi and
+		      * brne) */
 		     "3:	st %a[p]+, %A[n]\n\t"
 		     "	st %a[p]+, %B[n]\n\t"
-		     "	dec %[left]\n\t"
-		     "	brne 4f\n\t"
-		     "	movw %[p], %[base]\n\t"
-		     "	ldi %[left], %[max]\n\t"
-		     "	ldi %[wr], 1\n"
-		     "4:	ldi %A[n], lo8(%[q])\n\t"
-		     "	ldi %B[n], hi8(%[q])\n"
-		     "5:	sbis %[pin], %[bit]\n\t"
-		     "	rjmp 6f\n\t"
-		     "	adiw %[n], 1\n\t"
-		     "	brne 5b\n\t"
-		     "	rjmp 8f\n"
-		     "6:	st %a[p]+, %A[n]\n\t"
-		     "	st %a[p]+, %B[n]\n\t"
-		     "	dec %[left]\n\t"
-		     "	brne 1b\n\t"
-		     "	movw %[p], %[base]\n\t"
-		     "	ldi %[left], %[max]\n\t"
-		     "	ldi %[wr], 1\n\t"
-		     "	rjmp 1b\n"
-		     "8:	ldi %[end], 1\n\t"
-		     "	rjmp 10f\n"
-		     "9:	ldi %[end], 0\n"
-		     "10:\n"
-		     : [n] "=&w" (n), [p] "+&e" (p), [left] "+d" (left), [wr] "+d" (wrapped),
-		       [end] "=&d" (end)
-		     : [base] "r" (run), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
-		       [q] "i" (0x10000L - AB_QUIET), [max] "M" (AB_MAX_RUNS)
+		     "	nop\n\t"
+		     "	rjmp 4b\n"
+		     "9:\n"
+		     : [n] "=&w" (n), [p] "+&e" (p), [left] "+d" (left), [wr] "+d" (wrapped)
+		     : [base] "r" (run + 1), [pin] "I" (AB_PIN_IO), [bit] "I" (AB_RX_BIT),
+		       [q] "i" (AB_START), [it] "I" (AB_LOOP_CYCLES), [max] "M" (AB_MAX_RUNS)
 		     : "memory");
-	uint8_t count = (uint8_t)(AB_MAX_RUNS - left);	/* the next write position */
-	uint8_t oldest = 0;
+	/* The next write position: the record ends after a low run (the
+	 * quiet is high), which left does not count; so it is odd, and the
+	 * newest pair's first run, AB_PAIR before it, even: a low one, as
+	 * every second run back from there. 1 after a break, 255 (-1) after
+	 * a quiet without an edge: no pair. */
+	uint8_t next = (uint8_t)(AB_MAX_RUNS + 1 - left);
+	/* the pairs: all of the ring's, or those before NEXT */
+	_Static_assert(AB_PAIR % 2 == 1, "a pair from a low run ends before a low one");
+	int8_t pairs = wrapped ? (AB_MAX_RUNS - AB_PAIR + 1) / 2 : (int8_t)(next - AB_PAIR + 2) >> 1;
 
-	if (!end) {
-		return 0;	/* a break */
-	}
-	if (wrapped) {
-		oldest = count;
-		count = AB_MAX_RUNS;
-	}
-	memcpy(run + AB_MAX_RUNS, run, (AB_PAIR - 1) * sizeof(run[0]));
-	/* From the newest low run (even positions) back: the last pair wins. */
-	for (int8_t i = (int8_t)(count - AB_PAIR); i >= 0; i--) {
-		uint8_t at = (uint8_t)(oldest + i) & (AB_MAX_RUNS - 1);
+	memcpy(run + 1 + AB_MAX_RUNS, run + 1, (AB_PAIR - 1) * sizeof(run[0]));
+	/* From the newest back: the last pair wins. */
+	for (uint8_t at = (uint8_t)(next - AB_PAIR); pairs > 0; pairs--, at -= 2) {
+		uint8_t r = ab_check(run + 1 + (at & (AB_MAX_RUNS - 1)));
 
-		if (!(at & 1)) {
-			uint8_t r = ab_check(run + at);
-
-			if (r) {
-				return r;
-			}
+		if (r) {
+			return r;
 		}
 	}
 	return 0;
@@ -302,7 +381,7 @@ void uart_init(void)
 uint8_t uart_line_poll(void)
 {
 	if (autobaud.lost) {
-		ab_deaf();
+		ab_line(0);
 	}
 	if (autobaud.state == AB_TALK) {
 		return 0;
@@ -315,11 +394,9 @@ uint8_t uart_line_poll(void)
 
 	if (r == 0 || r == autobaud.rate) {
 		/* no rate yet: round the main loop (nothing received to drop) */
-		return autobaud.state == AB_DETECT;
+		return autobaud.rate == 0;  /* detecting */
 	}
-	autobaud.rate = r;
-	autobaud.state = AB_FRESH;
-	ab_listen((uint8_t)(r - 1));
+	ab_line(r);
 	return 1;
 }
 
@@ -328,14 +405,12 @@ void uart_line_rx(void)
 	if (!(MCU_UCSRA & _BV(FE))) {
 		autobaud.fe_run = 0;
 	} else if (++autobaud.fe_run >= autobaud.state) {
-		autobaud.lost = 1;
+		autobaud.lost = autobaud.fe_run;  /* nonzero: one load less than 1 */
 	}
 }
 
 void uart_line_confirm(void)
 {
-	if (autobaud.state == AB_FRESH) {
-		autobaud.state = AB_TALK;
-	}
+	autobaud.state |= AB_PROVEN;
 }
 

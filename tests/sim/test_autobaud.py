@@ -13,7 +13,7 @@ import pytest
 
 from conftest import REPLY_TIMEOUT, board_sent, build_gateway, require_builds
 from orfa.protocol import AUTOBAUD_PREAMBLE, AUTOBAUD_RATES, F_CPU
-from orfa.sim import BOARDS, SimBoard
+from orfa.sim import BOARDS, REPO_ROOT, SimBoard
 
 EEPROM = 0xA0
 COUNT = {"m32d": "SWAASR07P", "m128s": "SWAASR06P"}
@@ -125,3 +125,25 @@ def test_fixed_rate_build_does_not_answer_a_pc_at_9600(board):
         # its receiver got frames from the PC's bits, never a 'V'
         rx = [e for e in sim.trace_events(kinds=["uart rx"]) if e.cycle >= t0]
         assert rx and not any(e.fields[0] == "56" for e in rx), rx
+
+
+CHECK_ELF = REPO_ROOT / "build" / "sim-fw" / "autobaud_check.elf"
+PORTA, PORTB, PORTC = 0x3B, 0x38, 0x35   # data addresses on the ATmega32
+
+
+def test_the_pair_analysis_keeps_its_rule():
+    """firmware/autobaud.c's pair analysis, in assembly, gives the rate its
+    rule in plain C gives (tests/sim/fw/autobaud_check.c) on 4096 records:
+    random ones, and 0x0D pairs bent by up to half a bit a run or 20 % a
+    frame, across every bound of the rule."""
+    if not CHECK_ELF.is_file():
+        pytest.fail("missing %s: run `make sim`" % CHECK_ELF, pytrace=False)
+    with SimBoard("m32d", control=True, firmware=CHECK_ELF) as sim:
+        ctl = sim.control
+        while ctl.peek(PORTC)[0] != 0xA5:
+            assert ctl.time() < 40 * F_CPU, "the check did not finish"
+            ctl.wait(F_CPU // 2)
+        wrong, accepted = ctl.peek(PORTA)[0], ctl.peek(PORTB)[0] * 64
+    assert wrong == 0, "%d records where the analysis and its rule differ" % wrong
+    # the rule's every branch taken: many records found a rate, most did not
+    assert 256 <= accepted <= 2048, accepted
