@@ -42,13 +42,16 @@ bool clock_compare_pending(void)
 /* The next overflow is 2048 cycles away: it cannot come again before its
  * end. The compare is turned on at its wrap or, if an overflow was counted
  * by the servo interrupt instead (servo_pins.c), at the next one: "at or
- * after", not "at". */
+ * after", not "at". Its flag is cleared first: set at every match while
+ * the interrupt was off, it would wake the driver at once for nothing (the
+ * driver's wake-up is a wrap or more after the one it names). */
 ISR(MCU_CLOCK_OVF_vect, FRONT_ISR_LETS_RX)
 {
 	uint8_t now = (uint8_t)++clock_wraps;
 
 	if (compare_armed && (int8_t)(now - compare_from) >= 0) {
 		compare_armed = 0;
+		TIFR = MCU_CLOCK_OCF;  /* a 1 clears that flag only */
 		TIMSK |= MCU_CLOCK_OCIE;
 	}
 }
