@@ -174,25 +174,36 @@ static void servo_aim(const servo_edge_t *e)
 /* Arms Timer2 to wake SERVO_LEAD cycles before the next edge; false if that
  * is too close: the caller then waits for the edge in place. The compare
  * fires once per Timer2 wrap; the interrupt ignores the wraps before the
- * edge's. A wake-up more than SERVO_SLEEP wraps away (the gap to the next
- * frame: ~66 wraps) sleeps until two wraps before its own, the clock's
- * overflow interrupt turning the compare on again: each wrap's wake-up in
- * between only found its edge far (~150 cycles; about 7 % of the CPU with
- * 16 channels). */
-#define SERVO_SLEEP 3
+ * edge's. A wake-up a wrap or more away sleeps, the clock's overflow
+ * interrupt turning the compare on again with its stale flag cleared: each
+ * wrap's wake-up in between cost ~250 cycles with interrupts off, up to
+ * three an edge (about 4 % of the M32-D's control loop at 230400). It is
+ * turned on at the start of the wake-up's own wrap when the wake-up is
+ * SERVO_WAKE_MARGIN ticks or more into it, else a wrap before (one wake-up
+ * then finds its edge far): the overflow interrupt may come that late (a
+ * receive interrupt, the main loop's flush after it, its own entry), and
+ * the wake-up would come as late as it. */
+#define SERVO_WAKE_MARGIN ((SERVO_LEAD + 256) / 8)
+_Static_assert(2 * SERVO_RX_ISR + 200 <= SERVO_WAKE_MARGIN * 8,
+	       "the overflow interrupt turns the compare on before its match");
 static bool servo_arm(void)
 {
-	int16_t left = servo_ticks_left();
+	uint16_t now = servo_ticks();
+	int16_t left = (int16_t)(pulses.target - now);
 
 	if (left < SERVO_NEAR / 8) {
 		return false;
 	}
 	uint16_t wake = (uint16_t)(pulses.target - SERVO_LEAD / 8);
+	uint8_t from = (uint8_t)(wake >> 8);
 
+	if ((uint8_t)wake < SERVO_WAKE_MARGIN) {
+		from--;
+	}
 	OCR2 = (uint8_t)wake;
-	if (left > SERVO_SLEEP * 256 + SERVO_LEAD / 8) {
+	if ((int8_t)(from - (uint8_t)(now >> 8)) > 0) {
 		TIMSK &= (uint8_t)~_BV(OCIE2);
-		clock_compare_from((uint8_t)((wake >> 8) - 2));
+		clock_compare_from(from);
 	}
 	return true;
 }

@@ -42,13 +42,22 @@ bool clock_compare_pending(void)
 /* The next overflow is 2048 cycles away: it cannot come again before its
  * end. The compare is turned on at its wrap or, if an overflow was counted
  * by the servo interrupt instead (servo_pins.c), at the next one: "at or
- * after", not "at". */
+ * after", not "at". Its flag is cleared first, set by the matches while
+ * the interrupt was off (it would wake the driver at once for nothing),
+ * unless this wrap's match may be among them: the count has reached the
+ * compare's, or is two ticks from it (a match between the look and the
+ * clearing). Then the interrupt comes at once: late, not a wrap late. */
 ISR(MCU_CLOCK_OVF_vect, FRONT_ISR_LETS_RX)
 {
 	uint8_t now = (uint8_t)++clock_wraps;
 
 	if (compare_armed && (int8_t)(now - compare_from) >= 0) {
 		compare_armed = 0;
+		uint8_t t = (uint8_t)(MCU_CLOCK_TCNT + 2);
+
+		if (t > 2 && MCU_CLOCK_OCR > t) {  /* 8-bit: no more registers saved */
+			TIFR = MCU_CLOCK_OCF;  /* a 1 clears that flag only */
+		}
 		TIMSK |= MCU_CLOCK_OCIE;
 	}
 }

@@ -25,10 +25,11 @@ void clock_init(void);
 
 /* The time base's compare interrupt (a driver's: the M32-D's servo edges)
  * turned on by the overflow interrupt when the wraps reach `wrap` (their
- * low byte; at the first wrap at or after it, within 127): a driver whose
- * next compare is wraps away turns the interrupt off meanwhile rather
- * than wake at every wrap. Interrupts off. Boards whose file defines
- * BOARD_CLOCK_COMPARE. */
+ * low byte; at the first wrap at or after it, within 127), its flag
+ * cleared first (matches while it was off): a driver whose next compare
+ * is wraps away turns the interrupt off meanwhile rather than wake at
+ * every wrap, and names a wrap before its compare's own. Interrupts off.
+ * Boards whose file defines BOARD_CLOCK_COMPARE. */
 void clock_compare_from(uint8_t wrap);
 void clock_compare_cancel(void);
 
