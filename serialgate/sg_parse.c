@@ -100,7 +100,7 @@ static sg_event_t take_digit(sg_parser_t *p, uint8_t d)
 		p->hi = d;
 		return SG_MORE;
 	}
-	uint8_t b = (uint8_t)(p->hi << 4 | d);
+	uint8_t b = (uint8_t)(sg_nibble_up(p->hi) | d);
 	p->hi = SG_NO_DIGIT;
 	return sg_parse_byte(p, b);
 }
@@ -326,7 +326,7 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 				hi = d;
 				continue;
 			}
-			uint8_t b = (uint8_t)(hi << 4 | d);
+			uint8_t b = (uint8_t)(sg_nibble_up(hi) | d);
 			uint8_t at = p->nbytes;
 
 			hi = SG_NO_DIGIT;

@@ -104,6 +104,14 @@ static inline uint8_t sg_hex_value(uint8_t c)
 	return c <= 5 ? (uint8_t)(c + 10) : SG_NO_DIGIT;
 }
 
+/* A digit (0 to 15) as a byte's high nibble: written as the rotate it
+ * equals for such a value, which avr-gcc makes one SWAP (its shift by 4
+ * became a MUL and a move, ~5 cycles more on every byte of a request). */
+static inline uint8_t sg_nibble_up(uint8_t d)
+{
+	return (uint8_t)(d << 4 | d >> 4);
+}
+
 /* Feeds one character. After SG_REQUEST, `err` holds the error to reply (or
  * SG_OK), `cmd`, `nbytes` and `buf` the request; the parser is ready for the
  * next line. */
