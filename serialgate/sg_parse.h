@@ -140,6 +140,6 @@ static inline bool sg_parse_in_run(const sg_parser_t *p)
  * stored in place: ~40 cycles a character, where at 460800 baud a
  * character lasts 160 (docs/protocol.md, The line); sg_parse_char()'s
  * whole rule does the same with them (tests/unit's test_parse_run). */
-uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t head);
+uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, const volatile uint8_t *head);
 
 #endif
