@@ -205,6 +205,10 @@ void front_rx_poll(uint8_t most)
  * UDR in the hold, first in line; on the M128-S such a character goes to
  * uart_received() with the call-clobbered registers saved. A rate found
  * by autobaud needs uart_line_rx() on every character: uart_rx_all(). */
+/* `in` where UDR is in I/O space (the M32-D's: a cycle and a word less
+ * than `lds`), else `lds`: an assembler condition on the memory address. */
+#define RX_IO_LOAD(reg, sfr) \
+	".if " sfr " < 0x60\n\tin " reg ", " sfr " - 0x20\n\t.else\n\tlds " reg ", " sfr "\n\t.endif\n\t"
 /* The fast path's registers back, SREG last (from ISR_SREG), as they were. */
 #define RX_FAST_RESTORE \
 	"pop r31\n\tpop r30\n\tpop r24\n\tout __SREG__, " ISR_SREG "\n\t"
@@ -226,7 +230,7 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"subi r31, 1\n\t"
 		"cpi r31, %[record] + 1\n\t"
 		"brlo 10f\n\t"
-		"lds r24, %[udr]\n\t"
+		RX_IO_LOAD("r24", "%[udr]")
 		"tst r24\n\t"
 		"brmi 3f\n\t"
 		"cpi r24, 0x20\n\t"
@@ -266,7 +270,7 @@ ISR(MCU_UART_RX_vect, ISR_NAKED)
 		"subi r31, 1\n\t"
 		"cpi r31, %[record] + 1\n\t"
 		"brlo 2f\n\t"
-		"lds r24, %[udr]\n\t"
+		RX_IO_LOAD("r24", "%[udr]")
 		"cpi r24, 0x21\n\t"
 		"brlo 9f\n\t"
 		"tst r24\n\t"
