@@ -97,10 +97,6 @@ BUILD ?= build/$(BOARD)-$(MODE)
 # own, and the local latency is the same over the phases of the clock tick.
 # -fno-tree-sink -fno-tree-copyrename: 50 bytes less, the latency the same.
 FW_OPT ?= -Os -fno-move-loop-invariants -mstrict-X -mcall-prologues -fno-tree-sink -fno-tree-copyrename
-# r2 is the receive and transmit interrupts' place for SREG (firmware/uart.c
-# ISR_SREG): no compiled code may use it. At compile and at link (LTO
-# compiles there).
-FW_FIXED := -ffixed-r2
 CC := avr-gcc
 OBJCOPY := avr-objcopy
 AVR_SIZE := avr-size
@@ -109,12 +105,12 @@ FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) \
 	$(if $(filter auto,$(BAUD)),'-DORFA_BAUD_RATES(X)=$(foreach r,$(AUTOBAUD_RATES),X($(r)))',-DORFA_BAUD=$(BAUD)) \
 	-DORFA_BAUD_TOP=$(if $(filter auto,$(BAUD)),$(lastword $(AUTOBAUD_RATES)),$(BAUD)) \
 	-DORFA_ADDR=$(ADDR) -DORFA_MODE_$(MODE) \
-	-std=gnu99 $(FW_OPT) $(FW_FIXED) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
+	-std=gnu99 $(FW_OPT) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
 	-fshort-enums -I. -Iboards/$(BOARD) \
 	'-DORFA_DRIVER_LIST=$(foreach d,$(DRIVERS),X($(d)))'
 # -mrelax: the linker turns calls and jumps within reach into rcall/rjmp
 # (about 200 bytes less on the M32-D gateway).
-FW_LDFLAGS := -mmcu=$(BOARD_MCU) $(FW_OPT) $(FW_FIXED) -flto -mrelax -Wl,--gc-sections
+FW_LDFLAGS := -mmcu=$(BOARD_MCU) $(FW_OPT) -flto -mrelax -Wl,--gc-sections
 
 # Each driver's hardware part, where it has one.
 DRV_HW_spi := drivers/spi_hw.c
