@@ -87,7 +87,7 @@ void front_poll(void)
 	 * them, are taken in one loop (sg_parse_run()); the character it
 	 * stops at, or anything else, goes through sg_parse_char(). */
 	if (c >= ' ') {
-		uint8_t to = sg_parse_run(&parser, sg_rx.buf, tail, sg_rx.head);
+		uint8_t to = sg_parse_run(&parser, sg_rx.buf, tail, &sg_rx.head);
 		if (to != tail) {
 			sg_rx.tail = to;
 			return;

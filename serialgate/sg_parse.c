@@ -11,7 +11,7 @@ static __attribute__((noinline)) sg_event_t fail(sg_parser_t *p, uint8_t err)
 	return SG_MORE;
 }
 
-static __attribute__((noinline)) bool room(sg_parser_t *p, uint16_t bytes, uint16_t reply_chars)
+static bool room(sg_parser_t *p, uint16_t bytes, uint16_t reply_chars)
 {
 	return p->nbytes + bytes <= SG_BUF_SIZE && p->reply_len + reply_chars <= SG_REPLY_MAX;
 }
@@ -40,7 +40,8 @@ static inline __attribute__((always_inline)) uint8_t take_address(sg_parser_t *p
 
 sg_event_t sg_parse_frame(sg_parser_t *p)
 {
-	if (!room(p, 2, 2)) {
+	/* room(p, 2, 2) without its call: both in 8 bits */
+	if (p->nbytes > SG_BUF_SIZE - 2 || p->reply_len > SG_REPLY_MAX - 2) {
 		return fail(p, SG_ERR_DATA);
 	}
 	p->frame = p->nbytes;
@@ -70,7 +71,7 @@ sg_event_t sg_parse_byte(sg_parser_t *p, uint8_t b)
 		take_address(p, b);
 		return SG_MORE;
 	case SG_ST_WDATA:
-		if (!room(p, 1, 1)) {
+		if (p->nbytes >= SG_BUF_SIZE || p->reply_len >= SG_REPLY_MAX) {  /* room(p, 1, 1) */
 			return fail(p, SG_ERR_DATA);
 		}
 		take_data(p, p->nbytes, b);
@@ -100,7 +101,7 @@ static sg_event_t take_digit(sg_parser_t *p, uint8_t d)
 		p->hi = d;
 		return SG_MORE;
 	}
-	uint8_t b = (uint8_t)(p->hi << 4 | d);
+	uint8_t b = (uint8_t)(sg_nibble_up(p->hi) | d);
 	p->hi = SG_NO_DIGIT;
 	return sg_parse_byte(p, b);
 }
@@ -274,7 +275,7 @@ sg_event_t sg_parse_char(sg_parser_t *p, uint8_t c)
 	return fail(p, SG_ERR_HEX);  /* not a hex digit where a byte is expected */
 }
 
-uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t head)
+uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, const volatile uint8_t *head)
 {
 	uint8_t len = p->len;
 	uint8_t state = p->state;
@@ -285,7 +286,7 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 	if (p->lost_info || len >= SG_LINE_MAX) {
 		return tail;
 	}
-	if (state == SG_ST_BEGIN && tail != head && (ring[tail] | 0x20) == 's') {
+	if (state == SG_ST_BEGIN && tail != *head && (ring[tail] | 0x20) == 's') {
 		/* an I2C request's first character, as sg_parse_char() takes it */
 		sg_parse_init(p);
 		begin_i2c(p);
@@ -297,18 +298,34 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 	if (!sg_parse_in_run(p)) {
 		return tail;
 	}
-	uint8_t n = (uint8_t)(head - tail);
-	if (n > (uint8_t)(SG_LINE_MAX - len)) {
-		n = (uint8_t)(SG_LINE_MAX - len);
-	}
-	if (tail && n > (uint8_t)-tail) {
-		n = (uint8_t)-tail;  /* up to the ring's end: the next run goes on from buf[0] */
-	}
 	uint8_t hi = p->hi;
+	/* the index to stop at: the line's room, or the ring's end (0: the
+	 * next run goes on from buf[0]) */
+	uint8_t stop = (uint8_t)(tail + (uint8_t)(SG_LINE_MAX - len));
+	if (stop < tail) {
+		stop = 0;
+	}
 	const uint8_t *const from = ring + tail;
-	const uint8_t *const end = from + n;
+	const uint8_t *end = from;
 	const uint8_t *q = from;
-	for (; q != end; q++) {
+	for (;; q++) {
+		if (q == end) {
+			/* all taken that had come (at the start: none): what came
+			 * since, up to stop. Looked at again here, not left to
+			 * the next call: a call's start and end cost ~60 cycles,
+			 * a few times a request at 460800 baud. */
+			uint8_t at = (uint8_t)(q - ring);
+			uint8_t n = (uint8_t)(*head - at);
+			uint8_t room = (uint8_t)(stop - at);
+
+			if (n > room) {
+				n = room;
+			}
+			if (!n) {
+				break;
+			}
+			end = q + n;
+		}
 		uint8_t c = *q;
 
 		if (c == ' ') {
@@ -326,7 +343,7 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, uint8_t 
 				hi = d;
 				continue;
 			}
-			uint8_t b = (uint8_t)(hi << 4 | d);
+			uint8_t b = (uint8_t)(sg_nibble_up(hi) | d);
 			uint8_t at = p->nbytes;
 
 			hi = SG_NO_DIGIT;

@@ -389,7 +389,7 @@ static void run_ring(const uint8_t *data, size_t size)
 			got += feed((uint8_t)c, &ev, &accepted, rendered);
 			if (ev == SG_MORE && sg_rx.tail != sg_rx.head) {
 				/* as front_poll() does: the rest of the run at once */
-				sg_rx.tail = sg_parse_run(&parser, sg_rx.buf, sg_rx.tail, sg_rx.head);
+				sg_rx.tail = sg_parse_run(&parser, sg_rx.buf, sg_rx.tail, &sg_rx.head);
 			}
 		}
 	}

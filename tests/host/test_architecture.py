@@ -77,3 +77,17 @@ def test_every_named_function_is_defined(name):
                              re.M)
     where = [f for f, text in SOURCES if pattern.search(text)]
     assert where, "%s is defined nowhere" % name
+
+
+#: The firmware's C folders (docs/architecture.md, Folders).
+FIRMWARE_DIRS = ("boards/", "firmware/", "drivers/", "serialgate/", "i2c_slave/")
+EEPROM = re.compile(r"\bEE(DR|AR[LH]?|CR)\b|eeprom_")
+
+
+def test_the_eeprom_is_the_serial_interrupts_alone():
+    """The receive and transmit interrupts keep SREG in EEDR
+    (firmware/uart.c, ISR_KEEP): no other firmware file touches the
+    EEPROM's registers or avr-libc's EEPROM functions."""
+    users = sorted(f for f in FILES if f.startswith(FIRMWARE_DIRS) and f.endswith((".c", ".h"))
+                   and EEPROM.search((ROOT / f).read_text(errors="replace")))
+    assert users == ["firmware/uart.c"]

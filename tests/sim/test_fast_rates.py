@@ -115,6 +115,40 @@ def test_pipelined_requests_all_answered(board, rate):
         assert line["fe"] == line["dor"] == 0
 
 
+#: Issue 20's back-to-back figure: BURST requests sent at once at 460800
+#: are answered at BURST_SHARE of the wire or more.
+BURST = 11
+BURST_SHARE = 0.99
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_back_to_back_requests_at_99_percent_of_the_wire(board):
+    """BURST introspection counts on the line back to back at 460800 (as
+    make bench's row, tools/bench.py bench_burst), at three phases of the
+    board's clock: every reply right, the last reply's stop bit within the
+    wire time of the requests and that reply over BURST_SHARE. Simulated
+    cycles from fixed starts: deterministic."""
+    rate = 460800
+    byte = 10 * F_CPU // rate
+    want = {"m32d": "SWAASR07P", "m128s": "SWAASR06P"}[board]
+    starts = [4 * F_CPU + k * 100037 for k in range(3)]
+    with sim_for(board, rate) as sim, serial.Serial(sim.port, rate, timeout=0):
+        ctl = sim.control
+        ctl.wait(1000)                          # the firmware has set its rate
+        assert ctl.line()["pc"] == rate
+        for start in starts:                    # it runs free: all on the line at once
+            ctl.rx(start, REQUEST * BURST)
+        ctl.wait(starts[-1] + 2 * BURST * len(REQUEST) * byte - ctl.time())
+        events = sim.trace_events(kinds=["uart tx"])
+    for start in starts:
+        lines = sent_lines(events, start, last=True)[:BURST]
+        assert [text for _, text in lines] == [want] * BURST
+        took = lines[-1][0] + byte - start
+        wire = (BURST * len(REQUEST) + len(want) + 2) * byte
+        assert wire / took >= BURST_SHARE, "%d cycles for %d of wire: %.1f %%" % (
+            took, wire, 100 * wire / took)
+
+
 #: 16 servo channels pulsing, widths 1000..1700 us: on the M32-D one
 #: channel's end close to the next one's start (the planner moves them
 #: SERVO_GAP apart, so the interrupt waits in place between them); on the

@@ -792,7 +792,7 @@ static void test_parse_run(void)
 			if (tail == head) {
 				continue;
 			}
-			uint8_t to = sg_parse_run(&fast, ring, tail, head);
+			uint8_t to = sg_parse_run(&fast, ring, tail, &head);
 			for (; tail != to && !bad; tail++) {
 				taken++;
 				if (sg_parse_char(&slow, ring[tail]) != SG_MORE) {
