@@ -360,9 +360,15 @@ void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
 		newer = pulses.pending;
 		pulses.pending = 0;
 	}
-	/* The last plan: the buffer not taken over yet, else the running one. */
-	servo_sched_t *s = &pulses.sched[pulses.active ^ 1];
-	servo_plan(s, newer ? s : &pulses.sched[pulses.active], widths_us, was_us);
+	/* The buffer the interrupt does not run, and the one it does (each
+	 * an address, not a multiply by the schedule's size); the last plan:
+	 * the buffer not taken over yet, else the running one. */
+	servo_sched_t *s = &pulses.sched[1], *run = &pulses.sched[0];
+	if (pulses.active) {
+		s = run;
+		run = &pulses.sched[1];
+	}
+	servo_plan(s, newer ? s : run, widths_us, was_us);
 	uint8_t n = s->n;
 
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
