@@ -21,8 +21,15 @@ void sg_rx_init(void)
 
 /* The run of lost characters is over: its record, if a line ended in it.
  * Inlined: a call from the receive interrupt would make it save every
- * call-clobbered register, on every character. */
-static inline __attribute__((always_inline)) uint8_t end_run(uint8_t head)
+ * call-clobbered register, on every character. Not with autobaud, whose
+ * receive interrupt saves them anyway (it calls uart_line_rx() on every
+ * character): there one copy serves it and sg_rx_close() (~50 bytes). */
+#ifdef ORFA_BAUD
+#define END_RUN_INLINE inline __attribute__((always_inline))
+#else
+#define END_RUN_INLINE __attribute__((noinline))
+#endif
+static END_RUN_INLINE uint8_t end_run(uint8_t head)
 {
 	if (sg_rx.ends_lost) {
 		sg_rx.buf[head] = SG_RX_MARK_LOST;

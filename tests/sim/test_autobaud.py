@@ -127,6 +127,26 @@ def test_fixed_rate_build_does_not_answer_a_pc_at_9600(board):
         assert rx and not any(e.fields[0] == "56" for e in rx), rx
 
 
+@pytest.mark.parametrize("board", BOARDS)
+def test_receive_overflow_is_error_04(board):
+    """The receive ring's overflow at a found rate (serialgate/sg_rx.c's
+    lost-run record, out of line with autobaud): a request that lost
+    characters is ERROR 04, every other reply exact, one reply a request;
+    the record of a run that lost only empty lines' ends adds none."""
+    with start(board) as sim, sim.gateway(115200, autobaud=True, timeout=REPLY_TIMEOUT) as gw:
+        request = "S AA 00 01 S AB 3C P"         # 20 characters, 127 back
+        want = gw.request(request)
+        port = gw.serial
+        port.write((request + "\n").encode() * 100)
+        lines = [port.readline().rstrip(b"\r\n").decode() for _ in range(100)]
+        assert [line for line in lines if line not in (want, "ERROR 04")] == []
+        assert "ERROR 04" in lines and want in lines
+        port.write((request + "\r").encode() * 4 + b"\n" * 330 + b"V\r")
+        lines = [port.readline().rstrip(b"\r\n").decode() for _ in range(5)]
+        assert lines[:4] == [want] * 4 and lines[4] in ("V1.1", "ERROR 04")
+        assert gw.request("L") == "LAA"
+
+
 CHECK_ELF = REPO_ROOT / "build" / "sim-fw" / "autobaud_check.elf"
 PORTA, PORTB, PORTC = 0x3B, 0x38, 0x35   # data addresses on the ATmega32
 
