@@ -33,13 +33,13 @@ static uint16_t servo_clamp(uint16_t us)
 	return us > SERVO_MAX_US ? SERVO_MAX_US : us;
 }
 
-/* at / 3 for every at up to 3 * SERVO_MAX_TRIPLES, as a multiply: no
+/* Whether `at` is a multiple of 3, as a multiply: at * 171 (3's inverse
+ * modulo 256) is at most 85 for exactly those bytes (3k gives k). No
  * division in a TWI interrupt (drv_servo_check()), none linked at all (a
- * write's length). */
-_Static_assert(3 * SERVO_MAX_TRIPLES <= 48, "at * 43 >> 7 == at / 3 up to 48");
-static uint8_t servo_third(uint8_t at)
+ * write's length); one multiply and a compare, not at / 3 times 3. */
+static bool servo_triple_at(uint8_t at)
 {
-	return (uint8_t)((uint16_t)(at * 43u) >> 7);
+	return (uint8_t)(at * 171u) <= 85;
 }
 
 /* SP: [channel] selects the first channel for reads; [channel][hi][lo]...
@@ -53,7 +53,7 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 		servo.first = data[0];
 		return REG_OK;
 	}
-	if (len > 3 * SERVO_MAX_TRIPLES || len != (uint8_t)(3 * servo_third(len))) {
+	if (len > 3 * SERVO_MAX_TRIPLES || !servo_triple_at(len)) {
 		return REG_BAD_LENGTH;
 	}
 	uint16_t next[SERVO_CHANNELS];
@@ -117,7 +117,7 @@ reg_status_t drv_servo_check(uint8_t reg, const uint8_t *data, uint8_t len)
 	/* Every third byte names a channel (a 1-byte write too): bytes 0, 3,
 	 * 6, ... */
 	uint8_t at = (uint8_t)(len - 1);
-	if (at == (uint8_t)(3 * servo_third(at)) && data[at] >= SERVO_CHANNELS) {
+	if (servo_triple_at(at) && data[at] >= SERVO_CHANNELS) {
 		return REG_BAD_VALUE;
 	}
 	return REG_OK;
