@@ -11,7 +11,8 @@ _Static_assert((uint32_t)SYS_FAILSAFE_MAX_MS * CLOCK_HZ / 1000u + 1u < 65536u,
 
 /* The causes survive resets that keep SRAM (watchdog, external, brown-out)
  * until the host clears them; `check` (the complement) tells them from
- * what SRAM holds after power-up. */
+ * what SRAM holds after power-up. sys_keep() out of line: sys_boot() and
+ * a RESET write each had it inlined (4 bytes). */
 static struct {
 	uint8_t causes;
 	uint8_t check;
@@ -26,7 +27,7 @@ static struct {
 	uint8_t tripped;   /* the safe state is applied for this quiet spell */
 } sys;
 
-static void sys_keep(uint8_t causes)
+static __attribute__((noinline)) void sys_keep(uint8_t causes)
 {
 	sys_kept.causes = causes;
 	sys_kept.check = (uint8_t)~causes;

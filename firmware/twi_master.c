@@ -32,8 +32,9 @@ static struct {
 
 /* Nothing of ours on the bus until the fence is down: a frame this board
  * gave up on, or may have been in when it reset, is dropped by its slave
- * first (twi_quiet.h). */
-static void twi_fence_up(void)
+ * first (twi_quiet.h). Out of line: twi_abandon() and twi_init(), off the
+ * fast path, each had it inlined (8 bytes). */
+static __attribute__((noinline)) void twi_fence_up(void)
 {
 	twi.quiet = 1;
 	twi.quiet_t0 = clock_now();
