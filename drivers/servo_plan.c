@@ -102,7 +102,11 @@ static __attribute__((noinline)) void servo_place(uint8_t ch, const uint8_t *cha
 	 * and fall with its own fall, one after with its rise and fall, each
 	 * only near this channel's fall (rises are SERVO_SLOT apart, a pulse
 	 * is at least 500 us). */
-	int16_t d[2 * 2 * SERVO_NEIGHBOURS], *end = d;
+	/* static (scratch, in .noinit: not cleared at start-up): each
+	 * edge's place a fixed address, not a sum with the stack frame's
+	 * (10 bytes) */
+	static int16_t d[2 * 2 * SERVO_NEIGHBOURS] ORFA_NOINIT;
+	int16_t *end = d;
 	uint16_t w = placed.w[ch];
 	for (int8_t k = -SERVO_NEIGHBOURS; k <= SERVO_NEIGHBOURS; k++) {
 		uint8_t c = (uint8_t)(ch + k);
