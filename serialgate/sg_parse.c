@@ -11,10 +11,8 @@ static __attribute__((noinline)) sg_event_t fail(sg_parser_t *p, uint8_t err)
 	return SG_MORE;
 }
 
-static bool room(sg_parser_t *p, uint16_t bytes, uint16_t reply_chars)
-{
-	return p->nbytes + bytes <= SG_BUF_SIZE && p->reply_len + reply_chars <= SG_REPLY_MAX;
-}
+/* The room checks are 8-bit sums and differences. */
+_Static_assert(SG_BUF_SIZE <= 255 && SG_REPLY_MAX <= 255, "the room checks' 8 bits");
 
 /* A write frame's data byte at buf[at] (at: nbytes), with room for it. */
 static inline __attribute__((always_inline)) void take_data(sg_parser_t *p, uint8_t at, uint8_t b)
@@ -40,7 +38,7 @@ static inline __attribute__((always_inline)) uint8_t take_address(sg_parser_t *p
 
 sg_event_t sg_parse_frame(sg_parser_t *p)
 {
-	/* room(p, 2, 2) without its call: both in 8 bits */
+	/* room for the frame's two bytes and its two reply characters, in 8 bits */
 	if (p->nbytes > SG_BUF_SIZE - 2 || p->reply_len > SG_REPLY_MAX - 2) {
 		return fail(p, SG_ERR_DATA);
 	}
@@ -71,13 +69,16 @@ sg_event_t sg_parse_byte(sg_parser_t *p, uint8_t b)
 		take_address(p, b);
 		return SG_MORE;
 	case SG_ST_WDATA:
-		if (p->nbytes >= SG_BUF_SIZE || p->reply_len >= SG_REPLY_MAX) {  /* room(p, 1, 1) */
+		if (p->nbytes >= SG_BUF_SIZE || p->reply_len >= SG_REPLY_MAX) {  /* room for a byte and its reply character */
 			return fail(p, SG_ERR_DATA);
 		}
 		take_data(p, p->nbytes, b);
 		return SG_MORE;
 	case SG_ST_RCOUNT:
-		if (b == 0 || !room(p, b, 2u * b)) {
+		/* room for b bytes and their 2 * b reply characters, in 8 bits
+		 * (nbytes <= SG_BUF_SIZE, reply_len <= SG_REPLY_MAX always) */
+		if (b == 0 || b > (uint8_t)(SG_BUF_SIZE - p->nbytes) ||
+		    b > (uint8_t)((SG_REPLY_MAX - p->reply_len) >> 1)) {
 			return fail(p, SG_ERR_DATA);
 		}
 		p->buf[p->frame + 1] = b;
@@ -347,9 +348,9 @@ uint8_t sg_parse_run(sg_parser_t *p, const uint8_t *ring, uint8_t tail, const vo
 			uint8_t at = p->nbytes;
 
 			hi = SG_NO_DIGIT;
-			/* sg_parse_byte()'s common cases in place (room(p, 1, 1)
-			 * without its call): a write frame's data byte, a frame's
-			 * address */
+			/* sg_parse_byte()'s common cases in place (with its room
+			 * check for a data byte): a write frame's data byte, a
+			 * frame's address */
 			if (state == SG_ST_WDATA && at < SG_BUF_SIZE && p->reply_len < SG_REPLY_MAX) {
 				take_data(p, at, b);
 			} else if (state == SG_ST_ADDR) {
