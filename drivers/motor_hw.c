@@ -5,10 +5,11 @@
  */
 #include "drivers/motor_hw.h"
 
+#include <avr/interrupt.h>
 #include <avr/io.h>
-#include <util/atomic.h>
 
 #include "firmware/board_pins.h"
+#include "firmware/clock.h"
 #include "firmware/pins.h"
 
 #define MOTOR_TOP 367  /* 368 timer cycles per PWM period */
@@ -51,17 +52,24 @@ void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
 		}
 	}
 	/* OCR1A/B are double-buffered up to the next PWM period: written
-	 * together, both motors change in the same period. Short (under 50
-	 * cycles): the servo interrupt waits while interrupts are off. */
-	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-		/* Not across the end of a period, or the motors would change a
-		 * period apart: at most 32 cycles of waiting. */
-		while (TCNT1 > MOTOR_TOP - 32) {
+	 * together, both motors change in the same period, with interrupts
+	 * off, not across the end of a period (or the motors would change a
+	 * period apart: the wait for it is with interrupts on). Not while the
+	 * servo's compare waits: the CLI may be the one instruction after a
+	 * receive interrupt's RETI, and the compare would wait for both
+	 * (uart_rx_flush() does the same). */
+	uint8_t sreg = SREG;
+	for (;;) {
+		cli();
+		if (TCNT1 <= MOTOR_TOP - 32 && !clock_compare_pending()) {
+			break;
 		}
-		OCR1A = ocr[0];
-		OCR1B = ocr[1];
-		TCCR1A = (uint8_t)((TCCR1A & ~com_off) | com_on);
+		SREG = sreg;
 	}
+	OCR1A = ocr[0];
+	OCR1B = ocr[1];
+	TCCR1A = (uint8_t)((TCCR1A & ~com_off) | com_on);
+	SREG = sreg;
 	for (uint8_t m = 0; m < MOTOR_COUNT; m++) {
 		uint8_t d = MOTOR_PIN(BF_MOTOR_DIR, m);
 		pins_drive(d, dir[m]);
