@@ -204,6 +204,8 @@ static bool servo_arm(void)
 	if ((int8_t)(from - (uint8_t)(now >> 8)) > 0) {
 		TIMSK &= (uint8_t)~_BV(OCIE2);
 		clock_compare_from(from);
+	} else {
+		TIMSK |= _BV(OCIE2);  /* on already, but at a start */
 	}
 	return true;
 }
@@ -382,9 +384,11 @@ void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
 			servo_aim(s->edge);
 			servo_arm();
 			pulses.running = 1;
-			/* (A stale compare flag needs no clearing: the interrupt it
-			 * wakes finds its edge far and returns.) */
-			TIMSK |= _BV(OCIE2);
+			/* servo_arm() turned the compare on, or left it to the
+			 * clock's overflow (a stale flag needs no clearing: the
+			 * interrupt it wakes finds its edge far and returns); the
+			 * first edge is never SERVO_NEAR close */
+			_Static_assert(4096 > SERVO_NEAR, "a start's first edge is armed");
 		}
 	}
 }
