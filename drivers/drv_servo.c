@@ -15,10 +15,12 @@ static struct {
 
 void drv_servo_init(void)
 {
-	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++) {
-		servo.width[ch] = 0;
+	/* every width off, reads from channel 0: the struct zeroed byte by
+	 * byte (one loop; power-on, as .bss is, for the host's tests too) */
+	uint8_t *b = (uint8_t *)&servo;
+	for (uint8_t i = 0; i < sizeof servo; i++) {
+		b[i] = 0;
 	}
-	servo.first = 0;
 	servo_hw_init();
 }
 
