@@ -204,8 +204,6 @@ static bool servo_arm(void)
 	if ((int8_t)(from - (uint8_t)(now >> 8)) > 0) {
 		TIMSK &= (uint8_t)~_BV(OCIE2);
 		clock_compare_from(from);
-	} else {
-		TIMSK |= _BV(OCIE2);  /* on already, but at a start */
 	}
 	return true;
 }
@@ -382,13 +380,15 @@ void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
 			pulses.end = &s->edge[n];
 			pulses.frame = servo_ticks() + 4096 / 8;
 			servo_aim(s->edge);
+			/* on, unless servo_arm() leaves it to the clock's overflow
+			 * (a stale flag needs no clearing: the interrupt it wakes
+			 * finds its edge far and returns); interrupts are off, so
+			 * the compare waits for the arm; the first edge is never
+			 * SERVO_NEAR close */
+			_Static_assert(4096 > SERVO_NEAR, "a start's first edge is armed");
+			TIMSK |= _BV(OCIE2);
 			servo_arm();
 			pulses.running = 1;
-			/* servo_arm() turned the compare on, or left it to the
-			 * clock's overflow (a stale flag needs no clearing: the
-			 * interrupt it wakes finds its edge far and returns); the
-			 * first edge is never SERVO_NEAR close */
-			_Static_assert(4096 > SERVO_NEAR, "a start's first edge is armed");
 		}
 	}
 }
