@@ -54,14 +54,12 @@ void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)
 	/* OCR1A/B are double-buffered up to the next PWM period: written
 	 * together, both motors change in the same period, with interrupts
 	 * off, not across the end of a period (or the motors would change a
-	 * period apart: the wait for it is with interrupts on). Not while the
-	 * servo's compare waits: the CLI may be the one instruction after a
-	 * receive interrupt's RETI, and the compare would wait for both
-	 * (uart_rx_flush() does the same). */
-	uint8_t sreg = SREG;
+	 * period apart: the wait for it is with interrupts on), after the
+	 * servo's compare if it waits (clock_lock()). */
+	uint8_t sreg;
 	for (;;) {
-		cli();
-		if (TCNT1 <= MOTOR_TOP - 32 && !clock_compare_pending()) {
+		sreg = clock_lock();
+		if (TCNT1 <= MOTOR_TOP - 32) {
 			break;
 		}
 		SREG = sreg;

@@ -1,6 +1,7 @@
 #include "firmware/clock.h"
 
 #include <avr/interrupt.h>
+#include <stdbool.h>
 
 #include "board.h"
 #include "firmware/front.h"
@@ -34,7 +35,8 @@ void clock_compare_cancel(void)
 /* TIFR's flag and TIMSK's enable have the same bit: one AND for both. */
 _Static_assert(MCU_CLOCK_OCF == MCU_CLOCK_OCIE, "OCFn and OCIEn share a bit");
 
-bool clock_compare_pending(void)
+/* The compare interrupt is on and flagged, waiting for interrupts. */
+static bool clock_compare_pending(void)
 {
 	return TIFR & TIMSK & MCU_CLOCK_OCF;
 }
@@ -62,7 +64,7 @@ ISR(MCU_CLOCK_OVF_vect, FRONT_ISR_LETS_RX)
 	}
 }
 #else
-bool clock_compare_pending(void)
+static bool clock_compare_pending(void)
 {
 	return false;
 }
@@ -73,3 +75,17 @@ ISR(MCU_CLOCK_OVF_vect, FRONT_ISR_LETS_RX)
 	clock_wraps++;
 }
 #endif
+
+uint8_t clock_lock(void)
+{
+	uint8_t sreg = SREG;
+
+	for (;;) {
+		cli();
+		if (!clock_compare_pending()) {
+			return sreg;
+		}
+		SREG = sreg;
+	}
+}
+

@@ -8,7 +8,6 @@
 #ifndef ORFA_CLOCK_H
 #define ORFA_CLOCK_H
 
-#include <stdbool.h>
 #include <stdint.h>
 
 #define CLOCK_TICK_CYCLES 2048UL
@@ -33,13 +32,13 @@ void clock_init(void);
 void clock_compare_from(uint8_t wrap);
 void clock_compare_cancel(void);
 
-/* The compare interrupt is on and flagged, waiting for interrupts: a
- * section with interrupts off that may wait starts after it instead. On
- * the AVR the one instruction after an interrupt's RETI may be that
- * section's CLI: the compare would wait for the section as well as the
- * interrupt, more than its lead allows for (uart_rx_flush()). Interrupts
- * off. false on boards without BOARD_CLOCK_COMPARE. */
-bool clock_compare_pending(void);
+/* Interrupts off for a short section, once the compare interrupt is not
+ * waiting (it runs first, then they go off again): the AVR runs one
+ * instruction after an interrupt's RETI, and if that is the section's CLI
+ * the compare would wait for the section as well as the interrupt, more
+ * than its lead allows for. Returns SREG as it was, for the caller to put
+ * back. Called with interrupts on (or with the compare off). */
+uint8_t clock_lock(void);
 
 /* Ticks since clock_init, wrapping every 65536 (18.2 s): differences of
  * two readings are exact up to that. Interrupts stay on. */

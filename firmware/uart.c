@@ -130,18 +130,16 @@ RX_ALL_HANDLER
 /* BOARD_RX_BURST at a time, as the receive interrupt: interrupts are off
  * while it runs, and the servo interrupt's lead allows for that many (all
  * sixteen the hold can keep, ~1400 cycles, made an edge 8-11 cycles late
- * at 460800). Not while the servo's compare waits: a receive interrupt
- * that returns to the CLI here runs it as its one instruction, and the
- * compare would wait for both (an edge ~90 cycles late at 115200). The
- * main loop comes back for the rest. */
+ * at 460800). After the servo's compare if it waits (clock_lock()): a
+ * receive interrupt that returned to a plain CLI here ran it as its one
+ * instruction, and the compare waited for both (an edge ~90 cycles late
+ * at 115200). The main loop comes back for the rest. */
 void uart_rx_flush(void)
 {
 	if (held.head != held.tail) {
-		cli();
-		if (!clock_compare_pending()) {
-			front_rx_poll(BOARD_RX_BURST);
-		}
-		sei();
+		uint8_t sreg = clock_lock();
+		front_rx_poll(BOARD_RX_BURST);
+		SREG = sreg;
 	}
 }
 
