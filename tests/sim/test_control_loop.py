@@ -6,12 +6,13 @@ loop keeps the line busy: 95 % of the wire for its own characters or more,
 in simulated time, the simulator at real time (orfa-sim --real-time) so the
 PC has a real board's time per byte.
 
-Where the target is missed the firmware is what limits (docs/python.md,
-"Pipelining across calls", has the figures): above 115200 every board's
-per-character and per-request cost (docs/protocol.md, The line: 460800's
-budget), on the M32-D its 16-triple servo write too (about 35000 cycles).
-The M32-D at 115200 is at the target's edge (about 95.5 % in make bench): a
-busy machine's real-time simulator can leave it just under.
+Where the target is missed the board's CPU is what limits, not the line nor
+the PC (docs/python.md, "Where the board's time goes"): at 460800 receiving,
+parsing and answering the step's characters alone take longer than their
+wire time on both boards; at 230400 the M32-D's servo write and cycle-exact
+edges add what puts it past. Those rows still must reach FLOOR (a little
+under what make bench measures), so a slower firmware fails them; reaching
+95 % there is an expected failure (xfail), not a pass.
 """
 
 import sys
@@ -33,16 +34,16 @@ WARMUP = 5
 TRIES = 3
 TARGET = 95.0
 
-FIRMWARE_TIME = pytest.mark.xfail(reason="issue 20: the firmware's time per step is longer "
-                                  "than the step's wire time (the M32-D's servo write and "
-                                  "cycle-exact edges; per character and per request costs)")
+#: the pipelined loop's least % of the wire where the board's CPU is the limit
+#: (make bench: M32-D 81.4 at 230400 and 45.4 at 460800, M128-S 55.8 at 460800;
+#: the simulator at real time on a busy machine gives a few % less)
+FLOOR = {("m32d", 230400): 75.0, ("m32d", 460800): 40.0, ("m128s", 460800): 50.0}
 
-AT_THE_EDGE = pytest.mark.xfail(reason="issue 20: about 96 % in make bench, the simulator at real "
+AT_THE_EDGE = pytest.mark.xfail(reason="issue 20: about 97 % in make bench, the simulator at real "
                                 "time: a busy machine can leave it just under 95")
 
 CORRECT = {}
-AT_TARGET = {("m32d", 230400): FIRMWARE_TIME, ("m32d", 460800): FIRMWARE_TIME,
-             ("m128s", 230400): AT_THE_EDGE, ("m128s", 460800): FIRMWARE_TIME}
+AT_TARGET = {("m128s", 230400): AT_THE_EDGE}
 
 
 def cases(marks):
@@ -114,6 +115,14 @@ def test_the_pipelined_loop_keeps_the_wire_busy(loop_on, board, rate):
         wire = steps * max(sent, received) * 10 * F_CPU / rate
         tries.append((100.0 * wire / cycles, cpu / steps, cycles))
     share, cpu, cycles = max(tries)
+    floor = FLOOR.get((board, rate))
+    if floor is not None:
+        assert share >= floor, "%.1f %% of the wire at best, under this row's floor %.1f %% " \
+            "(tries %s)" % (share, floor, ", ".join("%.1f %%" % t[0] for t in tries))
+        assert cpu < max(sent, received) * 10 / rate
+        if share < TARGET:
+            pytest.xfail("issue 20: %.1f %% of the wire: the board's CPU a step is longer than "
+                         "the step's wire time (docs/python.md)" % share)
     assert share >= TARGET, "%.1f %% of the wire at best (%d steps of %d/%d characters in " \
         "%d cycles; tries %s)" % (share, steps, sent, received, cycles,
                                  ", ".join("%.1f %%" % t[0] for t in tries))
