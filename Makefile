@@ -105,12 +105,12 @@ FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) \
 	$(if $(filter auto,$(BAUD)),'-DORFA_BAUD_RATES(X)=$(foreach r,$(AUTOBAUD_RATES),X($(r)))',-DORFA_BAUD=$(BAUD)) \
 	-DORFA_BAUD_TOP=$(if $(filter auto,$(BAUD)),$(lastword $(AUTOBAUD_RATES)),$(BAUD)) \
 	-DORFA_ADDR=$(ADDR) -DORFA_MODE_$(MODE) \
-	-std=gnu99 $(FW_OPT) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
+	-std=gnu99 $(FW_OPT) $(FW_DEBUG) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
 	-fshort-enums -I. -Iboards/$(BOARD) \
 	'-DORFA_DRIVER_LIST=$(foreach d,$(DRIVERS),X($(d)))'
 # -mrelax: the linker turns calls and jumps within reach into rcall/rjmp
 # (about 200 bytes less on the M32-D gateway).
-FW_LDFLAGS := -mmcu=$(BOARD_MCU) $(FW_OPT) -flto -mrelax -Wl,--gc-sections
+FW_LDFLAGS := -mmcu=$(BOARD_MCU) $(FW_OPT) $(FW_DEBUG) -flto -mrelax -Wl,--gc-sections
 
 # Each driver's hardware part, where it has one.
 DRV_HW_spi := drivers/spi_hw.c
@@ -224,13 +224,15 @@ SIM_CFLAGS := -std=gnu99 -O2 -g -Wall -Wextra -Werror -I. -Isim -I/usr/include/s
 SIM_LIBS := -lsimavr -lelf -lutil -lpthread -lm
 
 sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf build/sim-fw/twi_slave_echo_m128.elf \
-	build/sim-fw/twi_arb_master.elf build/sim-fw/irq_latency.elf build/sim-fw/autobaud_check.elf
+	build/sim-fw/twi_arb_master.elf build/sim-fw/irq_latency.elf build/sim-fw/autobaud_check.elf \
+	build/sim-fw/profile_loop.elf
 
 # Test firmware for the simulator's bus tests (tests/sim/fw), not ORFA: the
 # echo slave on an ATmega32 at 0x20 and on an ATmega128 at 0x22, a master
 # that loses arbitration (ATmega32), a count of the instructions run after
 # SEI and RETI before a pending interrupt (ATmega32), autobaud's pair
-# analysis against its rule (the M32-D gateway's autobaud.c and rates).
+# analysis against its rule (the M32-D gateway's autobaud.c and rates), a
+# loop of known instructions for the `profile` request (ATmega32).
 # Each runs on a board's MCU at its clock (board.h).
 SIM_FW_CFLAGS := -std=gnu99 -Os -Wall -Wextra -Werror
 build/sim-fw/%_m128.elf: tests/sim/fw/%.c

@@ -448,7 +448,7 @@ void uart_putc(uint8_t c)
 		/* Full: the UDRE interrupt frees a slot per byte sent. The
 		 * watchdog is fed only when one did (progress): a stuck UDRE
 		 * interrupt must end in a reset, not spin here fed. */
-		while (next == uart.tx_tail) {
+		while (next == uart.tx_tail) {  /* profile: idle */
 		}
 		wdt_reset();
 	}

@@ -58,8 +58,8 @@ void front_poll(void)
 	uint8_t tail;
 	uint8_t spin = 16;
 	do {
-		tail = sg_rx.tail;
-	} while (tail == sg_rx.head && --spin);
+		tail = sg_rx.tail;                      /* profile: idle */
+	} while (tail == sg_rx.head && --spin);  /* profile: idle */
 	if (tail == sg_rx.head) {
 		uart_rx_flush();
 		if (!sg_rx_losing()) {

@@ -280,6 +280,22 @@ class SimControl(Closing):
         w = self.request(self._board("isr clear" if clear else "isr")).split()
         return {"longest": int(w[2]), "count": int(w[4]), "total": int(w[6])}
 
+    def profile_on(self) -> None:
+        """Count the board's cycles at each flash word from now (every
+        count zero again); see profile()."""
+        self.request(self._board("profile on"))
+
+    def profile_off(self) -> None:
+        """Stop counting; the counts stay for profile()."""
+        self.request(self._board("profile off"))
+
+    def profile(self) -> Dict[int, int]:
+        """{byte address: cycles} since profile_on(), words never run left
+        out. Every cycle between two instructions counts to the first: its
+        own, an interrupt's entry after it, its sleep (docs/simulator.md)."""
+        w = self.request(self._board("profile")).split()
+        return {int(a, 16): int(c) for a, _, c in (x.partition(":") for x in w[1:])}
+
     def i2c_stuck(self, pulses: int) -> None:
         """A device on the I2C bus holds SDA low until it has seen `pulses`
         more SCL pulses (falling edges), as a slave does whose byte a master

@@ -7,6 +7,8 @@
  */
 #include "harness/avr_step.h"
 
+#include "harness/profile.h"
+
 #include "sim_core.h"
 #include "sim_interrupts.h"
 #include "simavr16/interrupt.h"
@@ -74,6 +76,7 @@ int avr_step_until(avr_t *avr, uint64_t end)
 	while (avr->cycle < end) {
 		avr_flashaddr_t new_pc = avr->pc;
 
+		profile_note(avr);
 		if (avr->state == cpu_Running) {
 			new_pc = avr_run_one(avr);
 		}

@@ -16,6 +16,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include "harness/profile.h"
 #include "harness/control.h"
 #include "harness/fault.h"
 #include "harness/isr_watch.h"
@@ -456,6 +457,44 @@ static int req_isr(control_req_ctx_t *q)
 	return 0;
 }
 
+/* `profile on|off`; `profile`: the cycles counted at each flash word,
+ * as BYTEADDR:CYCLES (hex, decimal) in address order, words never run left
+ * out (profile.h) */
+static int req_profile(control_req_ctx_t *q)
+{
+	avr_t *avr = q->cb->avr;
+
+	if (q->argc == 2) {
+		if (!strcasecmp(q->argv[1], "on")) {
+			if (profile_on(avr) < 0) {
+				reply_printf(q->r, "ERR profile: out of memory");
+			} else {
+				reply_printf(q->r, "on");
+			}
+		} else if (!strcasecmp(q->argv[1], "off")) {
+			profile_off(avr);
+			reply_printf(q->r, "off");
+		} else {
+			return CONTROL_WRONG;
+		}
+		return 0;
+	}
+	uint32_t words;
+	const uint64_t *cycles = profile_counts(avr, &words);
+
+	if (!cycles) {
+		reply_printf(q->r, "ERR profile: not on (profile on)");
+		return 0;
+	}
+	reply_printf(q->r, "cycles");
+	for (uint32_t i = 0; i < words; i++) {
+		if (cycles[i]) {
+			reply_printf(q->r, " %X:%" PRIu64, (unsigned)(2 * i), cycles[i]);
+		}
+	}
+	return 0;
+}
+
 static int req_peek(control_req_ctx_t *q)
 {
 	avr_t *avr = q->cb->avr;
@@ -845,6 +884,7 @@ static const control_req_t control_reqs[] = {
 	{ "stack", "[FROM]", 1, 2, CONTROL_ANY_BOARD, req_stack },
 	{ "isr", "[clear]", 1, 2, CONTROL_ANY_BOARD, req_isr },
 	{ "peek", "ADDR [LEN]", 2, 3, CONTROL_ANY_BOARD, req_peek },
+	{ "profile", "[on|off]", 1, 2, CONTROL_ANY_BOARD, req_profile },
 	{ "rx", "CYCLE HEX...", 0, CONTROL_MAX_ARGS, CONTROL_GATEWAY, req_rx },
 	{ "line", "", 1, 1, CONTROL_GATEWAY, req_line },
 	{ "signals", "", 1, 1, CONTROL_ANY_BOARD, req_signals },

@@ -13,6 +13,7 @@
 
 #include "harness/avr_step.h"
 #include "harness/park_op.h"
+#include "harness/profile.h"
 
 #define PARK_BACKOFF_MIN 16
 #define PARK_BACKOFF_MAX 128
@@ -255,6 +256,7 @@ static int park_watch_one(park_t *p, avr_t *avr)
 		park_timers(&before, avr);
 	}
 	park_note_cells(p, &o);
+	profile_note(avr);
 	new_pc = avr_run_one(avr);
 	avr_step_after(avr, new_pc);
 	if (avr->state != cpu_Running || avr->interrupt_state || avr->pc != new_pc) {
@@ -285,6 +287,9 @@ static int park_watch_one(park_t *p, avr_t *avr)
 
 int park_run(park_t *p, avr_t *avr, uint64_t end, int allow)
 {
+	if (!allow) {
+		p->watching = 0;	/* one begun before parking was refused (profiling) */
+	}
 	while (p->watching && avr->cycle < end) {
 		if (!park_watch_one(p, avr) && p->parked) {
 			if (park_stays(p, avr, end)) {

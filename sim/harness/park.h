@@ -82,7 +82,8 @@ typedef struct park_t {
 
 /* Run a board that is not parked to END (as avr_step_until), watching a
  * turn of the loop it is in when a watch is on, and parking it when the
- * turn repeats; with ALLOW, a watch begins at the end when one is due.
+ * turn repeats; with ALLOW, a watch begins at the end when one is due;
+ * without it, a watch under way ends (no parking: `profile`).
  * Returns the MCU's state. */
 int park_run(park_t *p, avr_t *avr, uint64_t end, int allow);
 

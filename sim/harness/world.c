@@ -5,6 +5,8 @@
 
 #include "harness/world.h"
 
+#include "harness/profile.h"
+
 void world_init(world_t *w)
 {
 	memset(w, 0, sizeof(*w));
@@ -62,7 +64,7 @@ static int world_run_one(world_t *w, uint64_t target, uint32_t bytes)
 		if (park->parked && park_stays(park, avr, bytes ? end : target)) {
 			continue;
 		}
-		state = park_run(park, avr, end, !w->no_park);
+		state = park_run(park, avr, end, !w->no_park && !profile_boards);
 		if (world_state_dead(state)) {
 			w->dead = 0;
 			w->dead_state = state;
@@ -151,7 +153,7 @@ int world_run(world_t *w, uint64_t target, uint32_t bytes)
 				parked++;
 				continue;
 			}
-			state = park_run(park, avr, end, !w->no_park);
+			state = park_run(park, avr, end, !w->no_park && !profile_boards);
 			if (world_state_dead(state)) {
 				w->dead = i;
 				w->dead_state = state;
