@@ -7,7 +7,7 @@ in simulated time, the simulator at real time (orfa-sim --real-time) so the
 PC has a real board's time per byte.
 
 Where the target is missed the board's CPU is what limits, not the line nor
-the PC (docs/python.md, "Where the board's time goes"): at 460800 receiving,
+the PC (docs/python.md, "Pipelining across calls"; tools/profile.py): at 460800 receiving,
 parsing and answering the step's characters alone take longer than their
 wire time on both boards; at 230400 the M32-D's servo write and cycle-exact
 edges add what puts it past. Those rows still must reach FLOOR (a little

@@ -100,3 +100,23 @@ def test_the_profile_tool_refuses_wrong_arguments(args):
     r = run_tool(*args)
     assert r.returncode == 2 and r.stdout == ""
     assert r.stderr.splitlines()[-1].startswith("profile: error: ")
+
+
+CHARACTER_WORK = ("firmware/uart.c", "serialgate/sg_rx.c", "serialgate/sg_parse", "serialgate/sg_gate.c",
+                  "(the vector table)")
+
+
+@pytest.mark.parametrize("board, wire", [("m32d", 22720), ("m128s", 20800)])
+def test_at_460800_the_characters_alone_fill_the_wire(board, wire):
+    """docs/python.md's claim, measured: at 460800 a control-loop step's
+    characters (the serial interrupts, parsing, queueing the replies) take
+    about the step's whole wire time, so the board's work a step is far
+    beyond what 95 % of the wire allows."""
+    r = run_tool("--board", board, "--baud", "460800", "--steps", "10", "--top", "100")
+    assert (r.returncode, r.stderr) == (0, "")
+    out = r.stdout.splitlines()
+    rows = [re.match(r"(.*?)\s+(\d+)\s+[\d.]+%$", line) for line in out[2:-2]]
+    chars = sum(int(m.group(2)) for m in rows if m.group(1).startswith(CHARACTER_WORK))
+    work = int(re.match(r"work a step (\d+) cycles, the step's wire %d:" % wire, out[-1]).group(1))
+    assert chars >= 0.9 * wire
+    assert work > 1.5 * wire
