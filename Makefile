@@ -132,7 +132,7 @@ $(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 
-.PHONY: map map-board print-baud-rates print-autobaud-rates firmware flash fuses all-boards robot size sim unit fuzz fuzz-short test bench soak demo demo-robot doc-images clean setup
+.PHONY: map map-board print-baud-rates print-autobaud-rates print-gate-rates firmware flash fuses all-boards gate-rates robot size sim unit fuzz fuzz-short test bench soak demo demo-robot doc-images clean setup
 .DEFAULT_GOAL := firmware
 
 firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
@@ -154,6 +154,16 @@ $(BUILD)/orfa.hex: $(BUILD)/orfa.elf
 all-boards:
 	@set -e; for b in $(BOARDS); do for m in $(MODES); do \
 		$(MAKE) --no-print-directory BOARD=$$b MODE=$$m firmware; done; done
+
+# Each board's gateway at the fast rates and with autobaud, for a simulated
+# board at those rates (`orfa --sim B --baud R`, orfa.locate.gateway_firmware,
+# which makes any other rate on demand) and the installed package:
+# build/<board>-gate-<rate>/.
+GATE_RATES := 230400 460800 auto
+gate-rates:
+	@set -e; for b in $(BOARDS); do for r in $(GATE_RATES); do \
+		$(MAKE) --no-print-directory BOARD=$$b MODE=gate BAUD=$$r BUILD=build/$$b-gate-$$r \
+			firmware; done; done
 
 # The slave boards of the simulated test robot (tests/sim, tools/bench.py):
 # BOARD:ADDR, each built into build/robot/<board>-<addr>/orfa.elf.
@@ -190,6 +200,9 @@ print-baud-rates:
 
 print-autobaud-rates:
 	@echo $(AUTOBAUD_RATES)
+
+print-gate-rates:
+	@echo $(GATE_RATES)
 
 # --- flashing a real board (avrdude; docs/flashing.md) ----------------------
 # The part and the fuses come from boards/$(BOARD)/board.mk. PROGRAMMER is

@@ -6,6 +6,8 @@ build/ is up to date) and copies into the package
 
     orfa/_sim/orfa-sim                        build/sim/orfa-sim
     orfa/_firmware/<board>-<mode>/orfa.elf    build/<board>-<mode>/ (and .hex)
+    orfa/_firmware/<board>-gate-<rate>/       build/<board>-gate-<rate>/ (make gate-rates:
+                                              230400, 460800, auto)
     orfa/_firmware/robot/<board>-<addr>/      build/robot/ (the test robot's slaves)
 
 where orfa.locate finds them. The simulator is a program for this machine, so
@@ -38,7 +40,7 @@ SKIP = os.environ.get("ORFA_SKIP_BUILD", "") not in ("", "0")
 # Every board of boards/, each in the Makefile's MODES.
 BOARDS = sorted(p.parent.name for p in (ROOT / "boards").glob("*/board.mk"))
 MODES = ("gate", "slave")
-MAKE_GOALS = ["all-boards", "robot", "build/sim/orfa-sim"]
+MAKE_GOALS = ["all-boards", "gate-rates", "robot", "build/sim/orfa-sim"]
 SETUP_HINT = ("run tools/setup.sh (it installs them on Debian), or set"
               " ORFA_SKIP_BUILD=1 to install the host library without the simulator")
 
@@ -75,10 +77,17 @@ def build_artefacts():
         fail("`%s` failed in %s (exit %d; its output is above)" % (" ".join(cmd), ROOT, status))
     build = ROOT / "build"
     files = {"_sim/orfa-sim": build / "sim" / "orfa-sim"}
+    # the rates `make gate-rates` built (the Makefile's GATE_RATES)
+    rates = subprocess.run(["make", "-s", "--no-print-directory", "print-gate-rates"], cwd=str(ROOT),
+                           capture_output=True, text=True).stdout.split()
     for board in BOARDS:
         for mode in MODES:
             for name in ("orfa.elf", "orfa.hex"):
                 files["_firmware/%s-%s/%s" % (board, mode, name)] = build / ("%s-%s" % (board, mode)) / name
+        for rate in rates:
+            for name in ("orfa.elf", "orfa.hex"):
+                rel = "%s-gate-%s/%s" % (board, rate, name)
+                files["_firmware/" + rel] = build / rel
     for elf in sorted((build / "robot").glob("*/orfa.elf")):
         files["_firmware/robot/%s/orfa.elf" % elf.parent.name] = elf
     absent = [str(path) for path in files.values() if not path.is_file()]

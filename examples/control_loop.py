@@ -271,22 +271,11 @@ def check_sim_inputs(k, inputs):
 
 
 def firmware_at(board, baud):
-    """The gateway build for `baud`: the default one at 115200, else
-    build/test-baud/<board>-<baud> (as the tests build it; made with
-    `make BAUD=...` when missing or out of date)."""
-    from orfa.locate import firmware_path
-    if baud == p.DEFAULT_BAUD:
-        return firmware_path(board, "gate")
-    import subprocess
-    root = Path(__file__).resolve().parents[1]
-    out = Path("build") / "test-baud" / ("%s-%d" % (board, baud))
-    made = subprocess.run(["make", "-s", "--no-print-directory", "BOARD=" + board, "MODE=gate",
-                           "BAUD=%d" % baud, "BUILD=%s" % out], cwd=root,
-                          capture_output=True, text=True)
-    if made.returncode:
-        raise ValueError("no %s gateway at %d baud: %s" % (
-            board, baud, (made.stderr.strip().splitlines() or ["make failed"])[-1]))
-    return root / out / "orfa.elf"
+    """The gateway build for `baud` (orfa.locate.gateway_firmware: the
+    default one at 115200, else build/<board>-gate-<baud>, made with `make
+    BAUD=...` when missing or out of date); ValueError if none."""
+    from orfa.locate import gateway_firmware
+    return gateway_firmware(board, baud)
 
 
 def report(loop, steps, pipelined, check):

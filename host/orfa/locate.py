@@ -68,6 +68,36 @@ def firmware_path(board: str, mode: str = "gate") -> Path:
     return _first_file([d / ("%s-%s" % (board, mode)) / "orfa.elf" for d in firmware_dirs()])
 
 
+def gateway_firmware(board: str, baud) -> Path:
+    """The gateway ELF of `board` that talks at `baud` (a rate, or "auto":
+    the autobaud build): at the protocol's default rate the default build
+    (firmware_path), else <board>-gate-<baud>/orfa.elf in the firmware
+    directories. In the work tree (ORFA_FIRMWARE unset) that one is made
+    with `make BOARD=<board> MODE=gate BAUD=<baud>` when missing or out of
+    date. ValueError with one line when there is none for that rate (make's
+    reason where it refuses the rate: 921600, or one the line has not)."""
+    from .protocol import DEFAULT_BAUD
+    if baud == DEFAULT_BAUD:
+        return firmware_path(board, "gate")
+    name = "%s-gate-%s" % (board, baud)
+    if _env_path(FIRMWARE_ENV) is None and in_work_tree():
+        import subprocess
+        made = subprocess.run(["make", "-s", "--no-print-directory", "BOARD=" + board,
+                               "MODE=gate", "BAUD=%s" % baud, "BUILD=build/" + name],
+                              cwd=REPO_ROOT, capture_output=True, text=True)
+        if made.returncode:
+            why = (made.stderr.strip().splitlines() or ["make failed"])[-1]
+            why = why.split("*** ", 1)[-1].replace("  Stop.", "")
+            raise ValueError("no %s gateway at %s baud: %s" % (board, baud, why))
+        return REPO_ROOT / "build" / name / "orfa.elf"
+    path = _first_file([d / name / "orfa.elf" for d in firmware_dirs()])
+    if not path.is_file():
+        raise ValueError("no %s gateway at %s baud: %s is not there (make BOARD=%s MODE=gate "
+                         "BAUD=%s BUILD=build/%s in the source tree, then point %s at its "
+                         "build/)" % (board, baud, path, board, baud, name, FIRMWARE_ENV))
+    return path
+
+
 def slave_firmware_path(board: str, addr: int) -> Path:
     """The slave build for `board` at bus address `addr`: the test robot's
     (`make robot`, robot/<board>-0x<ADDR>/) when there is one, else
@@ -108,7 +138,7 @@ def build_hint() -> str:
         return "run `make all-boards sim` in %s (`make robot` for the test robot)" % REPO_ROOT
     if PACKAGE_SIM.is_file():
         return ("not part of the installed orfa (it has the builds of `make all-boards"
-                " robot sim`): give the ELF's path, or set %s" % FIRMWARE_ENV)
+                " gate-rates robot sim`): give the ELF's path, or set %s" % FIRMWARE_ENV)
     return ("this orfa was installed without the simulator (ORFA_SKIP_BUILD=1):"
             " reinstall it from the source tree after running"
             " tools/setup.sh there, or set %s and %s" % (SIM_ENV, FIRMWARE_ENV))

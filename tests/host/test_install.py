@@ -249,6 +249,12 @@ def test_issue_commands_run_from_the_venv(installed, tmp_path):
         [(d.uid, d.name) for d in boardmap.load("m32d").drivers]
     r = run([orfa, "--sim", "m32d", "servo", "3", "1500"], cwd=tmp_path)
     assert r.returncode == 0 and r.stderr == "", r.stderr
+    # the fast rates: the package's gateways built for them (make gate-rates)
+    for rate in ("230400", "460800"):
+        r = run([orfa, "--sim", "m128s", "--baud", rate, "request", "V"], cwd=tmp_path)
+        assert (r.returncode, r.stdout, r.stderr) == (0, "V1.1\n", "")
+    r = run([orfa, "--sim", "m128s", "--baud", "57600", "version"], cwd=tmp_path)
+    assert r.returncode == 2 and r.stderr.startswith("orfa: no m128s gateway at 57600 baud: ")
 
 
 def test_dash_page_is_in_the_package_and_flask_is_asked_for(installed, tmp_path):

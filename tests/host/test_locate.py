@@ -89,8 +89,39 @@ def test_installed_hints(package, monkeypatch):
         "this orfa was installed without the simulator (ORFA_SKIP_BUILD=1)")
     touch(package / "_sim" / "orfa-sim")
     assert locate.build_hint() == (
-        "not part of the installed orfa (it has the builds of `make all-boards robot sim`):"
+        "not part of the installed orfa (it has the builds of `make all-boards gate-rates robot sim`):"
         " give the ELF's path, or set ORFA_FIRMWARE")
+
+
+def test_a_gateway_for_a_rate_is_made_in_the_work_tree():
+    """The default rate is the default build; another is made (or found up
+    to date) in build/<board>-gate-<rate>/; one make refuses is a one-line
+    ValueError with make's reason."""
+    assert locate.gateway_firmware("m32d", 115200) == locate.firmware_path("m32d")
+    elf = locate.gateway_firmware("m128s", 230400)
+    assert elf == BUILD / "m128s-gate-230400" / "orfa.elf" and elf.is_file()
+    assert locate.gateway_firmware("m128s", "auto") == BUILD / "m128s-gate-auto" / "orfa.elf"
+    with pytest.raises(ValueError) as exc:
+        locate.gateway_firmware("m32d", 921600)
+    assert str(exc.value).startswith("no m32d gateway at 921600 baud: BAUD=921600 is refused: ")
+    assert "\n" not in str(exc.value) and "Stop" not in str(exc.value)
+
+
+def test_a_gateway_for_a_rate_outside_the_work_tree(package, monkeypatch, tmp_path):
+    monkeypatch.setattr(locate, "in_work_tree", lambda: False)
+    gate = touch(package / "_firmware" / "m32d-gate-460800" / "orfa.elf")
+    assert locate.gateway_firmware("m32d", 460800) == gate
+    with pytest.raises(ValueError) as exc:
+        locate.gateway_firmware("m32d", 57600)
+    assert str(exc.value) == (
+        "no m32d gateway at 57600 baud: %s is not there (make BOARD=m32d MODE=gate BAUD=57600"
+        " BUILD=build/m32d-gate-57600 in the source tree, then point ORFA_FIRMWARE at its"
+        " build/)" % (package / "_firmware" / "m32d-gate-57600" / "orfa.elf"))
+    # a setting is final, in the work tree too: nothing is made there
+    monkeypatch.setattr(locate, "in_work_tree", lambda: True)
+    monkeypatch.setenv("ORFA_FIRMWARE", str(tmp_path / "fw"))
+    with pytest.raises(ValueError, match="fw/m32d-gate-230400/orfa.elf is not there"):
+        locate.gateway_firmware("m32d", 230400)
 
 
 def test_simboard_names_the_missing_file_and_the_setting(tmp_path, monkeypatch):

@@ -55,6 +55,27 @@ def test_commands_at_the_fast_rates(rate):
         assert result.returncode == 1 and result.stderr.startswith("orfa: no reply line")
 
 
+@pytest.mark.parametrize("rate", [230400, 460800])
+def test_sim_at_a_fast_rate_runs_the_gateway_built_for_it(rate):
+    """`--sim B --baud R` and `orfa sim --baud R` simulate the board at R:
+    its gateway built for that rate (orfa.locate.gateway_firmware), not the
+    default build, which would say nothing to R."""
+    require_builds(["m32d"])
+    result = orfa("--sim", "m32d", "--baud", str(rate), "request", "V", "S AA 00 00 S AB 01 P")
+    assert (result.returncode, result.stdout, result.stderr) == (0, "V1.1\nSWAASR07P\n", "")
+    result = orfa("sim", "--board", "m128s", "--baud", str(rate), "--terminal", input="V\n")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[1:] == ["V1.1"]
+
+
+def test_sim_at_a_rate_without_a_build_is_one_line():
+    result = orfa("--sim", "m32d", "--baud", "921600", "version")
+    assert (result.returncode, result.stdout) == (2, "")
+    assert result.stderr.startswith("orfa: no m32d gateway at 921600 baud: BAUD=921600 is "
+                                    "refused: a character lasts 80 cycles there")
+    assert len(result.stderr.splitlines()) == 1
+
+
 def test_request_refused_on_the_host():
     result = orfa("request", "--port", "loop://", "V" * 129)
     assert result.returncode == 1

@@ -14,6 +14,7 @@ from .. import boardmap
 from .. import protocol as p
 from ..errors import UsageError, explain  # noqa: F401 (the commands' errors, one line each)
 from ..gateway import Gateway, os_reason
+from ..locate import gateway_firmware
 from ..sim import BOARDS, SimBoard, SimError, part_kinds
 
 #: The environment variable that gives --port its default.
@@ -247,7 +248,8 @@ def sim_board(board: str, args, **kw) -> SimBoard:
 @contextlib.contextmanager
 def connect(args) -> Iterator[Gateway]:
     """The Gateway of --port URL (or $ORFA_PORT), or of a board --sim starts
-    for this one command (stopped when the command ends). An explicit --sim
+    for this one command (stopped when the command ends), its gateway built
+    for --baud (orfa.locate.gateway_firmware). An explicit --sim
     wins over $ORFA_PORT; --port and --sim both given is a usage error."""
     devices = [opt for opt in ("eeprom", "part", "slave", "adc", "spi")
                if getattr(args, opt, None)]
@@ -257,7 +259,8 @@ def connect(args) -> Iterator[Gateway]:
         if args.port:
             raise UsageError("give --port or --sim, not both")
         try:
-            sim = sim_board(args.sim, args, trace=False, control=args.autobaud).start()
+            sim = sim_board(args.sim, args, trace=False, control=args.autobaud,
+                            firmware=gateway_firmware(args.sim, args.baud)).start()
         except (SimError, ValueError) as exc:
             raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
         try:

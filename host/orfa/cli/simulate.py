@@ -9,6 +9,7 @@ import signal
 import sys
 
 from .. import protocol as p
+from ..locate import gateway_firmware
 from ..sim import BOARDS, SimError
 from .common import UsageError, add_sim_devices, arg, baud_rate, command, sim_board
 from .common import adc_spec, eeprom_spec, slave_spec  # noqa: F401 (here before)
@@ -48,7 +49,8 @@ def cmd_sim(args) -> int:
     if args.vcd:
         extra += ["--vcd", args.vcd]
     try:
-        board = sim_board(args.board, args, trace=False, firmware=args.firmware,
+        board = sim_board(args.board, args, trace=False,
+                          firmware=args.firmware or gateway_firmware(args.board, args.baud),
                           control=control, extra_args=extra).start()
     except (SimError, ValueError) as exc:
         raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
@@ -83,7 +85,8 @@ def add_parsers(sub, common) -> None:
     cmd = command(sub, [], cmd_sim, arg("--board", choices=BOARDS, default="m32d",
                                         help="the gateway's board (default %(default)s)"))
     add_sim_devices(cmd)
-    cmd.add_argument("--firmware", help="ELF to run (default: build/<board>-gate/orfa.elf)")
+    cmd.add_argument("--firmware", help="ELF to run (default: the board's gateway built for"
+                     " --baud: build/<board>-gate/orfa.elf at 115200)")
     cmd.add_argument("--control", nargs="?", const="", metavar="PATH",
                      help="open the control socket (at PATH if given) and print its path")
     cmd.add_argument("--trace", metavar="FILE", help="write the bus and serial trace to FILE")
@@ -91,7 +94,8 @@ def add_parsers(sub, common) -> None:
     cmd.add_argument("--terminal", action="store_true",
                      help="also open a line console on the board (as orfa console)")
     cmd.add_argument("--baud", type=baud_rate, default=p.DEFAULT_BAUD,
-                     help="the console's rate (default %(default)s)")
+                     help="the gateway's serial rate, its firmware built for it, and the"
+                          " console's (default %(default)s)")
     cmd.add_argument("--autobaud", action="store_true",
                      help="the console opens with the BAUD=auto preamble (eight CRs,"
                           " 20 ms of simulated quiet)")
