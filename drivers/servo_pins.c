@@ -145,13 +145,14 @@ _Static_assert(SERVO_FRAME % 8 == 0 && SERVO_LEAD % 8 == 0 && SERVO_FINE % 8 == 
  */
 static uint16_t servo_ticks(void)
 {
+	uint16_t wraps = clock_wraps;  /* read once (volatile, but interrupts are off) */
 	uint8_t t = TCNT2;
 	if (TIFR & _BV(TOV2)) {
 		TIFR = _BV(TOV2);  /* a 1 clears that flag only */
-		clock_wraps++;
+		clock_wraps = ++wraps;
 		t = TCNT2;         /* again: the first read may be from before the overflow */
 	}
-	return (uint16_t)(clock_wraps << 8 | t);
+	return (uint16_t)(wraps << 8 | t);
 }
 
 /* Ticks from now until the next edge. */
