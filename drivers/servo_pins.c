@@ -155,10 +155,14 @@ static uint16_t servo_ticks(void)
 	return (uint16_t)(wraps << 8 | t);
 }
 
-/* Ticks from now until the next edge. */
+/* Ticks from now until the next edge. The target read after the call:
+ * read before it, it was kept across it in r28/r29, pushed and popped
+ * (8 B, 8 cycles a look). */
 static int16_t servo_ticks_left(void)
 {
-	return (int16_t)(pulses.target - servo_ticks());
+	uint16_t now = servo_ticks();
+
+	return (int16_t)(pulses.target - now);
 }
 
 /* Makes `e` the next edge: its tick and Timer0 count. */
