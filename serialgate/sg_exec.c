@@ -165,6 +165,7 @@ void sg_exec_lost(const sg_parser_t *p)
 {
 	for (uint16_t i = 0; i < p->lost; i++) {
 		out_error(SG_ERR_DATA);
+		sg_lost_answered();
 	}
 }
 

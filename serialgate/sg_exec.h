@@ -25,7 +25,16 @@ void sg_exec_init(void);
 /* Runs the request the parser just completed (or replies its error). */
 void sg_exec(sg_parser_t *p);
 
-/* After SG_LOST: ERROR 04 for each request the receive buffer lost. */
+/* After SG_LOST: ERROR 04 for each request the receive buffer lost,
+ * sg_lost_answered() after each. */
 void sg_exec_lost(const sg_parser_t *p);
+
+/* A lost request's ERROR 04 is queued (provided by the front end or a
+ * test): the gateway feeds the watchdog there. A flood of short requests
+ * beyond the flow rule owes thousands of them (up to 65535 a lost run),
+ * a loop of seconds; the CPU, not the wire, holds it back while the
+ * receive interrupt takes most cycles, so uart_putc() never waits for
+ * room, the only place it feeds on progress. Each reply is progress. */
+void sg_lost_answered(void);
 
 #endif

@@ -1,6 +1,7 @@
 /* The serial gateway front end: UART characters in, replies out. */
 #include "firmware/front.h"
 
+#include <avr/wdt.h>
 #include <util/atomic.h>
 
 #include "firmware/sys.h"
@@ -23,6 +24,11 @@ void sg_out(uint8_t c)
 void sg_out2(uint8_t a, uint8_t b)
 {
 	uart_put2(a, b);
+}
+
+void sg_lost_answered(void)
+{
+	wdt_reset();  /* progress: a reply out (sg_exec.h) */
 }
 
 void uart_received(uint8_t c)

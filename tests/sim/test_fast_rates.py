@@ -372,3 +372,49 @@ def test_flow_rule_holds_the_host_back_at_460800():
     print("\nm32d at %d: a 16-triple write runs %d..%d cycles, its %d characters take %d "
           "on the wire; at most %d characters unanswered" % (
               rate, min(run), max(run), per, per * byte, worst))
+
+
+#: A flood of the shortest request, 120 frames long (2.4 s of the
+#: board's time): the review's reset came after about 60 (at 460800, no
+#: servos; here, without the fix, after ~100).
+SHORT_FLOOD_FRAMES = 120
+
+
+def test_m32d_a_long_flood_of_short_requests_ends_in_no_reset():
+    """A host that breaks the flow rule at 460800 with `V` lines back to
+    back (2 characters a request, a reply of 6): the receive interrupt
+    takes most of the CPU, the ring overflows, and a lost run's requests,
+    each owed an `ERROR 04`, grow from run to run while the main loop
+    answers the last one, into the thousands. That loop of replies never
+    waited for the transmit ring (the CPU, not the wire, held it back), so
+    uart_putc() never fed the watchdog, and the board reset (after ~100
+    frames here). Each owed reply now feeds it (progress). No reset; every
+    request is answered, once: a `V1.1` or an `ERROR 04`."""
+    rate = 460800
+    per_char = 10 * F_CPU // rate
+    blob = b"V\n" * (RX_MAX // 2)
+    with sim_for("m32d", rate) as sim, serial.Serial(sim.port, rate, timeout=REPLY_TIMEOUT):
+        ctl = sim.control
+        at = ctl.rx_after(1000, blob)
+        first, sent = at - len(blob) * per_char, 1
+        while at < first + SHORT_FLOOD_FRAMES * SERVO_FRAME:
+            try:
+                at = ctl.rx(at, blob)
+                sent += 1
+            except SimControlError as e:    # the simulator's queue is full
+                assert "too many" in str(e), e
+                ctl.wait(8 * RX_MAX * per_char)
+        # the owed replies go on long after the flood (~170 M cycles here)
+        lines = sent * len(blob) // 2
+        for _ in range(10):
+            ctl.wait(50 * SERVO_FRAME)
+            out = board_sent(sim, first)
+            if out.count(b"\n") >= lines:
+                break
+        assert sim.trace_events(kinds=["reset"]) == []
+        assert out.count(b"\n") == out.count(b"V1.1\r\n") + out.count(b"ERROR 04\r\n") == lines
+        assert out.count(b"V1.1\r\n") > 0
+        # and the board serves the next request at once
+        at = ctl.rx_after(1000, b"V\n")
+        ctl.wait(1000)
+        assert board_sent(sim, at) == b"V1.1\r\n"

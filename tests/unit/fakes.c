@@ -47,6 +47,10 @@ void sg_out2(uint8_t a, uint8_t b)
 	sg_out(b);
 }
 
+void sg_lost_answered(void)
+{
+}
+
 /* Devices: 0xA0 EEPROM; 0x50 acknowledges its address, refuses data;
  * 0x60 hangs the bus (every step fails); 0x62 takes everything, then holds
  * SCL so that no STOP can be made (the transaction is abandoned). */
