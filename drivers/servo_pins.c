@@ -213,10 +213,21 @@ static bool servo_arm(void)
 	return true;
 }
 
-/* Lets the receive interrupt hand on what the hold keeps: all of it when
+/* Lets the receive interrupt hand on what the hold keeps: all of it while
  * the next edge is SERVO_FAR away, BOARD_RX_BURST characters when it is
  * SERVO_NEAR away, nothing closer (the caller then waits for the edge in
- * place, holding). */
+ * place, holding). All of it goes SERVO_RX_CHUNK at a time, the edge
+ * looked at again in between (servo_ticks() counting Timer2's overflow):
+ * in one call, a full hold and what arrived meanwhile ran ~2250 cycles
+ * with interrupts off at 460800 (~115 a character), past a Timer2 wrap,
+ * and an overflow went uncounted: every edge after it a wrap (2048
+ * cycles) late, one pulse that much too long. Now ~1400 cycles at most
+ * between two looks; the next chunk only while the hold keeps some: a
+ * turn as long as UDR had a character (~45 cycles a turn more) never
+ * caught up with characters back to back at 460800 (interrupts off
+ * ~11000 cycles). The cost: a chunk's call and look, the interrupt's
+ * longest run with the line busy at 460800 ~3700 -> ~4600 cycles. */
+#define SERVO_RX_CHUNK 12
 static void servo_rx_release(void)
 {
 	if (SERVO_RX_ISR == 0) {
@@ -224,8 +235,11 @@ static void servo_rx_release(void)
 	}
 	int16_t left = servo_ticks_left();
 
+	while (left > SERVO_FAR / 8 && front_rx_poll(SERVO_RX_CHUNK)) {
+		left = servo_ticks_left();
+	}
 	if (left > SERVO_NEAR / 8) {
-		front_rx_poll(left > SERVO_FAR / 8 ? FRONT_HOLD_ALL : BOARD_RX_BURST);
+		front_rx_poll(BOARD_RX_BURST);
 	}
 }
 

@@ -153,12 +153,13 @@ void front_rx_held(void)
 	held_tell();
 }
 
-void front_rx_poll(uint8_t most)
+bool front_rx_poll(uint8_t most)
 {
 	if (held.head != held.tail || (MCU_UCSRA & _BV(RXC))) {
 		held.budget = most;
 		rx_all_call();
 	}
+	return held.head != held.tail;
 }
 
 #else
@@ -184,12 +185,13 @@ void front_rx_held(void)
 {
 }
 
-void front_rx_poll(uint8_t most)
+bool front_rx_poll(uint8_t most)
 {
 	(void)most;
 	if (MCU_UCSRA & _BV(RXC)) {
 		rx_all_call();
 	}
+	return false;  /* no hold */
 }
 #endif
 

@@ -183,9 +183,10 @@ void front_rx_hold(void)
 {
 }
 
-void front_rx_poll(uint8_t most)
+bool front_rx_poll(uint8_t most)
 {
 	(void)most;
+	return false;
 }
 
 void front_rx_held(void)
