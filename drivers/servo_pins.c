@@ -235,8 +235,12 @@ static void servo_rx_release(void)
 	}
 	int16_t left = servo_ticks_left();
 
-	while (left > SERVO_FAR / 8 && front_rx_poll(SERVO_RX_CHUNK)) {
-		left = servo_ticks_left();
+	if (left > SERVO_FAR / 8) {
+		while (front_rx_poll(SERVO_RX_CHUNK) && (left = servo_ticks_left()) > SERVO_FAR / 8) {
+		}
+		if (left > SERVO_FAR / 8) {
+			return;  /* the hold empty (one call, as before, when it was) */
+		}
 	}
 	if (left > SERVO_NEAR / 8) {
 		front_rx_poll(BOARD_RX_BURST);
