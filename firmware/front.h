@@ -3,7 +3,6 @@
 #ifndef ORFA_FRONT_H
 #define ORFA_FRONT_H
 
-#include <stdbool.h>
 #include <stdint.h>
 
 void front_init(void);
@@ -23,8 +22,9 @@ void front_poll(void);
  * held or waits in UDR, to hand on `most` characters at most (about 70
  * cycles each; FRONT_HOLD_ALL: everything); a pending interrupt of higher
  * priority may run instead: the caller allows for the longest. Called with
- * interrupts off, returns with them off; true if characters are still
- * held after it (`most` ran out before the hold did).
+ * interrupts off, returns with them off, and with the number of
+ * characters still held (not 0: `most` ran out before the hold did; a
+ * count, not a bool: no compare, 6 bytes).
  */
 #define FRONT_HOLD_ALL 0xFF
 
@@ -45,7 +45,7 @@ void front_poll(void);
  * instruction(s). */
 
 void front_rx_hold(void);
-bool front_rx_poll(uint8_t most);
+uint8_t front_rx_poll(uint8_t most);
 /* Before such an interrupt returns, after its last front_rx_hold(): what
  * the hold keeps is told to the receive interrupt's fast path (a few
  * cycles; nothing in the I2C slave). */

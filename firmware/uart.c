@@ -153,13 +153,13 @@ void front_rx_held(void)
 	held_tell();
 }
 
-bool front_rx_poll(uint8_t most)
+uint8_t front_rx_poll(uint8_t most)
 {
 	if (held.head != held.tail || (MCU_UCSRA & _BV(RXC))) {
 		held.budget = most;
 		rx_all_call();
 	}
-	return held.head != held.tail;
+	return (uint8_t)(held.head - held.tail);
 }
 
 #else
@@ -185,13 +185,13 @@ void front_rx_held(void)
 {
 }
 
-bool front_rx_poll(uint8_t most)
+uint8_t front_rx_poll(uint8_t most)
 {
 	(void)most;
 	if (MCU_UCSRA & _BV(RXC)) {
 		rx_all_call();
 	}
-	return false;  /* no hold */
+	return 0;  /* no hold */
 }
 #endif
 

@@ -183,10 +183,10 @@ void front_rx_hold(void)
 {
 }
 
-bool front_rx_poll(uint8_t most)
+uint8_t front_rx_poll(uint8_t most)
 {
 	(void)most;
-	return false;
+	return 0;
 }
 
 void front_rx_held(void)
