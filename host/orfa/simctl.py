@@ -296,6 +296,16 @@ class SimControl(Closing):
         w = self.request(self._board("profile")).split()
         return {int(a, 16): int(c) for a, _, c in (x.partition(":") for x in w[1:])}
 
+    def flag(self, vector: int, clear: bool = False) -> Dict[str, int]:
+        """How long the board's interrupt flag of `vector` (its number in
+        the vector table: the M32-D's Timer2 overflow is 5) stayed raised
+        before its handler took it or the firmware cleared it, since the
+        first call (which starts the watch) or the last clear: {"longest"
+        in cycles, "count"}. Longer than the event's period (a Timer2
+        wrap: 2048 cycles): an event was lost."""
+        w = self.request(self._board("flag %d%s" % (vector, " clear" if clear else ""))).split()
+        return {"longest": int(w[1]), "count": int(w[3])}
+
     def i2c_stuck(self, pulses: int) -> None:
         """A device on the I2C bus holds SDA low until it has seen `pulses`
         more SCL pulses (falling edges), as a slave does whose byte a master

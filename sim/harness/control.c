@@ -495,6 +495,46 @@ static int req_profile(control_req_ctx_t *q)
 	return 0;
 }
 
+/* `flag N [clear]`: how long vector N's flag stayed raised (flag_watch_t),
+ * watched from the first such request on. */
+static int req_flag(control_req_ctx_t *q)
+{
+	control_board_t *cb = q->cb;
+	flag_watch_t *w = NULL;
+	char *end;
+	long n = strtol(q->argv[1], &end, 10);
+
+	if (end == q->argv[1] || *end || n < 1 || n > 255 ||
+	    (q->argc == 3 && strcasecmp(q->argv[2], "clear"))) {
+		return CONTROL_WRONG;
+	}
+	int i = 0;
+	for (; i < CONTROL_FLAG_WATCHES && cb->flags[i]; i++) {
+		if (cb->flags[i]->vector == n) {
+			w = cb->flags[i];
+			break;
+		}
+	}
+	if (!w) {
+		if (i == CONTROL_FLAG_WATCHES) {
+			reply_printf(q->r, "ERR flag: %d vectors watched already", CONTROL_FLAG_WATCHES);
+			return 0;
+		}
+		w = calloc(1, sizeof(*w));
+		if (!w || flag_watch_init(w, cb->avr, (int)n) < 0) {
+			free(w);
+			reply_printf(q->r, "ERR flag: no vector %ld on this board", n);
+			return 0;
+		}
+		cb->flags[i] = w;
+	}
+	reply_printf(q->r, "longest %" PRIu64 " count %" PRIu64, w->longest, w->count);
+	if (q->argc == 3) {
+		flag_watch_clear(w);
+	}
+	return 0;
+}
+
 static int req_peek(control_req_ctx_t *q)
 {
 	avr_t *avr = q->cb->avr;
@@ -883,6 +923,7 @@ static const control_req_t control_reqs[] = {
 	{ "spidev", "P", 2, 2, CONTROL_NAMES_BOARD, req_spidev },
 	{ "stack", "[FROM]", 1, 2, CONTROL_ANY_BOARD, req_stack },
 	{ "isr", "[clear]", 1, 2, CONTROL_ANY_BOARD, req_isr },
+	{ "flag", "VECTOR [clear]", 2, 3, CONTROL_ANY_BOARD, req_flag },
 	{ "peek", "ADDR [LEN]", 2, 3, CONTROL_ANY_BOARD, req_peek },
 	{ "profile", "[on|off]", 1, 2, CONTROL_ANY_BOARD, req_profile },
 	{ "rx", "CYCLE HEX...", 0, CONTROL_MAX_ARGS, CONTROL_GATEWAY, req_rx },

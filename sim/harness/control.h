@@ -41,6 +41,7 @@ typedef struct control_client_t {
 } control_client_t;
 
 #define CONTROL_MAX_BOARDS 16
+#define CONTROL_FLAG_WATCHES 4	/* vectors whose flags `flag` watches, a board */
 
 /* A board the requests can reach: the gateway (addr 0, first) or a slave,
  * named by its 8-bit address: `10/servo3`, `@10`. */
@@ -49,6 +50,7 @@ typedef struct control_board_t {
 	avr_t *avr;
 	board_model_t *bm;
 	struct isr_watch_t *twi_isr;	/* its TWI interrupt's durations (`isr`), or NULL */
+	struct flag_watch_t *flags[CONTROL_FLAG_WATCHES];	/* `flag`, made at its first */
 } control_board_t;
 
 typedef struct control_t {

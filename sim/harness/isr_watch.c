@@ -81,3 +81,49 @@ void isr_watch_clear(isr_watch_t *w)
 	w->count = 0;
 	w->total = 0;
 }
+
+static void flag_watch_pending(struct avr_irq_t *irq, uint32_t value, void *param)
+{
+	flag_watch_t *w = param;
+	uint64_t now = w->avr->cycle;
+
+	(void)irq;
+	if (value) {
+		if (!w->raised) {
+			w->raised = 1;
+			w->since = now;
+		}
+		return;
+	}
+	if (!w->raised) {
+		return;
+	}
+	w->raised = 0;
+	if (now - w->since > w->longest) {
+		w->longest = now - w->since;
+	}
+	w->count++;
+}
+
+int flag_watch_init(flag_watch_t *w, avr_t *avr, int vector)
+{
+	avr_int_table_p t = &avr->interrupts;
+
+	memset(w, 0, sizeof(*w));
+	w->avr = avr;
+	w->vector = vector;
+	for (int i = 0; i < t->vector_count; i++) {
+		if (t->vector[i] && t->vector[i]->vector == vector) {
+			avr_irq_register_notify(&t->vector[i]->irq[AVR_INT_IRQ_PENDING],
+						flag_watch_pending, w);
+			return 0;
+		}
+	}
+	return -1;
+}
+
+void flag_watch_clear(flag_watch_t *w)
+{
+	w->longest = 0;
+	w->count = 0;
+}

@@ -34,4 +34,25 @@ void isr_watch_init(isr_watch_t *w, avr_t *avr, avr_int_vector_t *vect);
 /* Forget what was measured (the counts start again). */
 void isr_watch_clear(isr_watch_t *w);
 
+/*
+ * How long an interrupt's flag stays raised before its handler takes it or
+ * the firmware clears it (a write of 1 to the flag), in cycles: a flag
+ * raised again meanwhile is an event lost (a timer overflow a wrap later
+ * goes uncounted; simavr 1.6 does not tell of that raise, so the longest
+ * time tells: over a wrap). The control request `flag`.
+ */
+typedef struct flag_watch_t {
+	avr_t *avr;
+	int vector;
+	int raised;
+	uint64_t since;		/* cycle it was raised at */
+	uint64_t longest;	/* cycles */
+	uint64_t count;		/* raises taken or cleared */
+} flag_watch_t;
+
+/* Watch vector number VECTOR's flag on AVR: 0, or -1 if it has none. */
+int flag_watch_init(flag_watch_t *w, avr_t *avr, int vector);
+
+void flag_watch_clear(flag_watch_t *w);
+
 #endif
