@@ -5,6 +5,8 @@
 
 #include <stdint.h>
 
+#include "board.h"  /* BOARD_RX_BURST: a hold */
+
 void front_init(void);
 /* One step of the front end's work; when it has none, it calls sys_poll()
  * (the link-loss failsafe): the busy path pays nothing for it. */
@@ -22,9 +24,9 @@ void front_poll(void);
  * held or waits in UDR, to hand on `most` characters at most (about 70
  * cycles each; FRONT_HOLD_ALL: everything); a pending interrupt of higher
  * priority may run instead: the caller allows for the longest. Called with
- * interrupts off, returns with them off, and with the number of
- * characters still held (not 0: `most` ran out before the hold did; a
- * count, not a bool: no compare, 6 bytes).
+ * interrupts off, returns with them off, and (a board with a hold) with
+ * the number of characters still held (not 0: `most` ran out before the
+ * hold did; a count, not a bool: no compare, 6 bytes).
  */
 #define FRONT_HOLD_ALL 0xFF
 
@@ -45,7 +47,14 @@ void front_poll(void);
  * instruction(s). */
 
 void front_rx_hold(void);
-uint8_t front_rx_poll(uint8_t most);
+#ifdef BOARD_RX_BURST
+typedef uint8_t front_rx_left_t;
+#else
+/* No hold: nothing to tell, and no instruction to tell it (the M128-S's
+ * compare interrupts call it at every edge). */
+typedef void front_rx_left_t;
+#endif
+front_rx_left_t front_rx_poll(uint8_t most);
 /* Before such an interrupt returns, after its last front_rx_hold(): what
  * the hold keeps is told to the receive interrupt's fast path (a few
  * cycles; nothing in the I2C slave). */

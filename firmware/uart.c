@@ -153,7 +153,7 @@ void front_rx_held(void)
 	held_tell();
 }
 
-uint8_t front_rx_poll(uint8_t most)
+front_rx_left_t front_rx_poll(uint8_t most)
 {
 	if (held.head != held.tail || (MCU_UCSRA & _BV(RXC))) {
 		held.budget = most;
@@ -185,13 +185,12 @@ void front_rx_held(void)
 {
 }
 
-uint8_t front_rx_poll(uint8_t most)
+front_rx_left_t front_rx_poll(uint8_t most)
 {
 	(void)most;
 	if (MCU_UCSRA & _BV(RXC)) {
 		rx_all_call();
 	}
-	return 0;  /* no hold */
 }
 #endif
 

@@ -183,10 +183,12 @@ void front_rx_hold(void)
 {
 }
 
-uint8_t front_rx_poll(uint8_t most)
+front_rx_left_t front_rx_poll(uint8_t most)
 {
 	(void)most;
-	return 0;
+#ifdef BOARD_RX_BURST
+	return 0;  /* no receiver: nothing held */
+#endif
 }
 
 void front_rx_held(void)
