@@ -325,7 +325,12 @@ static uint8_t __attribute__((noinline)) ab_scan(void)
 		     "	brne 1f\n\t"
 		     "	movw %[p], %[base]\n\t"
 		     "	ldi %[left], %[max]\n\t"
-		     "	ldi %[wr], 1\n"
+		     "	ldi %[wr], 1\n\t"
+		     /* the line busy a ring's runs: progress, the watchdog
+		      * fed (a flood that never left the line quiet kept
+		      * this loop 256 ms and reset the board, again and
+		      * again); this step a cycle longer */
+		     "	wdr\n"
 		     "1:	ldi %A[n], lo8(%[q])\n\t"
 		     "	ldi %B[n], hi8(%[q])\n"
 		     "2:	sbic %[pin], %[bit]\n\t"

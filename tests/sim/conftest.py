@@ -64,6 +64,18 @@ def board_sent(sim: SimBoard, since: int) -> bytes:
                  if e.cycle >= since)
 
 
+def wait_quiet(ctl, port, cycles: int) -> None:
+    """Let the board's time pass until it has sent nothing for two stretches
+    of `cycles` in a row (what came read and dropped): the replies a flood
+    beyond the flow rule left owed (thousands of `ERROR 04`) are out."""
+    quiet = 0
+    while quiet < 2:
+        ctl.wait(cycles)
+        waiting = port.in_waiting
+        port.read(waiting)
+        quiet = 0 if waiting else quiet + 1
+
+
 class Bench:
     """A running simulated board, the open serial port, and helpers."""
 

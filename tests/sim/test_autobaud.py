@@ -10,11 +10,13 @@ own rate, so a wrong rate gets no reply (test_serial_line.py).
 import random
 
 import pytest
+import serial
 
-from conftest import REPLY_TIMEOUT, board_sent, build_gateway, require_builds
+from conftest import REPLY_TIMEOUT, board_sent, build_gateway, require_builds, wait_quiet
 from orfa.errors import ReplyTimeout
 from orfa.protocol import AUTOBAUD_PREAMBLE, AUTOBAUD_RATES, F_CPU
 from orfa.sim import BOARDS, REPO_ROOT, SimBoard
+from orfa.simctl import RX_MAX, SimControlError
 
 EEPROM = 0xA0
 COUNT = {"m32d": "SWAASR07P", "m128s": "SWAASR06P"}
@@ -166,6 +168,40 @@ def test_receive_overflow_is_error_04(board):
         lines = [port.readline().rstrip(b"\r\n").decode() for _ in range(5)]
         assert lines[:4] == [want] * 4 and lines[4] in ("V1.1", "ERROR 04")
         assert gw.request("L") == "LAA"
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_a_flood_before_the_first_reply_ends_in_no_reset(board):
+    """A host that floods the line right after its preamble (V lines back to
+    back at 460800 for 0.6 s, beyond the flow rule), before any reply:
+    while the rate is fresh the idle main loop records the line's runs (a
+    preamble at another rate would move it) until the line is quiet, and
+    the flood never let it be: 256 ms without the watchdog fed, a reset,
+    and again every 256 ms, the board never talking. Each ring's worth of
+    runs now feeds it (firmware/autobaud.c, ab_scan()): no reset, and after
+    the flood (its lost requests answered `ERROR 04`) the board answers."""
+    rate = 460800
+    per_char = 10 * F_CPU // rate
+    blob = b"V\n" * (RX_MAX // 2)
+    with start(board) as sim, serial.Serial(sim.port, rate, timeout=REPLY_TIMEOUT) as port:
+        ctl = sim.control
+        ctl.wait(1000)                      # the simulator reads the port's rate
+        at = ctl.rx_after(1000, AUTOBAUD_PREAMBLE)
+        at = first = ctl.rx(at + F_CPU // 50, blob)    # a host waits 20 ms
+        while at < first + F_CPU * 3 // 5:
+            try:
+                at = ctl.rx(at, blob)
+            except SimControlError as e:
+                if "is past" in str(e):     # the host fell behind: on from now
+                    at = ctl.rx_after(1000, blob)
+                else:                       # the simulator's queue is full
+                    assert "too many" in str(e), e
+                    ctl.wait(8 * RX_MAX * per_char)
+        ctl.wait(at - ctl.time() + F_CPU // 50)
+        wait_quiet(ctl, port, F_CPU // 50)
+        assert sim.trace_events(kinds=["reset"]) == []
+        port.write(b"V\n")
+        assert port.readline() == b"V1.1\r\n"
 
 
 CHECK_ELF = REPO_ROOT / "build" / "sim-fw" / "autobaud_check.elf"

@@ -17,7 +17,7 @@ import pytest
 import serial
 
 from conftest import (REPLY_TIMEOUT, SERVO_FRAME, WIDTH_TOL, board_sent, build_gateway,
-                      require_builds, us_to_cycles)
+                      require_builds, us_to_cycles, wait_quiet)
 from orfa import boardmap
 from orfa.flow import FLOW_WINDOW
 from orfa.gateway import Gateway
@@ -406,14 +406,8 @@ def flood_request(i):
 
 def servo_write_after_a_flood(ctl, port, widths):
     """The 16 channels' widths written once the board has answered the
-    flood (mostly `ERROR 04`, thousands after `V` lines): no reply for two
-    frames of its time."""
-    quiet = 0
-    while quiet < 2:
-        ctl.wait(SERVO_FRAME)
-        waiting = port.in_waiting
-        port.read(waiting)
-        quiet = 0 if waiting else quiet + 1
+    flood (mostly `ERROR 04`, thousands after `V` lines)."""
+    wait_quiet(ctl, port, SERVO_FRAME)
     reg = boardmap.load("m32d").reg("servo", "SP")
     port.write(b"\nSAA%02X%sP\n" % (reg, "".join("%02X%04X" % cw for cw in enumerate(widths)).encode()))
     assert port.readline() == b"SW" + b"A" * 49 + b"P\r\n"
