@@ -4,18 +4,18 @@
 file, function or line, the board's work a step against the step's wire
 time.
 
-    python3 tools/profile.py [--board m32d|m128s] [--baud 230400] [--steps 3]
+    python3 tools/profile.py [--board m32d|m128s] [--baud 230400] [--steps N]
                              [--by file|function|line] [--top N]
 
 The gateway is built with debug information (build/profile/BOARD-BAUD,
 `make FW_DEBUG=-g`: the same code but for a few calls the linker relaxes
 differently, 8 bytes on the M32-D) and runs in the simulator with an
-MPU-6050 on its bus. STEPS steps' requests (each with new servo widths) go
-on the serial line at once, back to back at the rate, so the board is the
-limit, as where the pipelined loop falls short of the wire; the simulator's
-`profile` request (docs/simulator.md) counts every cycle from the first
-start bit to the last reply's stop bit. The same steps are put on the line
-once before, unprofiled, to learn that span. Cycles at lines marked
+MPU-6050 on its bus, at real time (orfa-sim --real-time). The pipelined
+loop (control_loop.timed(), 2 steps submitted ahead) runs WARMUP steps to
+fill its pipeline, then STEPS more; the simulator's `profile` request
+(docs/simulator.md) counts every cycle from the moment the host has step
+WARMUP-1's inputs to the moment it has the last step's (the span
+control_loop.timed() measures for make bench). Cycles at lines marked
 `profile: idle` in the firmware (the main loop looking for a character,
 uart_putc() waiting for room) are the board's idle time, not its work.
 Figures differ by a few hundred cycles from run to run: the timers' phase at
