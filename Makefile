@@ -238,14 +238,15 @@ SIM_LIBS := -lsimavr -lelf -lutil -lpthread -lm
 
 sim: build/sim/orfa-sim build/sim-fw/twi_slave_echo.elf build/sim-fw/twi_slave_echo_m128.elf \
 	build/sim-fw/twi_arb_master.elf build/sim-fw/irq_latency.elf build/sim-fw/autobaud_check.elf \
-	build/sim-fw/profile_loop.elf
+	build/sim-fw/profile_loop.elf build/sim-fw/profile_sleep.elf
 
 # Test firmware for the simulator's bus tests (tests/sim/fw), not ORFA: the
 # echo slave on an ATmega32 at 0x20 and on an ATmega128 at 0x22, a master
 # that loses arbitration (ATmega32), a count of the instructions run after
 # SEI and RETI before a pending interrupt (ATmega32), autobaud's pair
 # analysis against its rule (the M32-D gateway's autobaud.c and rates), a
-# loop of known instructions for the `profile` request (ATmega32).
+# loop of known instructions and a sleeping loop for the `profile` request
+# (ATmega32).
 # Each runs on a board's MCU at its clock (board.h).
 SIM_FW_CFLAGS := -std=gnu99 -Os -Wall -Wextra -Werror
 build/sim-fw/%_m128.elf: tests/sim/fw/%.c

@@ -17,6 +17,13 @@ typedef struct profile_t {
 static profile_t profiles[PROFILE_MAX_BOARDS];
 int profile_boards;
 
+/* The instruction AVR's next cycles belong to: asleep, its SLEEP (one
+ * word; the PC is past it), else the one at the PC. */
+static avr_flashaddr_t profile_pc(const avr_t *avr)
+{
+	return avr->state == cpu_Sleeping ? avr->pc - 2 : avr->pc;
+}
+
 static profile_t *profile_of(avr_t *avr)
 {
 	for (int i = 0; i < PROFILE_MAX_BOARDS; i++) {
@@ -46,7 +53,7 @@ int profile_on(avr_t *avr)
 	for (uint32_t i = 0; i < p->words; i++) {
 		p->cycles[i] = 0;
 	}
-	p->pc = avr->pc;
+	p->pc = profile_pc(avr);
 	p->at = avr->cycle;
 	if (!p->on) {
 		p->on = 1;
@@ -90,6 +97,6 @@ void profile_note_slow(avr_t *avr)
 	if (p->pc / 2 < p->words) {
 		p->cycles[p->pc / 2] += avr->cycle - p->at;
 	}
-	p->pc = avr->pc;
+	p->pc = profile_pc(avr);
 	p->at = avr->cycle;
 }

@@ -15,12 +15,15 @@ from orfa.simctl import SimControlError
 ELF = REPO_ROOT / "build" / "sim-fw" / "profile_loop.elf"
 
 
-def loop_address():
-    if not ELF.is_file():
-        pytest.fail("missing %s: run `make sim`" % ELF, pytrace=False)
-    out = subprocess.run(["avr-nm", str(ELF)], capture_output=True, text=True, check=True).stdout
+SLEEP_ELF = REPO_ROOT / "build" / "sim-fw" / "profile_sleep.elf"
+
+
+def loop_address(elf=ELF, label="profile_loop"):
+    if not elf.is_file():
+        pytest.fail("missing %s: run `make sim`" % elf, pytrace=False)
+    out = subprocess.run(["avr-nm", str(elf)], capture_output=True, text=True, check=True).stdout
     return next(int(f[0], 16) for f in (line.split() for line in out.splitlines())
-                if f[-1] == "profile_loop")
+                if f[-1] == label)
 
 
 def test_each_cycle_counts_once_to_its_instruction():
@@ -37,6 +40,25 @@ def test_each_cycle_counts_once_to_its_instruction():
     nop1, nop2, rjmp = counts[at], counts[at + 2], counts[at + 4]
     # turns of 1 + 1 + 2 cycles, the profile begun and read anywhere in a turn
     assert abs(nop1 - nop2) <= 1 and abs(rjmp - 2 * nop1) <= 2
+
+
+def test_a_sleep_counts_to_its_sleep_instruction():
+    """tests/sim/fw/profile_sleep.c: SLEEP, NOP, RJMP, woken every 262144
+    cycles while other timers fire in each sleep; the sleep's cycles are the
+    SLEEP's (they went to the NOP after it, not yet run, from the first
+    timer in a sleep on)."""
+    at = loop_address(SLEEP_ELF, "profile_sleep")
+    with SimBoard("m32d", control=True, firmware=SLEEP_ELF) as sim:
+        ctl = sim.control
+        ctl.wait(1000)
+        replies = ctl.requests(["profile on", "time", "wait 2000000", "time", "profile"])
+        t0, t1 = int(replies[1]), int(replies[3])
+        counts = {int(a, 16): int(c) for a, _, c in
+                  (x.partition(":") for x in replies[4].split()[1:])}
+    assert sum(counts.values()) == t1 - t0
+    wakes = (t1 - t0) // 262144
+    assert counts[at] > t1 - t0 - 1000
+    assert counts[at + 2] <= wakes + 1 and counts[at + 4] <= 2 * (wakes + 1)
 
 
 def total(reply):
