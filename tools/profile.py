@@ -166,7 +166,8 @@ def main(argv=None):
         elf = build(a.board, a.baud)
         counts, cycles, rx, tx = profile_steps(a.board, a.baud, a.steps, elf)
         rows, idle = classify(counts, elf, a.by)
-    except (ProfileError, OrfaError, SimControlError, OSError, ValueError) as e:
+    except (ProfileError, OrfaError, SimControlError, OSError, ValueError,
+            subprocess.CalledProcessError) as e:
         print("profile: %s" % e, file=sys.stderr)
         return 1
     total = sum(counts.values())

@@ -142,3 +142,20 @@ def test_at_460800_the_characters_alone_fill_the_wire(board, wire):
     work = int(re.match(r"work a step (\d+) cycles, the step's wire %d:" % wire, out[-1]).group(1))
     assert chars >= 0.9 * wire
     assert work > 1.5 * wire
+
+
+def test_the_profile_tool_says_a_failed_binutils_run_in_one_line(monkeypatch, capsys):
+    """avr-nm or avr-addr2line exiting non-zero: exit 1, one line."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("profile_tool", REPO_ROOT / "tools" / "profile.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+
+    def fails(*_):
+        raise subprocess.CalledProcessError(1, ["avr-nm", "orfa.elf"])
+    monkeypatch.setattr(tool, "build", lambda board, baud: "orfa.elf")
+    monkeypatch.setattr(tool, "profile_steps", lambda *_: ({0: 1}, 1, 1, 1))
+    monkeypatch.setattr(tool, "classify", fails)
+    assert tool.main([]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("profile: Command ") and err.count("\n") == 1
