@@ -26,15 +26,20 @@ def loop_address(elf=ELF, label="profile_loop"):
                 if f[-1] == label)
 
 
-def test_each_cycle_counts_once_to_its_instruction():
-    at = loop_address()
-    with SimBoard("m32d", control=True, firmware=ELF) as sim:
+def profiled(elf, cycles):
+    """(cycle at `profile on`, cycle at the read, the counts) of `cycles`
+    cycles of `elf` on an M32-D, profiled in one batch."""
+    with SimBoard("m32d", control=True, firmware=elf) as sim:
         ctl = sim.control
         ctl.wait(1000)
-        replies = ctl.requests(["profile on", "time", "wait 40000", "time", "profile"])
-        t0, t1 = int(replies[1]), int(replies[3])
-        counts = {int(a, 16): int(c) for a, _, c in
-                  (x.partition(":") for x in replies[4].split()[1:])}
+        replies = ctl.requests(["profile on", "time", "wait %d" % cycles, "time", "profile"])
+    return int(replies[1]), int(replies[3]), {int(a, 16): int(c) for a, _, c in
+                                              (x.partition(":") for x in replies[4].split()[1:])}
+
+
+def test_each_cycle_counts_once_to_its_instruction():
+    at = loop_address()
+    t0, t1, counts = profiled(ELF, 40000)
     assert sum(counts.values()) == t1 - t0 >= 40000
     assert set(counts) == {at, at + 2, at + 4}
     nop1, nop2, rjmp = counts[at], counts[at + 2], counts[at + 4]
@@ -48,13 +53,7 @@ def test_a_sleep_counts_to_its_sleep_instruction():
     SLEEP's (they went to the NOP after it, not yet run, from the first
     timer in a sleep on)."""
     at = loop_address(SLEEP_ELF, "profile_sleep")
-    with SimBoard("m32d", control=True, firmware=SLEEP_ELF) as sim:
-        ctl = sim.control
-        ctl.wait(1000)
-        replies = ctl.requests(["profile on", "time", "wait 2000000", "time", "profile"])
-        t0, t1 = int(replies[1]), int(replies[3])
-        counts = {int(a, 16): int(c) for a, _, c in
-                  (x.partition(":") for x in replies[4].split()[1:])}
+    t0, t1, counts = profiled(SLEEP_ELF, 2000000)
     assert sum(counts.values()) == t1 - t0
     wakes = (t1 - t0) // 262144
     assert counts[at] > t1 - t0 - 1000
