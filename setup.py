@@ -78,8 +78,11 @@ def build_artefacts():
     build = ROOT / "build"
     files = {"_sim/orfa-sim": build / "sim" / "orfa-sim"}
     # the rates `make gate-rates` built (the Makefile's GATE_RATES)
-    rates = subprocess.run(["make", "-s", "--no-print-directory", "print-gate-rates"], cwd=str(ROOT),
-                           capture_output=True, text=True).stdout.split()
+    asked = subprocess.run(["make", "-s", "--no-print-directory", "print-gate-rates"], cwd=str(ROOT),
+                           capture_output=True, text=True)
+    rates = asked.stdout.split()
+    if asked.returncode or not rates:
+        fail("`make print-gate-rates` failed in %s: %s" % (ROOT, asked.stderr.strip() or "no rates"))
     for board in BOARDS:
         for mode in MODES:
             for name in ("orfa.elf", "orfa.hex"):

@@ -698,11 +698,10 @@ def print_watchdog(boards, width):
 # Kept in one block, called once from main(), so it merges apart from the rest.
 
 def autobaud_elf(board):
-    """The BAUD=auto gateway of `board`, built into build/bench-auto/."""
-    out = "build/bench-auto/%s-gate" % board
-    subprocess.run(["make", "--no-print-directory", "-s", "BOARD=" + board, "MODE=gate",
-                    "BAUD=auto", "BUILD=" + out], cwd=ROOT, check=True)
-    return ROOT / out / "orfa.elf"
+    """The BAUD=auto gateway of `board` (orfa.locate.gateway_firmware:
+    build/<board>-gate-auto/, made when out of date)."""
+    from orfa.locate import gateway_firmware
+    return gateway_firmware(board, "auto")
 
 
 def autobaud_detection(board, rate, elf):

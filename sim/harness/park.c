@@ -13,7 +13,6 @@
 
 #include "harness/avr_step.h"
 #include "harness/park_op.h"
-#include "harness/profile.h"
 
 #define PARK_BACKOFF_MIN 16
 #define PARK_BACKOFF_MAX 128
@@ -256,7 +255,6 @@ static int park_watch_one(park_t *p, avr_t *avr)
 		park_timers(&before, avr);
 	}
 	park_note_cells(p, &o);
-	profile_note(avr);
 	new_pc = avr_run_one(avr);
 	avr_step_after(avr, new_pc);
 	if (avr->state != cpu_Running || avr->interrupt_state || avr->pc != new_pc) {

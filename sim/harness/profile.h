@@ -1,7 +1,8 @@
 /*
  * profile.h: where a board's cycles go (the `profile` control request):
  * the simulated cycles spent at each flash word while profiling is on,
- * counted from the run loop before each instruction (avr_step.c, park.c).
+ * counted from the run loop before each instruction (avr_step.c; no board
+ * is parked, nor watched for parking, while one is profiled: park.c).
  * Every cycle between two instructions counts to the first of them: its
  * own cycles, and an interrupt's entry that follows it (4 cycles), or its
  * sleep. tools/profile.py turns the counts into a table by function,

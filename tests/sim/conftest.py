@@ -9,7 +9,6 @@ sees another's state. Each simulator has its own temp dir and link path.
 import contextlib
 import math
 import re
-import subprocess
 import time
 from pathlib import Path
 
@@ -18,6 +17,7 @@ import pytest
 from orfa import boardmap
 from orfa import protocol as p
 from orfa.gateway import Gateway
+from orfa.locate import gateway_firmware
 from orfa.sim import BOARDS, BUILD_HINT, SimBoard, missing_builds
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -39,21 +39,19 @@ def require_builds(boards=BOARDS):
 
 
 def build_gateway(board: str, baud) -> Path:
-    """A gateway firmware for `board` at `baud` (a rate, or "auto"), built
-    once per session into build/test-baud/<board>-<baud>/ (the default
-    builds stay as they are); its ELF."""
-    out = ROOT / "build" / "test-baud" / ("%s-%s" % (board, baud))
-    if out not in _BUILT:
-        r = subprocess.run(["make", "--no-print-directory", "-s", "BOARD=" + board, "MODE=gate",
-                            "BAUD=%s" % baud, "BUILD=%s" % out.relative_to(ROOT)],
-                           cwd=ROOT, capture_output=True, text=True, timeout=300)
-        if r.returncode != 0:
-            pytest.fail("building %s BAUD=%s failed:\n%s" % (board, baud, r.stderr), pytrace=False)
-        _BUILT.add(out)
-    return out / "orfa.elf"
+    """A gateway firmware for `board` at `baud` (a rate, or "auto"): the one
+    `orfa --sim` runs at that rate (orfa.locate.gateway_firmware: the
+    default build at 115200, else build/<board>-gate-<baud>/, made once per
+    session); its ELF."""
+    if (board, baud) not in _BUILT:
+        try:
+            _BUILT[(board, baud)] = gateway_firmware(board, baud)
+        except ValueError as exc:
+            pytest.fail(str(exc), pytrace=False)
+    return _BUILT[(board, baud)]
 
 
-_BUILT = set()
+_BUILT = {}
 
 
 def board_sent(sim: SimBoard, since: int) -> bytes:
@@ -69,11 +67,19 @@ def wait_quiet(ctl, port, cycles: int) -> None:
     of `cycles` in a row (what came read and dropped): the replies a flood
     beyond the flow rule left owed (thousands of `ERROR 04`) are out."""
     quiet = 0
-    while quiet < 2:
+    for _ in range(WAIT_QUIET_TURNS):
         ctl.wait(cycles)
         waiting = port.in_waiting
         port.read(waiting)
         quiet = 0 if waiting else quiet + 1
+        if quiet == 2:
+            return
+    pytest.fail("the board still sends after %d stretches of %d cycles" % (WAIT_QUIET_TURNS, cycles),
+                pytrace=False)
+
+
+#: wait_quiet()'s bound: a board that never stops sending fails, not hangs
+WAIT_QUIET_TURNS = 500
 
 
 class Bench:

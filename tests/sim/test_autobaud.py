@@ -2,7 +2,7 @@
 the PC's rate from the eight 0x0D of the preamble, at every one of the ten
 rates on both boards, also after noise, and then talks normally.
 
-The autobaud builds go to build/test-baud/<board>-auto/ (the default
+The autobaud builds go to build/<board>-gate-auto/ (the default
 fixed-rate build stays); the simulator's serial line decodes at each end's
 own rate, so a wrong rate gets no reply (test_serial_line.py).
 """

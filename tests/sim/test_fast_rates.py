@@ -1,6 +1,6 @@
 """The serial rates beyond 115200 (docs/protocol.md, "The line"): 230400 and
 460800 baud, UBRR 1 and 0 at 7.3728 MHz, fixed-rate gateway builds on both
-boards (built once into build/test-baud/).
+boards (built into build/<board>-gate-<rate>/, as `orfa --sim` runs them).
 
 The pipelined runs are a host that follows the flow rule: fewer than
 FLOW_WINDOW characters of requests unanswered, each request put on the line

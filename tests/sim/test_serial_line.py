@@ -3,7 +3,7 @@ rate comes from its port's termios, RXD shows the PC's bit waveform, and
 each end decodes the other's bits at its own rate, so a PC at the wrong rate
 gets garbage or nothing, as on a real line; equal rates behave as before.
 
-Fixed-rate firmware at other rates is built once into build/test-baud/.
+Fixed-rate firmware at other rates is built into build/<board>-gate-<rate>/.
 """
 
 import pytest
