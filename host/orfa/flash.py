@@ -22,7 +22,7 @@ from typing import List, Optional, Sequence
 
 from . import boardmap, ihex
 from .errors import FlashError
-from .locate import firmware_dirs, firmware_path
+from .locate import firmware_dirs, firmware_path, gateway_firmware
 
 PROGRAMMER = "usbasp"
 MODES = ("gate", "slave")
@@ -109,11 +109,13 @@ def slave_elf(board: str, addr: int) -> Path:
 
 
 def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str,
-                 addr: Optional[int] = None) -> Path:
+                 addr: Optional[int] = None, rate=None) -> Path:
     """The Intel HEX to write: `given` (an ELF is converted), else the build's
     .hex if it is as new as its ELF, else that ELF converted (a .hex older
     than its ELF, or none: an ELF given by ORFA_FIRMWARE alone). Conversions go to `tmpdir`.
-    With `addr` (slave mode): the slave build that answers on it (slave_elf)."""
+    With `addr` (slave mode): the slave build that answers on it (slave_elf).
+    With `rate` (gate mode: a serial rate or "auto"): the gateway built for
+    it (orfa.locate.gateway_firmware: build/<board>-gate-<rate>/)."""
     if given:
         path = Path(given)
         try:
@@ -128,6 +130,12 @@ def firmware_hex(board: str, mode: str, given: Optional[str], tmpdir: str,
         return path
     if addr is not None:
         elf = slave_elf(board, addr)
+        hex_path = elf.with_suffix(".hex")
+    elif rate is not None:
+        try:
+            elf = gateway_firmware(board, rate)
+        except ValueError as exc:
+            raise FlashError(str(exc)) from None
         hex_path = elf.with_suffix(".hex")
     else:
         elf = firmware_path(board, mode)
@@ -198,12 +206,20 @@ def cmd_flash(args) -> int:
             print("orfa: --addr picks the slave build that answers on it: it goes with"
                   " --mode slave, not %s" % clash, file=sys.stderr)
             return EXIT_SETUP
+    if args.rate is not None:
+        clash = ("--mode slave" if args.mode == "slave" else "--hex" if args.hex
+                 else "--fuses" if args.fuses else None)
+        if clash:
+            print("orfa: --rate picks the gateway built for that serial rate: it goes with"
+                  " --mode gate, not %s" % clash, file=sys.stderr)
+            return EXIT_SETUP
     try:
         with tempfile.TemporaryDirectory(prefix="orfa-flash-") as tmpdir:
             if args.fuses:
                 argv = fuses_argv(args.board, **kw)
             else:
-                hex_path = firmware_hex(args.board, args.mode, args.hex, tmpdir, args.addr)
+                hex_path = firmware_hex(args.board, args.mode, args.hex, tmpdir, args.addr,
+                                        args.rate)
                 argv = flash_argv(args.board, str(hex_path), **kw)
             if args.dry_run:
                 print(shlex.join(argv))
@@ -226,6 +242,21 @@ def _number(text: str) -> int:
         raise argparse.ArgumentTypeError("%r is not a number (0x10)" % text) from None
 
 
+def _rate(text: str):
+    """--rate: "auto", or a rate in baud (whether a gateway is built for it
+    is firmware_hex's to say)."""
+    if text == "auto":
+        return text
+    try:
+        rate = int(text)
+    except ValueError:
+        rate = 0
+    if rate <= 0:
+        import argparse
+        raise argparse.ArgumentTypeError("%r is not a serial rate (460800) or auto" % text)
+    return rate
+
+
 def add_parser(subparsers) -> None:
     """Register `flash` on an argparse subparsers object."""
     p = subparsers.add_parser(
@@ -243,6 +274,11 @@ def add_parser(subparsers) -> None:
                         " on (default: the packaged build's, 0x%02X); another address"
                         " takes the test robot's build robot/<board>-<ADDR> (make robot)"
                         " or says how to build one" % SLAVE_ADDR)
+    p.add_argument("--rate", type=_rate, metavar="BAUD",
+                   help="with --mode gate: the gateway built for this serial rate"
+                        " (230400, 460800, auto: the packaged builds, make gate-rates;"
+                        " in the source tree any rate make takes is built first);"
+                        " default: the 115200 build")
     what = p.add_mutually_exclusive_group()
     what.add_argument("--hex", metavar="FILE",
                       help="the Intel HEX (or ELF, converted to a temporary .hex)"

@@ -269,6 +269,32 @@ def test_orfa_flash_dry_run_prints_the_command_only(avrdude, built):
     assert avrdude.calls() == []
 
 
+def test_orfa_flash_rate_writes_the_gateway_built_for_it(avrdude, built):
+    """--rate picks build/<board>-gate-<rate>/ (made first in the source
+    tree), the default rate the default build; a rate make refuses, a word
+    that is no rate and a slave's mode are one line each, exit 2."""
+    r = orfa(avrdude, "--rate", "460800", "--dry-run")
+    assert (r.returncode, r.stderr) == (0, "")
+    assert r.stdout == "avrdude -c usbasp -p m32 -U flash:w:build/m32d-gate-460800/orfa.hex:i\n"
+    r = orfa(avrdude, "--board", "m128s", "--rate", "auto")
+    assert r.returncode == 0, r.stderr
+    assert avrdude.calls() == [expected("m128s", "usbasp", None,
+                                        "flash:w:build/m128s-gate-auto/orfa.hex:i")]
+    r = orfa(avrdude, "--rate", "115200", "--dry-run")
+    assert r.stdout == "avrdude -c usbasp -p m32 -U flash:w:build/m32d-gate/orfa.hex:i\n"
+    for args, err in [
+            (["--rate", "921600"], "orfa: no m32d gateway at 921600 baud: BAUD=921600 is refused: "),
+            (["--rate", "460800", "--mode", "slave"],
+             "orfa: --rate picks the gateway built for that serial rate: it goes with --mode"
+             " gate, not --mode slave"),
+            (["--rate", "fast"], "orfa flash: error: argument --rate: 'fast' is not a serial"
+                                 " rate (460800) or auto")]:
+        r = orfa(avrdude, *args)
+        assert r.returncode == 2 and r.stdout == "", args
+        assert r.stderr.startswith(err) and len(r.stderr.splitlines()) == 1, r.stderr
+    assert len(avrdude.calls()) == 1
+
+
 def test_orfa_flash_without_avrdude_is_one_clear_line(avrdude, built, tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()

@@ -232,6 +232,11 @@ def test_orfa_flash_writes_the_packages_hex(installed, tmp_path):
     hex_path = installed.site / "orfa" / "_firmware" / "m128s-slave" / "orfa.hex"
     assert r.stdout == "avrdude -c usbasp -p %s -U flash:w:%s:i\n" % (
         boardmap.load("m128s").avrdude_part, hex_path), r.stdout
+    # a gateway for a fast rate: the package's build of it (make gate-rates)
+    r = run([installed.bin / "orfa", "flash", "--dry-run", "--rate", "460800"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    hex_path = installed.site / "orfa" / "_firmware" / "m32d-gate-460800" / "orfa.hex"
+    assert r.stdout == "avrdude -c usbasp -p m32 -U flash:w:%s:i\n" % hex_path, r.stdout
 
 
 def test_issue_commands_run_from_the_venv(installed, tmp_path):
