@@ -132,7 +132,7 @@ $(error MODE=$(MODE): use MODE=gate (serial gateway) or MODE=slave (I2C slave at
 endif
 FW_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(FW_SRC))
 
-.PHONY: map map-board print-baud-rates print-autobaud-rates print-gate-rates firmware flash fuses all-boards gate-rates robot size sim unit fuzz fuzz-short test bench soak demo demo-robot doc-images clean setup
+.PHONY: map map-board print-baud-rates print-autobaud-rates print-gate-rates firmware flash fuses all-boards gate-rates robot size sim unit fuzz fuzz-short test bench profile soak demo demo-robot doc-images clean setup
 .DEFAULT_GOAL := firmware
 
 firmware: $(BUILD)/orfa.elf $(BUILD)/orfa.hex
@@ -299,6 +299,13 @@ doc-images:
 bench: setup
 	@$(MAKE) --no-print-directory all-boards robot sim
 	python3 tools/bench.py
+
+# Where a gateway's cycles go in the robot control loop (tools/profile.py): a
+# table by source file for each board at each rate above 115200.
+profile: setup
+	@$(MAKE) --no-print-directory sim
+	@set -e; for b in $(BOARDS); do for r in 230400 460800; do \
+		python3 tools/profile.py --board $$b --baud $$r; echo; done; done
 
 # Seeded random requests against a simulated robot, every reply compared with
 # the reference model of the protocol (tests/sim/spec_model.py); docs/testing.md.
