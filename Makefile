@@ -304,7 +304,7 @@ bench: setup
 # table by source file for each board at each rate above 115200.
 profile: setup
 	@$(MAKE) --no-print-directory sim
-	@set -e; for b in $(BOARDS); do for r in 230400 460800; do \
+	@set -e; for b in $(BOARDS); do for r in $(filter-out auto,$(GATE_RATES)); do \
 		python3 tools/profile.py --board $$b --baud $$r; echo; done; done
 
 # Seeded random requests against a simulated robot, every reply compared with

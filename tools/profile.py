@@ -38,11 +38,13 @@ sys.path[:0] = [str(ROOT / "host"), str(ROOT / "examples")]
 import control_loop as cl  # noqa: E402
 from orfa import Board, OrfaError  # noqa: E402
 from orfa.gateway import Gateway  # noqa: E402
-from orfa.protocol import F_CPU  # noqa: E402
+from orfa.locate import make_gateway  # noqa: E402
+from orfa.protocol import BAUD_RATES, DEFAULT_BAUD, F_CPU  # noqa: E402
 from orfa.sim import SimBoard  # noqa: E402
 from orfa.simctl import SimControlError  # noqa: E402
 
-RATES = (115200, 230400, 460800)
+#: the control loop's rates (make bench's): the default and those above it
+RATES = tuple(r for r in BAUD_RATES if r >= DEFAULT_BAUD)
 IDLE_MARK = "profile: idle"
 #: steps run before the profile starts (the pipeline filled)
 WARMUP = 5
@@ -53,14 +55,10 @@ class ProfileError(Exception):
 
 
 def build(board, baud):
-    out = "build/profile/%s-%d" % (board, baud)
-    r = subprocess.run(["make", "-s", "--no-print-directory", "BOARD=" + board, "MODE=gate",
-                        "BAUD=%d" % baud, "BUILD=" + out, "FW_DEBUG=-g"], cwd=ROOT,
-                       capture_output=True, text=True)
-    if r.returncode:
-        raise ProfileError("no %s gateway at %d baud: %s" % (
-            board, baud, (r.stderr.strip().splitlines() or ["make failed"])[-1]))
-    return ROOT / out / "orfa.elf"
+    try:
+        return make_gateway(board, baud, "build/profile/%s-%d" % (board, baud), "FW_DEBUG=-g")
+    except ValueError as exc:
+        raise ProfileError(str(exc)) from None
 
 
 def profile_steps(board, baud, steps, elf):

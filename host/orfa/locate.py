@@ -68,28 +68,35 @@ def firmware_path(board: str, mode: str = "gate") -> Path:
     return _first_file([d / ("%s-%s" % (board, mode)) / "orfa.elf" for d in firmware_dirs()])
 
 
+def make_gateway(board: str, baud, build: str, *make_vars: str) -> Path:
+    """`make BOARD=<board> MODE=gate BAUD=<baud> BUILD=<build>` (and
+    `make_vars`, e.g. FW_DEBUG=-g) in the work tree; the ELF. ValueError
+    with one line when make refuses (its reason: 921600, a rate the line
+    has not)."""
+    import subprocess
+    made = subprocess.run(["make", "-s", "--no-print-directory", "BOARD=" + board, "MODE=gate",
+                           "BAUD=%s" % baud, "BUILD=" + build] + list(make_vars),
+                          cwd=REPO_ROOT, capture_output=True, text=True)
+    if made.returncode:
+        why = (made.stderr.strip().splitlines() or ["make failed"])[-1]
+        why = why.split("*** ", 1)[-1].replace("  Stop.", "")
+        raise ValueError("no %s gateway at %s baud: %s" % (board, baud, why))
+    return REPO_ROOT / build / "orfa.elf"
+
+
 def gateway_firmware(board: str, baud) -> Path:
     """The gateway ELF of `board` that talks at `baud` (a rate, or "auto":
     the autobaud build): at the protocol's default rate the default build
     (firmware_path), else <board>-gate-<baud>/orfa.elf in the firmware
     directories. In the work tree (ORFA_FIRMWARE unset) that one is made
-    with `make BOARD=<board> MODE=gate BAUD=<baud>` when missing or out of
-    date. ValueError with one line when there is none for that rate (make's
-    reason where it refuses the rate: 921600, or one the line has not)."""
+    (make_gateway) when missing or out of date. ValueError with one line
+    when there is none for that rate."""
     from .protocol import DEFAULT_BAUD
     if baud == DEFAULT_BAUD:
         return firmware_path(board, "gate")
     name = "%s-gate-%s" % (board, baud)
     if _env_path(FIRMWARE_ENV) is None and in_work_tree():
-        import subprocess
-        made = subprocess.run(["make", "-s", "--no-print-directory", "BOARD=" + board,
-                               "MODE=gate", "BAUD=%s" % baud, "BUILD=build/" + name],
-                              cwd=REPO_ROOT, capture_output=True, text=True)
-        if made.returncode:
-            why = (made.stderr.strip().splitlines() or ["make failed"])[-1]
-            why = why.split("*** ", 1)[-1].replace("  Stop.", "")
-            raise ValueError("no %s gateway at %s baud: %s" % (board, baud, why))
-        return REPO_ROOT / "build" / name / "orfa.elf"
+        return make_gateway(board, baud, "build/" + name)
     path = _first_file([d / name / "orfa.elf" for d in firmware_dirs()])
     if not path.is_file():
         raise ValueError("no %s gateway at %s baud: %s is not there (make BOARD=%s MODE=gate "

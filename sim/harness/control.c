@@ -16,10 +16,10 @@
 #include <sys/un.h>
 #include <unistd.h>
 
-#include "harness/profile.h"
 #include "harness/control.h"
 #include "harness/fault.h"
 #include "harness/isr_watch.h"
+#include "harness/profile.h"
 #include "boards/sram.h"
 #include "parts/part.h"
 
@@ -501,16 +501,15 @@ static int req_flag(control_req_ctx_t *q)
 {
 	control_board_t *cb = q->cb;
 	flag_watch_t *w = NULL;
-	char *end;
-	long n = strtol(q->argv[1], &end, 10);
+	uint64_t n;
 
-	if (end == q->argv[1] || *end || n < 1 || n > 255 ||
+	if (parse_u64(q->argv[1], &n) < 0 || n < 1 || n > 255 ||
 	    (q->argc == 3 && strcasecmp(q->argv[2], "clear"))) {
 		return CONTROL_WRONG;
 	}
 	int i = 0;
 	for (; i < CONTROL_FLAG_WATCHES && cb->flags[i]; i++) {
-		if (cb->flags[i]->vector == n) {
+		if (cb->flags[i]->vector == (int)n) {
 			w = cb->flags[i];
 			break;
 		}
@@ -523,7 +522,7 @@ static int req_flag(control_req_ctx_t *q)
 		w = calloc(1, sizeof(*w));
 		if (!w || flag_watch_init(w, cb->avr, (int)n) < 0) {
 			free(w);
-			reply_printf(q->r, "ERR flag: no vector %ld on this board", n);
+			reply_printf(q->r, "ERR flag: no vector %d on this board", (int)n);
 			return 0;
 		}
 		cb->flags[i] = w;

@@ -89,10 +89,11 @@ static void flag_watch_pending(struct avr_irq_t *irq, uint32_t value, void *para
 
 	(void)irq;
 	if (value) {
-		if (!w->raised) {
-			w->raised = 1;
-			w->since = now;
-		}
+		/* simavr tells of a raise only when the flag was down: one while
+		 * it is held raised here was cleared unseen (a reset clears the
+		 * flags without telling), so it counts from now */
+		w->raised = 1;
+		w->since = now;
 		return;
 	}
 	if (!w->raised) {

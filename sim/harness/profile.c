@@ -2,6 +2,7 @@
 #include "harness/profile.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 #define PROFILE_MAX_BOARDS 16
 
@@ -50,9 +51,7 @@ int profile_on(avr_t *avr)
 		}
 		p->avr = avr;
 	}
-	for (uint32_t i = 0; i < p->words; i++) {
-		p->cycles[i] = 0;
-	}
+	memset(p->cycles, 0, p->words * sizeof *p->cycles);
 	p->pc = profile_pc(avr);
 	p->at = avr->cycle;
 	if (!p->on) {
