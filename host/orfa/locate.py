@@ -72,11 +72,18 @@ def make_gateway(board: str, baud, build: str, *make_vars: str) -> Path:
     """`make BOARD=<board> MODE=gate BAUD=<baud> BUILD=<build>` (and
     `make_vars`, e.g. FW_DEBUG=-g) in the work tree; the ELF. ValueError
     with one line when make refuses (its reason: 921600, a rate the line
-    has not)."""
+    has not). One make at a time in the work tree: two programs that ask
+    for the same build at once (two `orfa sim --baud 460800`) would write
+    its files together, and one of them fail."""
+    import fcntl
     import subprocess
-    made = subprocess.run(["make", "-s", "--no-print-directory", "BOARD=" + board, "MODE=gate",
-                           "BAUD=%s" % baud, "BUILD=" + build] + list(make_vars),
-                          cwd=REPO_ROOT, capture_output=True, text=True)
+    lock_path = REPO_ROOT / "build" / ".make-gateway.lock"
+    lock_path.parent.mkdir(parents=True, exist_ok=True)
+    with open(lock_path, "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        made = subprocess.run(["make", "-s", "--no-print-directory", "BOARD=" + board,
+                               "MODE=gate", "BAUD=%s" % baud, "BUILD=" + build] + list(make_vars),
+                              cwd=REPO_ROOT, capture_output=True, text=True)
     if made.returncode:
         why = (made.stderr.strip().splitlines() or ["make failed"])[-1]
         why = why.split("*** ", 1)[-1].replace("  Stop.", "")

@@ -2,6 +2,7 @@
 (ORFA_SIM / ORFA_FIRMWARE, the installed package's copies, the work tree's
 build/), and what the hint says in each case."""
 
+import os
 from pathlib import Path
 
 import pytest
@@ -105,6 +106,21 @@ def test_a_gateway_for_a_rate_is_made_in_the_work_tree():
         locate.gateway_firmware("m32d", 921600)
     assert str(exc.value).startswith("no m32d gateway at 921600 baud: BAUD=921600 is refused: ")
     assert "\n" not in str(exc.value) and "Stop" not in str(exc.value)
+
+
+def test_two_programs_asking_for_one_build_at_once_both_get_it():
+    """Two makes of one new build directory at once (two `orfa sim --baud R`
+    started together) wrote its files together: one failed on the other's
+    half-written configuration. make_gateway takes them one at a time."""
+    import shutil
+    from concurrent.futures import ThreadPoolExecutor
+    build = "build/test-locate-%d" % os.getpid()
+    try:
+        with ThreadPoolExecutor(2) as pool:
+            elfs = list(pool.map(lambda _: locate.make_gateway("m32d", 230400, build), range(2)))
+        assert elfs == [locate.REPO_ROOT / build / "orfa.elf"] * 2 and elfs[0].is_file()
+    finally:
+        shutil.rmtree(locate.REPO_ROOT / build, ignore_errors=True)
 
 
 def test_a_gateway_for_a_rate_outside_the_work_tree(package, monkeypatch, tmp_path):
