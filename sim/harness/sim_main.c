@@ -680,10 +680,15 @@ static int sim_run(sim_t *sim)
 		size_t room = usart_host_room(&sim->gateway.usart);
 		size_t n;
 
-		/* The PC's rate, before its bytes go on the line (and before a
-		 * control client schedules some with `rx`). */
-		usart_set_host_baud(&sim->gateway.usart, pty_baud(&sim->pty));
 		n = pty_read(&sim->pty, buf, room < sizeof(buf) ? room : sizeof(buf));
+		/* The PC's rate, before its bytes go on the line (and before a
+		 * control client schedules some with `rx`), looked up after
+		 * they are read: a program sets its rate, then writes, so the
+		 * rate seen now is the one its bytes were written at. Looked up
+		 * before the read, a program that did both in between (pyserial
+		 * opening the port and writing at once) had its first bytes put
+		 * on the line at the pty's old rate, all framing errors. */
+		usart_set_host_baud(&sim->gateway.usart, pty_baud(&sim->pty));
 		if (n) {
 			usart_host_send(&sim->gateway.usart, buf, n);
 		}
