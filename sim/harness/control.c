@@ -135,6 +135,18 @@ static int parse_hex(const char *s, uint8_t *out, size_t *n, size_t max)
 
 /* --- commands -------------------------------------------------------------- */
 
+/* The PC's rate as its port's termios say now (docs/simulator.md): read by
+ * the run loop as it takes the PC's bytes, and again by the requests that
+ * go by it, for a program may set its rate just before it asks (pyserial's
+ * open, then `rx`): read a moment before, `rx` put its bytes on the line at
+ * the old rate. */
+static void pc_rate_now(control_t *c)
+{
+	if (c->pty) {
+		usart_set_host_baud(c->usart, pty_baud(c->pty));
+	}
+}
+
 /* Schedule bytes on the board's receive line: `rx CYCLE HEX...`. */
 static void cmd_rx(control_t *c, reply_t *r, int argc, char **argv)
 {
@@ -184,6 +196,7 @@ static void cmd_rx(control_t *c, reply_t *r, int argc, char **argv)
 		   n, room, (unsigned)USART_INJECT_QUEUE);
 		return;
 	}
+	pc_rate_now(c);
 	end = usart_inject(c->usart, at, bytes, n);
 	reply_printf(r, "%" PRIu64, end);
 }
@@ -665,6 +678,7 @@ static int req_line(control_req_ctx_t *q)
 {
 	usart_t *u = q->c->usart;
 
+	pc_rate_now(q->c);
 	reply_printf(q->r, "pc %u bit %u board %u ubrr %u rxen %d since %" PRIu64 " fe %u pty %u dor %u",
 		     (unsigned)u->host_baud, (unsigned)u->host_bit, (unsigned)usart_board_bit(u),
 		     (unsigned)u->ubrr, usart_rxen(u), (uint64_t)u->rxen_since,

@@ -14,6 +14,7 @@
 #include "sim_avr.h"
 
 #include "boards/board_model.h"
+#include "periph/pty.h"
 #include "periph/twi_bus.h"
 #include "periph/usart.h"
 #include "parts/part.h"
@@ -60,6 +61,7 @@ typedef struct control_t {
 	control_board_t board[CONTROL_MAX_BOARDS];
 	int nboards;
 	usart_t *usart;			/* the board's serial port (`rx`) */
+	const pty_t *pty;		/* the PC's port: its rate, read at `rx` and `line` */
 	control_client_t client[CONTROL_CLIENTS];
 	uint32_t activity;		/* bumps on every request */
 	twi_bus_t *bus;			/* the I2C bus (`i2c`) */

@@ -601,6 +601,7 @@ static int sim_build(sim_t *sim, const sim_args_t *args)
 			strerror(errno));
 		return 2;
 	}
+	sim->control.pty = &sim->pty;
 	for (int i = 1; i < w->nboards; i++) {
 		control_add_board(&sim->control, w->boards[i]->addr, w->boards[i]->avr,
 				  &w->boards[i]->bm);
@@ -681,13 +682,13 @@ static int sim_run(sim_t *sim)
 		size_t n;
 
 		n = pty_read(&sim->pty, buf, room < sizeof(buf) ? room : sizeof(buf));
-		/* The PC's rate, before its bytes go on the line (and before a
-		 * control client schedules some with `rx`), looked up after
-		 * they are read: a program sets its rate, then writes, so the
-		 * rate seen now is the one its bytes were written at. Looked up
-		 * before the read, a program that did both in between (pyserial
-		 * opening the port and writing at once) had its first bytes put
-		 * on the line at the pty's old rate, all framing errors. */
+		/* The PC's rate, before its bytes go on the line, looked up
+		 * after they are read: a program sets its rate, then writes, so
+		 * the rate seen now is the one its bytes were written at. Looked
+		 * up before the read, a program that did both in between
+		 * (pyserial opening the port and writing at once) had its first
+		 * bytes put on the line at the pty's old rate, all framing
+		 * errors. `rx` and `line` look it up again (control.c). */
 		usart_set_host_baud(&sim->gateway.usart, pty_baud(&sim->pty));
 		if (n) {
 			usart_host_send(&sim->gateway.usart, buf, n);
