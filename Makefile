@@ -20,7 +20,9 @@
 
 BOARD ?= m32d
 MODE ?= gate
-BAUD ?= 115200
+# The line's rate after reset (docs/protocol.md; host/orfa/protocol.py's DEFAULT_BAUD).
+DEFAULT_BAUD := 115200
+BAUD ?= $(DEFAULT_BAUD)
 ADDR ?= 0x10
 
 BOARDS := m32d m128s
@@ -40,6 +42,12 @@ ifeq ($(filter $(BAUD),$(BAUD_RATES) auto),)
 $(error BAUD=$(BAUD) is not a rate of the line: use one of $(BAUD_RATES), or auto)
 endif
 MODES := gate slave
+# A slave has no serial port: BAUD is the gateway's, and a slave build is the
+# same whatever it says (FW_BAUD below). Said once when
+# given on make's own command line; a rate make refuses is refused here too.
+ifeq ($(MODE)$(origin BAUD)$(MAKELEVEL),slavecommand line0)
+$(info make: BAUD=$(BAUD) ignored: MODE=slave has no serial port (the gateway's BAUD sets the line's rate))
+endif
 
 ifeq ($(wildcard boards/$(BOARD)/board.mk),)
 $(error BOARD=$(BOARD): no such board (boards/: $(notdir $(wildcard boards/*))))
@@ -90,7 +98,11 @@ endif
 DRIVERS ?= $(BOARD_DRIVERS)
 
 # BUILD=dir puts one more build elsewhere (the test robot's slaves at their addresses).
-BUILD ?= build/$(BOARD)-$(MODE)
+# A gateway at a rate other than the default goes to build/<board>-gate-<BAUD>/
+# (gate-rates' builds, where orfa.locate.gateway_firmware, `orfa --sim B --baud R`
+# and `orfa flash --rate R` find it): build/<board>-gate/ is always the
+# default rate's, the one a program opening the port at 115200 runs.
+BUILD ?= build/$(BOARD)-$(MODE)$(if $(and $(filter gate,$(MODE)),$(filter-out $(DEFAULT_BAUD),$(BAUD))),-$(BAUD))
 # -fno-move-loop-invariants -mstrict-X: 130 bytes less on the M32-D gateway,
 # no slower where it counts (make bench). -mcall-prologues: register saves
 # through one shared routine, 250 bytes less; interrupt handlers keep their
@@ -101,9 +113,12 @@ CC := avr-gcc
 OBJCOPY := avr-objcopy
 AVR_SIZE := avr-size
 
+# The rate compiled in: BAUD's for a gateway; a slave's is the default, whatever
+# BAUD says (no serial port: its build is the same).
+FW_BAUD := $(if $(filter gate,$(MODE)),$(BAUD),$(DEFAULT_BAUD))
 FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) \
-	$(if $(filter auto,$(BAUD)),'-DORFA_BAUD_RATES(X)=$(foreach r,$(AUTOBAUD_RATES),X($(r)))',-DORFA_BAUD=$(BAUD)) \
-	-DORFA_BAUD_TOP=$(if $(filter auto,$(BAUD)),$(lastword $(AUTOBAUD_RATES)),$(BAUD)) \
+	$(if $(filter auto,$(FW_BAUD)),'-DORFA_BAUD_RATES(X)=$(foreach r,$(AUTOBAUD_RATES),X($(r)))',-DORFA_BAUD=$(FW_BAUD)) \
+	-DORFA_BAUD_TOP=$(if $(filter auto,$(FW_BAUD)),$(lastword $(AUTOBAUD_RATES)),$(FW_BAUD)) \
 	-DORFA_ADDR=$(ADDR) -DORFA_MODE_$(MODE) \
 	-std=gnu99 $(FW_OPT) $(FW_DEBUG) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
 	-fshort-enums -I. -Iboards/$(BOARD) \
@@ -162,8 +177,7 @@ all-boards:
 GATE_RATES := 230400 460800 auto
 gate-rates:
 	@set -e; for b in $(BOARDS); do for r in $(GATE_RATES); do \
-		$(MAKE) --no-print-directory BOARD=$$b MODE=gate BAUD=$$r BUILD=build/$$b-gate-$$r \
-			firmware; done; done
+		$(MAKE) --no-print-directory BOARD=$$b MODE=gate BAUD=$$r firmware; done; done
 
 # The slave boards of the simulated test robot (tests/sim, tools/bench.py):
 # BOARD:ADDR, each built into build/robot/<board>-<addr>/orfa.elf.

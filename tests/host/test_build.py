@@ -75,6 +75,46 @@ def test_auto_baud_links_the_autobaud_module_only(board, tmp_path):
     assert "-DORFA_BAUD=9600" in r.stdout
 
 
+def make_all(*args):
+    """`make -n -B` with make's own BUILD: every command a fresh build runs."""
+    return subprocess.run(["make", "--no-print-directory", "-n", "-B"] + list(args),
+                          cwd=ROOT, capture_output=True, text=True, timeout=60)
+
+
+@pytest.mark.parametrize("board", ["m32d", "m128s"])
+@pytest.mark.parametrize("baud", ["230400", "460800", "auto", "9600"])
+def test_a_gateway_at_another_rate_builds_apart_from_the_default(board, baud):
+    """README's `make BOARD=m32d MODE=gate BAUD=460800` writes
+    build/<board>-gate-460800/ (where orfa --sim --baud, orfa flash --rate
+    and gate-rates have it), never build/<board>-gate/: that one is the
+    115200 build `orfa --sim m32d` runs at 115200 (it ran a 460800 build
+    after such a make, and every reply was lost)."""
+    r = make_all("BOARD=" + board, "MODE=gate", "BAUD=" + baud)
+    assert r.returncode == 0, r.stderr
+    assert " -o build/%s-gate-%s/orfa.elf" % (board, baud) in r.stdout
+    assert "build/%s-gate/" % board not in r.stdout
+    r = make_all("BOARD=" + board, "MODE=gate", "BAUD=115200")
+    assert r.returncode == 0, r.stderr
+    assert " -o build/%s-gate/orfa.elf" % board in r.stdout
+
+
+@pytest.mark.parametrize("board", ["m32d", "m128s"])
+def test_a_slave_ignores_baud_and_says_so(board):
+    """A slave has no serial port: BAUD changes nothing in its build (its
+    flags are the default rate's, so nothing is rebuilt either), and make
+    says it once."""
+    r = make_all("BOARD=" + board, "MODE=slave", "BAUD=460800")
+    assert r.returncode == 0, r.stderr
+    said = [l for l in r.stdout.splitlines() if "BAUD=460800" in l]
+    assert said == ["make: BAUD=460800 ignored: MODE=slave has no serial port"
+                    " (the gateway's BAUD sets the line's rate)"]
+    plain = make_all("BOARD=" + board, "MODE=slave")
+    assert r.stdout.replace(said[0] + "\n", "") == plain.stdout
+    assert " -o build/%s-slave/orfa.elf" % board in plain.stdout
+    assert "BAUD" not in plain.stdout.replace("-DORFA_BAUD=115200", "") \
+        .replace("-DORFA_BAUD_TOP=115200", "")
+
+
 @pytest.mark.parametrize("target, name", [("print-baud-rates", "BAUD_RATES"),
                                           ("print-autobaud-rates", "AUTOBAUD_RATES")])
 def test_host_knows_the_rates_the_build_knows(target, name):
