@@ -22,9 +22,29 @@ from .errors import SerialError
 SCAN_FIRST, SCAN_LAST = 0x08, 0x77
 
 
+#: Above this no port has a rate (Linux's termios2 takes 32 bits; pyserial
+#: overflows on a real port and refuses on loop://).
+MAX_BAUDRATE = 2 ** 31 - 1
+
+
+def check_baudrate(baudrate) -> int:
+    """The rate as pyserial takes it (an int above 0, or what int() makes
+    one of: "460800"); else ValueError in serial.Serial's words, before a
+    port is opened: a bad argument is the caller's, not the port's."""
+    try:
+        rate = int(baudrate)
+    except (TypeError, ValueError):
+        rate = 0
+    if not 0 < rate <= MAX_BAUDRATE:
+        raise ValueError("Not a valid baudrate: %r" % (baudrate,))
+    return rate
+
+
 def open_port(url: str, baudrate: int, timeout: float) -> serial.SerialBase:
-    """serial.serial_for_url, its errors as one-line SerialErrors; a real
-    port in low-latency mode (low_latency)."""
+    """serial.serial_for_url, its errors as one-line SerialErrors (a bad
+    baudrate a ValueError: check_baudrate); a real port in low-latency
+    mode (low_latency)."""
+    baudrate = check_baudrate(baudrate)
     try:
         port = serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
     except (serial.SerialException, OSError, ValueError) as e:
