@@ -184,6 +184,34 @@ def test_sim_with_control_socket_and_trace(tmp_path):
             proc.wait()
 
 
+def test_sim_at_a_fast_rate_with_its_own_control_socket():
+    """`orfa sim --baud 230400 --control` (no PATH: the simulator's own
+    socket, docs/cli.md's example) prints the port, then the socket's path
+    (it was a TypeError traceback: a Path added to a str); the board runs
+    the 230400 build, `orfa --port P --baud 230400` talks to it, and the
+    socket's `line` says both ends run at 230400 (UBRR 1)."""
+    from orfa.simctl import SimControl
+    require_builds(["m32d"])
+    proc = subprocess.Popen([sys.executable, "-m", "orfa", "sim", "--baud", "230400", "--control"],
+                            env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        port = proc.stdout.readline().strip()
+        control = proc.stdout.readline().strip()
+        assert os.path.exists(port) and os.path.exists(control), \
+            (port, control, proc.stderr.read() if proc.poll() is not None else "")
+        result = orfa("request", "--port", port, "--baud", "230400", "V", "S AA 00 00 S AB 01 P")
+        assert (result.returncode, result.stdout, result.stderr) == (0, "V1.1\nSWAASR07P\n", "")
+        with SimControl(control) as ctl:
+            assert ctl.request("line").split()[:6] == ["pc", "230400", "bit", "32", "board", "32"]
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=10) == 0
+        assert proc.stderr.read() == ""
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
 def test_sim_board_for_one_command():
     """What a new user types first: `orfa --sim m32d scan` shows the gateway
     itself (0x55 in the 7-bit grid); devices come with the sim options."""

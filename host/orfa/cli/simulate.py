@@ -66,7 +66,7 @@ def cmd_sim(args) -> int:
             link = args.control or None
             if link:
                 _link(board.control_path, link)
-            print(control_label + (link or board.control_path), flush=True)
+            print(control_label + str(link or board.control_path), flush=True)
         if args.terminal:
             with board.gateway(args.baud, autobaud=args.autobaud) as gw:
                 return run_console(gw)
