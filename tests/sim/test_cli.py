@@ -212,6 +212,47 @@ def test_sim_at_a_fast_rate_with_its_own_control_socket():
             proc.wait()
 
 
+@pytest.mark.parametrize("board, rate", [("m32d", 460800), ("m128s", 230400)])
+def test_autobaud_runs_the_autobaud_build(board, rate):
+    """`--autobaud` with a simulated board runs its BAUD=auto gateway
+    (build/<board>-gate-auto/), which finds the rate from the preamble: it
+    ran the fixed --baud build, which ignores the CRs, so nothing of
+    autobaud was tried. `orfa sim --autobaud` likewise: before the
+    preamble the board's receiver is off (it times the pin)."""
+    from orfa.simctl import SimControl
+    require_builds([board])
+    result = orfa("--sim", board, "--baud", str(rate), "--autobaud", "request", "V",
+                  "S AA 00 00 S AB 01 P")
+    assert (result.returncode, result.stdout, result.stderr) == \
+        (0, "V1.1\nSWAASR%02XP\n" % {"m32d": 7, "m128s": 6}[board], "")
+    proc = subprocess.Popen([sys.executable, "-m", "orfa", "sim", "--board", board, "--baud",
+                             str(rate), "--autobaud", "--control"],
+                            env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        proc.stdout.readline()
+        with SimControl(proc.stdout.readline().strip()) as ctl:
+            assert ctl.line()["rxen"] == 0
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=10) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+@pytest.mark.parametrize("rate", ["921600", "12345"])
+def test_autobaud_refuses_a_rate_it_does_not_find(rate):
+    """A rate the BAUD=auto build does not detect is one line, exit 2, at
+    once (it waited out --timeout for a reply that could not come)."""
+    require_builds(["m32d"])
+    for args in (["--sim", "m32d", "--baud", rate, "--autobaud", "version"],
+                 ["sim", "--baud", rate, "--autobaud"]):
+        result = orfa(*args)
+        assert (result.returncode, result.stdout, result.stderr) == \
+            (2, "", "orfa: no m32d gateway finds %s baud: BAUD=auto detects 2400 4800 9600"
+             " 14400 19200 28800 38400 57600 76800 115200 230400 460800\n" % rate)
+
+
 def test_sim_board_for_one_command():
     """What a new user types first: `orfa --sim m32d scan` shows the gateway
     itself (0x55 in the 7-bit grid); devices come with the sim options."""

@@ -56,7 +56,8 @@ def _connection_options(parser, suppress: bool) -> None:
                        default=default(False),
                        help="addresses are 7-bit (i2c-tools' form), not the protocol's 8-bit")
     group.add_argument("--autobaud", action="store_true", default=default(False),
-                       help="open the line with the BAUD=auto preamble (eight CRs, 20 ms quiet)")
+                       help="open the line with the BAUD=auto preamble (eight CRs, 20 ms quiet);"
+                            " --sim runs the board's BAUD=auto gateway")
 
 
 class Parser(argparse.ArgumentParser):
