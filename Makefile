@@ -329,9 +329,13 @@ soak: setup
 	@$(MAKE) --no-print-directory all-boards robot sim
 	python3 tools/soak.py --requests $(SOAK_REQUESTS) --seed $(SOAK_SEED)
 
+# The demos' console talks at the rate their gateway is built for (BAUD=460800;
+# BAUD=auto: the autobaud build, found from the console's preamble).
+DEMO_LINE = $(if $(filter auto,$(BAUD)),--autobaud,--baud $(BAUD))
+
 demo: setup
 	@$(MAKE) -s --no-print-directory BOARD=m32d MODE=gate firmware sim
-	@PYTHONPATH=host exec python3 -m orfa sim --board m32d --eeprom 0xA0 --terminal
+	@PYTHONPATH=host exec python3 -m orfa sim --board m32d --eeprom 0xA0 $(DEMO_LINE) --terminal
 
 # A robot: the M32-D gateway, an M128-S slave at 0x10, an M32-D slave at 0x12,
 # the EEPROM at A0 and the robot's sensors (an MPU-6050 IMU at D0, an
@@ -347,7 +351,7 @@ demo-robot: setup
 		--part mpu6050@0xD0 --part hmc5883l@0x3C --part lis3mdl@0x38 \
 		--part bmp280@0xEC --part 24lc32@0xA8 \
 		--slave m128s:0x10:build/robot/m128s-0x10/orfa.elf \
-		--slave m32d:0x12:build/robot/m32d-0x12/orfa.elf --terminal
+		--slave m32d:0x12:build/robot/m32d-0x12/orfa.elf $(DEMO_LINE) --terminal
 
 clean:
 	rm -rf build
