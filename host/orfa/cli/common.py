@@ -228,8 +228,11 @@ def add_sim_devices(parser, suppress: bool = False) -> None:
 
 
 def sim_board(board: str, args, **kw) -> SimBoard:
-    """A SimBoard with the devices of args (not started); two devices at
-    one address are a UsageError."""
+    """A SimBoard with the devices of args (not started), running the
+    gateway for --baud and --autobaud (sim_firmware) unless
+    firmware= names one; two devices at one address are a UsageError."""
+    if kw.get("firmware") is None:
+        kw["firmware"] = sim_firmware(board, args)
     seen = {}
     parts = getattr(args, "part", None) or ()
     for opt, addr in ([("--eeprom", a) for a in getattr(args, "eeprom", None) or ()]
@@ -262,7 +265,7 @@ def sim_firmware(board: str, args):
 def connect(args) -> Iterator[Gateway]:
     """The Gateway of --port URL (or $ORFA_PORT), or of a board --sim starts
     for this one command (stopped when the command ends), its gateway built
-    for --baud (sim_firmware: with --autobaud, the BAUD=auto one). An explicit --sim
+    for --baud (sim_board: with --autobaud, the BAUD=auto one). An explicit --sim
     wins over $ORFA_PORT; --port and --sim both given is a usage error."""
     devices = [opt for opt in ("eeprom", "part", "slave", "adc", "spi")
                if getattr(args, opt, None)]
@@ -272,8 +275,7 @@ def connect(args) -> Iterator[Gateway]:
         if args.port:
             raise UsageError("give --port or --sim, not both")
         try:
-            sim = sim_board(args.sim, args, trace=False, control=args.autobaud,
-                            firmware=sim_firmware(args.sim, args)).start()
+            sim = sim_board(args.sim, args, trace=False, control=args.autobaud).start()
         except (SimError, ValueError) as exc:
             raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
         try:

@@ -10,7 +10,7 @@ import sys
 
 from .. import protocol as p
 from ..sim import BOARDS, SimError
-from .common import UsageError, add_sim_devices, arg, baud_rate, command, sim_board, sim_firmware
+from .common import UsageError, add_sim_devices, arg, baud_rate, command, sim_board
 from .common import adc_spec, eeprom_spec, slave_spec  # noqa: F401 (here before)
 from .console import run_console
 
@@ -49,7 +49,7 @@ def cmd_sim(args) -> int:
         extra += ["--vcd", args.vcd]
     try:
         board = sim_board(args.board, args, trace=False,
-                          firmware=args.firmware or sim_firmware(args.board, args),
+                          firmware=args.firmware,
                           control=control, extra_args=extra).start()
     except (SimError, ValueError) as exc:
         raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
