@@ -6,6 +6,7 @@ pseudo-terminal path (the simulator's link) and a real port are the same.
 
 from __future__ import annotations
 
+import math
 import time
 from collections import deque
 from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Sequence, Union
@@ -40,11 +41,25 @@ def check_baudrate(baudrate) -> int:
     return rate
 
 
+def check_timeout(timeout) -> float:
+    """Seconds to wait for a reply: a finite number, 0 or more (not None,
+    which pyserial takes for "forever": every call here has a deadline);
+    else ValueError in pyserial's words."""
+    try:
+        seconds = float(timeout)
+    except (TypeError, ValueError):
+        seconds = math.nan
+    if isinstance(timeout, (str, bytes)) or not 0 <= seconds < math.inf:
+        raise ValueError("Not a valid timeout: %r (seconds, 0 or more)" % (timeout,))
+    return timeout
+
+
 def open_port(url: str, baudrate: int, timeout: float) -> serial.SerialBase:
     """serial.serial_for_url, its errors as one-line SerialErrors (a bad
-    baudrate a ValueError: check_baudrate); a real port in low-latency
-    mode (low_latency)."""
+    baudrate or timeout a ValueError: check_baudrate, check_timeout); a
+    real port in low-latency mode (low_latency)."""
     baudrate = check_baudrate(baudrate)
+    timeout = check_timeout(timeout)
     try:
         port = serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
     except (serial.SerialException, OSError, ValueError) as e:

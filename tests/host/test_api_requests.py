@@ -422,6 +422,17 @@ def test_a_bad_baudrate_is_a_value_error_as_pyserials(rate):
         assert str(e.value) == "Not a valid baudrate: %r" % (rate,)
 
 
+@pytest.mark.parametrize("timeout", [-1, "abc", None, float("nan"), float("inf")])
+def test_a_bad_timeout_is_a_value_error_too(timeout):
+    """A timeout that is no number of seconds is a ValueError as pyserial
+    has it ('Not a valid timeout'), raised before the port is opened: it
+    was a SerialError, or for None a TypeError at the first request."""
+    with pytest.raises(ValueError) as e:
+        Gateway("loop://", timeout=timeout)
+    assert not isinstance(e.value, errors.OrfaError)
+    assert str(e.value) == "Not a valid timeout: %r (seconds, 0 or more)" % (timeout,)
+
+
 @pytest.mark.parametrize("rate", [230400, 460800, 921600, 12345, "460800"])
 def test_a_rate_pyserial_takes_opens(rate):
     """Rates pyserial sets are taken as it takes them (a number in a string
