@@ -102,7 +102,8 @@ DRIVERS ?= $(BOARD_DRIVERS)
 # (gate-rates' builds, where orfa.locate.gateway_firmware, `orfa --sim B --baud R`
 # and `orfa flash --rate R` find it): build/<board>-gate/ is always the
 # default rate's, the one a program opening the port at 115200 runs.
-BUILD ?= build/$(BOARD)-$(MODE)$(if $(and $(filter gate,$(MODE)),$(filter-out $(DEFAULT_BAUD),$(BAUD))),-$(BAUD))
+gate_build = build/$(1)-gate$(if $(filter-out $(DEFAULT_BAUD),$(2)),-$(2))
+BUILD ?= $(if $(filter gate,$(MODE)),$(call gate_build,$(BOARD),$(BAUD)),build/$(BOARD)-$(MODE))
 # -fno-move-loop-invariants -mstrict-X: 130 bytes less on the M32-D gateway,
 # no slower where it counts (make bench). -mcall-prologues: register saves
 # through one shared routine, 250 bytes less; interrupt handlers keep their
@@ -177,7 +178,8 @@ all-boards:
 GATE_RATES := 230400 460800 auto
 gate-rates:
 	@set -e; for b in $(BOARDS); do for r in $(GATE_RATES); do \
-		$(MAKE) --no-print-directory BOARD=$$b MODE=gate BAUD=$$r firmware; done; done
+		$(MAKE) --no-print-directory BOARD=$$b MODE=gate BAUD=$$r \
+			BUILD=$(call gate_build,$$b,$$r) firmware; done; done
 
 # The slave boards of the simulated test robot (tests/sim, tools/bench.py):
 # BOARD:ADDR, each built into build/robot/<board>-<addr>/orfa.elf.
