@@ -485,11 +485,17 @@ class Gateway(Closing):
         self._write(SYNC_OPEN)
         deadline = time.monotonic() + self.timeout
         seen: List[str] = []
-        while True:
-            text = self._line_by(deadline, seen)
-            if seen and seen[-1] == flow.MARKER_REPLY and flow.SYNC_SECOND_REPLY.match(text):
-                break
-            seen.append(text)
+        try:
+            while True:
+                text = self._line_by(deadline, seen)
+                if seen and seen[-1] == flow.MARKER_REPLY and flow.SYNC_SECOND_REPLY.match(text):
+                    break
+                seen.append(text)
+        except p.ReplyTimeout as e:
+            # a board built for another rate sees garbage and answers in it
+            raise p.ReplyTimeout("%s; nothing answered the opening sync at %s baud (a gateway"
+                                 " answers only at the rate it was built for, its BAUD)"
+                                 % (e, self.serial.baudrate)) from None
         self._synced = True
         self._dirty = False
         return len(seen) - 1

@@ -433,6 +433,24 @@ def test_a_bad_timeout_is_a_value_error_too(timeout):
     assert str(e.value) == "Not a valid timeout: %r (seconds, 0 or more)" % (timeout,)
 
 
+def test_a_silent_opening_names_the_rate():
+    """No board answers the opening sync (a port nobody answers; a board
+    built for another rate gets only garbage): the error says at which rate
+    it asked, and that a gateway answers only at its build's."""
+    import os
+    import pty
+    master, slave = pty.openpty()
+    try:
+        with Gateway(os.ttyname(slave), baudrate=460800, timeout=0.2) as gw:
+            with pytest.raises(ReplyTimeout) as e:
+                gw.request("V")
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert str(e.value) == ("no reply line (got b''); nothing answered the opening sync at 460800"
+                            " baud (a gateway answers only at the rate it was built for, its BAUD)")
+
+
 @pytest.mark.parametrize("rate", [230400, 460800, 921600, 12345, "460800"])
 def test_a_rate_pyserial_takes_opens(rate):
     """Rates pyserial sets are taken as it takes them (a number in a string
