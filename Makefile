@@ -20,7 +20,9 @@
 
 BOARD ?= m32d
 MODE ?= gate
-BAUD ?= 115200
+# The line's rate after reset (docs/protocol.md; host/orfa/protocol.py's DEFAULT_BAUD).
+DEFAULT_BAUD := 115200
+BAUD ?= $(DEFAULT_BAUD)
 ADDR ?= 0x10
 
 BOARDS := m32d m128s
@@ -40,6 +42,12 @@ ifeq ($(filter $(BAUD),$(BAUD_RATES) auto),)
 $(error BAUD=$(BAUD) is not a rate of the line: use one of $(BAUD_RATES), or auto)
 endif
 MODES := gate slave
+# A slave has no serial port: BAUD is the gateway's, and a slave build is the
+# same whatever it says (FW_BAUD below). Said once when
+# given on make's own command line; a rate make refuses is refused here too.
+ifeq ($(MODE)$(origin BAUD)$(MAKELEVEL),slavecommand line0)
+$(info make: BAUD=$(BAUD) ignored: MODE=slave has no serial port (the gateway's BAUD sets the line's rate))
+endif
 
 ifeq ($(wildcard boards/$(BOARD)/board.mk),)
 $(error BOARD=$(BOARD): no such board (boards/: $(notdir $(wildcard boards/*))))
@@ -90,7 +98,12 @@ endif
 DRIVERS ?= $(BOARD_DRIVERS)
 
 # BUILD=dir puts one more build elsewhere (the test robot's slaves at their addresses).
-BUILD ?= build/$(BOARD)-$(MODE)
+# A gateway at a rate other than the default goes to build/<board>-gate-<BAUD>/
+# (gate-rates' builds, where orfa.locate.gateway_firmware, `orfa --sim B --baud R`
+# and `orfa flash --rate R` find it): build/<board>-gate/ is always the
+# default rate's, the one a program opening the port at 115200 runs.
+gate_build = build/$(1)-gate$(if $(filter-out $(DEFAULT_BAUD),$(2)),-$(2))
+BUILD ?= $(if $(filter gate,$(MODE)),$(call gate_build,$(BOARD),$(BAUD)),build/$(BOARD)-$(MODE))
 # -fno-move-loop-invariants -mstrict-X: 130 bytes less on the M32-D gateway,
 # no slower where it counts (make bench). -mcall-prologues: register saves
 # through one shared routine, 250 bytes less; interrupt handlers keep their
@@ -101,9 +114,12 @@ CC := avr-gcc
 OBJCOPY := avr-objcopy
 AVR_SIZE := avr-size
 
+# The rate compiled in: BAUD's for a gateway; a slave's is the default, whatever
+# BAUD says (no serial port: its build is the same).
+FW_BAUD := $(if $(filter gate,$(MODE)),$(BAUD),$(DEFAULT_BAUD))
 FW_CFLAGS := -mmcu=$(BOARD_MCU) -DF_CPU=$(BOARD_F_CPU) \
-	$(if $(filter auto,$(BAUD)),'-DORFA_BAUD_RATES(X)=$(foreach r,$(AUTOBAUD_RATES),X($(r)))',-DORFA_BAUD=$(BAUD)) \
-	-DORFA_BAUD_TOP=$(if $(filter auto,$(BAUD)),$(lastword $(AUTOBAUD_RATES)),$(BAUD)) \
+	$(if $(filter auto,$(FW_BAUD)),'-DORFA_BAUD_RATES(X)=$(foreach r,$(AUTOBAUD_RATES),X($(r)))',-DORFA_BAUD=$(FW_BAUD)) \
+	-DORFA_BAUD_TOP=$(if $(filter auto,$(FW_BAUD)),$(lastword $(AUTOBAUD_RATES)),$(FW_BAUD)) \
 	-DORFA_ADDR=$(ADDR) -DORFA_MODE_$(MODE) \
 	-std=gnu99 $(FW_OPT) $(FW_DEBUG) -flto -Wall -Wextra -Werror -ffunction-sections -fdata-sections \
 	-fshort-enums -I. -Iboards/$(BOARD) \
@@ -162,8 +178,8 @@ all-boards:
 GATE_RATES := 230400 460800 auto
 gate-rates:
 	@set -e; for b in $(BOARDS); do for r in $(GATE_RATES); do \
-		$(MAKE) --no-print-directory BOARD=$$b MODE=gate BAUD=$$r BUILD=build/$$b-gate-$$r \
-			firmware; done; done
+		$(MAKE) --no-print-directory BOARD=$$b MODE=gate BAUD=$$r \
+			BUILD=$(call gate_build,$$b,$$r) firmware; done; done
 
 # The slave boards of the simulated test robot (tests/sim, tools/bench.py):
 # BOARD:ADDR, each built into build/robot/<board>-<addr>/orfa.elf.
@@ -315,9 +331,13 @@ soak: setup
 	@$(MAKE) --no-print-directory all-boards robot sim
 	python3 tools/soak.py --requests $(SOAK_REQUESTS) --seed $(SOAK_SEED)
 
+# The demos' console talks at the rate their gateway is built for (BAUD=460800;
+# BAUD=auto: the autobaud build, found from the console's preamble).
+DEMO_LINE = $(if $(filter auto,$(BAUD)),--autobaud,--baud $(BAUD))
+
 demo: setup
 	@$(MAKE) -s --no-print-directory BOARD=m32d MODE=gate firmware sim
-	@PYTHONPATH=host exec python3 -m orfa sim --board m32d --eeprom 0xA0 --terminal
+	@PYTHONPATH=host exec python3 -m orfa sim --board m32d --eeprom 0xA0 $(DEMO_LINE) --terminal
 
 # A robot: the M32-D gateway, an M128-S slave at 0x10, an M32-D slave at 0x12,
 # the EEPROM at A0 and the robot's sensors (an MPU-6050 IMU at D0, an
@@ -333,7 +353,7 @@ demo-robot: setup
 		--part mpu6050@0xD0 --part hmc5883l@0x3C --part lis3mdl@0x38 \
 		--part bmp280@0xEC --part 24lc32@0xA8 \
 		--slave m128s:0x10:build/robot/m128s-0x10/orfa.elf \
-		--slave m32d:0x12:build/robot/m32d-0x12/orfa.elf --terminal
+		--slave m32d:0x12:build/robot/m32d-0x12/orfa.elf $(DEMO_LINE) --terminal
 
 clean:
 	rm -rf build

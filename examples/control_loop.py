@@ -290,6 +290,19 @@ def report(loop, steps, pipelined, check):
              " ".join("%.1f" % w for w in gyro)))
 
 
+def baud(text):
+    """--baud: a whole number of baud above 0 (which rates a board runs,
+    the board or its build says)."""
+    try:
+        rate = int(text, 10)
+    except ValueError:
+        rate = 0
+    if rate <= 0:
+        raise argparse.ArgumentTypeError("%r is not a serial rate: a whole number of baud"
+                                         " above 0 (460800)" % text)
+    return rate
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     where = ap.add_mutually_exclusive_group(required=True)
@@ -297,7 +310,7 @@ def main(argv=None):
     where.add_argument("--sim", action="store_true", help="run on a simulated board")
     ap.add_argument("--board", choices=("m32d", "m128s"), default="m32d",
                     help="the simulated board (--sim; default m32d)")
-    ap.add_argument("--baud", type=int, default=p.DEFAULT_BAUD, help="serial rate (default 115200)")
+    ap.add_argument("--baud", type=baud, default=p.DEFAULT_BAUD, help="serial rate (default 115200)")
     ap.add_argument("--steps", type=int, default=500, metavar="N", help="steps to run (default 500)")
     ap.add_argument("--one-at-a-time", action="store_true",
                     help="each request after the last one's reply (as naive code does)")

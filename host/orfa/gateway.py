@@ -6,6 +6,7 @@ pseudo-terminal path (the simulator's link) and a real port are the same.
 
 from __future__ import annotations
 
+import math
 import time
 from collections import deque
 from typing import Callable, Dict, FrozenSet, Iterable, List, Optional, Sequence, Union
@@ -22,9 +23,43 @@ from .errors import SerialError
 SCAN_FIRST, SCAN_LAST = 0x08, 0x77
 
 
+#: Above this no port has a rate (Linux's termios2 takes 32 bits; pyserial
+#: overflows on a real port and refuses on loop://).
+MAX_BAUDRATE = 2 ** 31 - 1
+
+
+def check_baudrate(baudrate) -> int:
+    """The rate as pyserial takes it (an int above 0, or what int() makes
+    one of: "460800"); else ValueError in serial.Serial's words, before a
+    port is opened: a bad argument is the caller's, not the port's."""
+    try:
+        rate = int(baudrate)
+    except (TypeError, ValueError):
+        rate = 0
+    if not 0 < rate <= MAX_BAUDRATE:
+        raise ValueError("Not a valid baudrate: %r" % (baudrate,))
+    return rate
+
+
+def check_timeout(timeout) -> float:
+    """Seconds to wait for a reply: a finite number, 0 or more (not None,
+    which pyserial takes for "forever": every call here has a deadline);
+    else ValueError in pyserial's words."""
+    try:
+        seconds = float(timeout)
+    except (TypeError, ValueError):
+        seconds = math.nan
+    if isinstance(timeout, (str, bytes)) or not 0 <= seconds < math.inf:
+        raise ValueError("Not a valid timeout: %r (seconds, 0 or more)" % (timeout,))
+    return timeout
+
+
 def open_port(url: str, baudrate: int, timeout: float) -> serial.SerialBase:
-    """serial.serial_for_url, its errors as one-line SerialErrors; a real
-    port in low-latency mode (low_latency)."""
+    """serial.serial_for_url, its errors as one-line SerialErrors (a bad
+    baudrate or timeout a ValueError: check_baudrate, check_timeout); a
+    real port in low-latency mode (low_latency)."""
+    baudrate = check_baudrate(baudrate)
+    timeout = check_timeout(timeout)
     try:
         port = serial.serial_for_url(url, baudrate=baudrate, timeout=timeout)
     except (serial.SerialException, OSError, ValueError) as e:
@@ -450,11 +485,17 @@ class Gateway(Closing):
         self._write(SYNC_OPEN)
         deadline = time.monotonic() + self.timeout
         seen: List[str] = []
-        while True:
-            text = self._line_by(deadline, seen)
-            if seen and seen[-1] == flow.MARKER_REPLY and flow.SYNC_SECOND_REPLY.match(text):
-                break
-            seen.append(text)
+        try:
+            while True:
+                text = self._line_by(deadline, seen)
+                if seen and seen[-1] == flow.MARKER_REPLY and flow.SYNC_SECOND_REPLY.match(text):
+                    break
+                seen.append(text)
+        except p.ReplyTimeout as e:
+            # a board built for another rate sees garbage and answers in it
+            raise p.ReplyTimeout("%s; nothing answered the opening sync at %s baud (a gateway"
+                                 " answers only at the rate it was built for, its BAUD)"
+                                 % (e, self.serial.baudrate)) from None
         self._synced = True
         self._dirty = False
         return len(seen) - 1

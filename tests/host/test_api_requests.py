@@ -404,6 +404,61 @@ def test_bad_port_is_one_line():
         Board.open("nope://x")
 
 
+@pytest.mark.parametrize("rate", [0, -1, "abc", None, 2 ** 40])
+def test_a_bad_baudrate_is_a_value_error_as_pyserials(rate):
+    """Gateway(port, baudrate=...) keeps pyserial's convention: a rate that
+    is none is the caller's ValueError (serial.Serial's words), raised
+    before any port is opened, not an OrfaError of the port; so are
+    Board.open's, SMBus's and busio.I2C's, which pass it on."""
+    from orfa.busio import I2C
+    from orfa.smbus import SMBus
+    for opener in (lambda: Gateway("loop://", baudrate=rate),
+                   lambda: Board.open("/dev/ttyORFA-none", baudrate=rate),
+                   lambda: SMBus("/dev/ttyORFA-none", baudrate=rate),
+                   lambda: I2C("/dev/ttyORFA-none", baudrate=rate)):
+        with pytest.raises(ValueError) as e:
+            opener()
+        assert not isinstance(e.value, errors.OrfaError)
+        assert str(e.value) == "Not a valid baudrate: %r" % (rate,)
+
+
+@pytest.mark.parametrize("timeout", [-1, "abc", None, float("nan"), float("inf")])
+def test_a_bad_timeout_is_a_value_error_too(timeout):
+    """A timeout that is no number of seconds is a ValueError as pyserial
+    has it ('Not a valid timeout'), raised before the port is opened: it
+    was a SerialError, or for None a TypeError at the first request."""
+    with pytest.raises(ValueError) as e:
+        Gateway("loop://", timeout=timeout)
+    assert not isinstance(e.value, errors.OrfaError)
+    assert str(e.value) == "Not a valid timeout: %r (seconds, 0 or more)" % (timeout,)
+
+
+def test_a_silent_opening_names_the_rate():
+    """No board answers the opening sync (a port nobody answers; a board
+    built for another rate gets only garbage): the error says at which rate
+    it asked, and that a gateway answers only at its build's."""
+    import os
+    import pty
+    master, slave = pty.openpty()
+    try:
+        with Gateway(os.ttyname(slave), baudrate=460800, timeout=0.2) as gw:
+            with pytest.raises(ReplyTimeout) as e:
+                gw.request("V")
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert str(e.value) == ("no reply line (got b''); nothing answered the opening sync at 460800"
+                            " baud (a gateway answers only at the rate it was built for, its BAUD)")
+
+
+@pytest.mark.parametrize("rate", [230400, 460800, 921600, 12345, "460800"])
+def test_a_rate_pyserial_takes_opens(rate):
+    """Rates pyserial sets are taken as it takes them (a number in a string
+    too): the line, not the library, tells whether a board answers there."""
+    with Gateway("loop://", baudrate=rate, sync=False) as gw:
+        assert gw.serial.baudrate == int(rate)
+
+
 def test_extra_error_line_among_equal_replies(fake):
     """Replies of one shape cannot show where an extra line came in: the
     marker after the run finds one line too many, and every result from

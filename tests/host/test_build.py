@@ -75,6 +75,46 @@ def test_auto_baud_links_the_autobaud_module_only(board, tmp_path):
     assert "-DORFA_BAUD=9600" in r.stdout
 
 
+def build_dir(*args):
+    """The BUILD make's own default gives for these variables (nothing built)."""
+    r = subprocess.run(["make", "-s", "--no-print-directory", "--eval",
+                        "orfa-build-dir: ; @echo $(BUILD)"] + list(args) + ["orfa-build-dir"],
+                       cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    return r.stdout.splitlines()[-1]
+
+
+@pytest.mark.parametrize("board", ["m32d", "m128s"])
+@pytest.mark.parametrize("baud", ["230400", "460800", "auto", "9600"])
+def test_a_gateway_at_another_rate_builds_apart_from_the_default(board, baud):
+    """README's `make BOARD=m32d MODE=gate BAUD=460800` writes
+    build/<board>-gate-460800/ (where orfa --sim --baud, orfa flash --rate
+    and gate-rates have it), never build/<board>-gate/: that one is the
+    115200 build `orfa --sim m32d` runs at 115200 (it ran a 460800 build
+    after such a make, and every reply was lost)."""
+    assert build_dir("BOARD=" + board, "MODE=gate", "BAUD=" + baud) == \
+        "build/%s-gate-%s" % (board, baud)
+    assert build_dir("BOARD=" + board, "MODE=gate", "BAUD=115200") == "build/%s-gate" % board
+    assert build_dir("BOARD=" + board, "MODE=gate") == "build/%s-gate" % board
+
+
+@pytest.mark.parametrize("board", ["m32d", "m128s"])
+def test_a_slave_ignores_baud_and_says_so(board, tmp_path):
+    """A slave has no serial port: BAUD changes nothing in its build (its
+    flags are the default rate's, so nothing is rebuilt either), and make
+    says it once."""
+    assert build_dir("BOARD=" + board, "MODE=slave", "BAUD=460800") == "build/%s-slave" % board
+    r = make("-B", "BOARD=" + board, "MODE=slave", "BAUD=460800", tmp_path=tmp_path)
+    assert r.returncode == 0, r.stderr
+    said = [l for l in r.stdout.splitlines() if "BAUD=460800" in l]
+    assert said == ["make: BAUD=460800 ignored: MODE=slave has no serial port"
+                    " (the gateway's BAUD sets the line's rate)"]
+    plain = make("-B", "BOARD=" + board, "MODE=slave", tmp_path=tmp_path)
+    assert r.stdout.replace(said[0] + "\n", "") == plain.stdout
+    assert "BAUD" not in plain.stdout.replace("-DORFA_BAUD=115200", "") \
+        .replace("-DORFA_BAUD_TOP=115200", "")
+
+
 @pytest.mark.parametrize("target, name", [("print-baud-rates", "BAUD_RATES"),
                                           ("print-autobaud-rates", "AUTOBAUD_RATES")])
 def test_host_knows_the_rates_the_build_knows(target, name):

@@ -312,3 +312,14 @@ def test_an_explicit_sim_wins_over_the_environments_port(monkeypatch):
 def contextlib_nullcontext(value):
     import contextlib
     return contextlib.nullcontext(value)
+
+
+def test_help_says_which_rates_the_gateway_runs(capsys, monkeypatch):
+    """`orfa --help` under --baud: the gateway's builds' rates (to 460800)
+    and that --sim runs the build for the rate (it said only the default)."""
+    monkeypatch.setenv("COLUMNS", "200")
+    status, out, _ = run(["--help"], capsys)
+    assert status == 0
+    baud = [line for line in out.splitlines() if line.lstrip().startswith("--baud BAUD")]
+    assert baud == ["  --baud BAUD           serial rate, the gateway's BAUD (default 115200; its"
+                    " builds run 2400..460800); --sim runs the gateway built for it"]

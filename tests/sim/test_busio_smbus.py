@@ -290,3 +290,32 @@ def test_docs_examples_print_what_the_docs_show(capsys):
     for code, shown in examples:
         exec(compile(code, "docs/sensors.md", "exec"), {})
         assert capsys.readouterr().out == shown
+
+
+# --- the fast rates ---------------------------------------------------------------------
+
+@pytest.mark.parametrize("board, rate", [("m32d", 460800), ("m128s", 230400)])
+def test_smbus_and_busio_at_a_fast_rate(board, rate):
+    """SMBus and busio.I2C opened on a port with baudrate= the gateway's
+    BAUD (460800, 230400): an MPU-6050's WHO_AM_I and its 14-byte burst,
+    as a robot program reads them."""
+    from conftest import build_gateway
+    require_builds([board])
+    with SimBoard(board, firmware=build_gateway(board, rate), trace=False,
+                  parts=[("mpu6050", 0xD0)]) as sim:
+        port = sim.port
+        with SMBus(port, baudrate=rate) as bus:
+            assert bus.gateway.serial.baudrate == rate
+            assert bus.read_byte_data(0x68, 0x75) == 0x68
+            assert len(bus.read_i2c_block_data(0x68, 0x3B, 14)) == 14
+        i2c = I2C(port, baudrate=rate)
+        try:
+            assert i2c.try_lock()
+            assert i2c.scan() == [0x55, 0x68]
+            burst = bytearray(14)
+            i2c.writeto_then_readfrom(0x68, bytes([0x3B]), burst)
+            who = bytearray(1)
+            i2c.writeto_then_readfrom(0x68, bytes([0x75]), who)
+            assert who == b"\x68"
+        finally:
+            i2c.deinit()

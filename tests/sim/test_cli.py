@@ -184,6 +184,75 @@ def test_sim_with_control_socket_and_trace(tmp_path):
             proc.wait()
 
 
+def test_sim_at_a_fast_rate_with_its_own_control_socket():
+    """`orfa sim --baud 230400 --control` (no PATH: the simulator's own
+    socket, docs/cli.md's example) prints the port, then the socket's path
+    (it was a TypeError traceback: a Path added to a str); the board runs
+    the 230400 build, `orfa --port P --baud 230400` talks to it, and the
+    socket's `line` says both ends run at 230400 (UBRR 1)."""
+    from orfa.simctl import SimControl
+    require_builds(["m32d"])
+    proc = subprocess.Popen([sys.executable, "-m", "orfa", "sim", "--baud", "230400", "--control"],
+                            env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        port = proc.stdout.readline().strip()
+        control = proc.stdout.readline().strip()
+        assert os.path.exists(port) and os.path.exists(control), \
+            (port, control, proc.stderr.read() if proc.poll() is not None else "")
+        result = orfa("request", "--port", port, "--baud", "230400", "V", "S AA 00 00 S AB 01 P")
+        assert (result.returncode, result.stdout, result.stderr) == (0, "V1.1\nSWAASR07P\n", "")
+        with SimControl(control) as ctl:
+            assert ctl.request("line").split()[:6] == ["pc", "230400", "bit", "32", "board", "32"]
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=10) == 0
+        assert proc.stderr.read() == ""
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+@pytest.mark.parametrize("board, rate", [("m32d", 460800), ("m128s", 230400)])
+def test_autobaud_runs_the_autobaud_build(board, rate):
+    """`--autobaud` with a simulated board runs its BAUD=auto gateway
+    (build/<board>-gate-auto/), which finds the rate from the preamble: it
+    ran the fixed --baud build, which ignores the CRs, so nothing of
+    autobaud was tried. `orfa sim --autobaud` likewise: before the
+    preamble the board's receiver is off (it times the pin)."""
+    from orfa.simctl import SimControl
+    require_builds([board])
+    result = orfa("--sim", board, "--baud", str(rate), "--autobaud", "request", "V",
+                  "S AA 00 00 S AB 01 P")
+    assert (result.returncode, result.stdout, result.stderr) == \
+        (0, "V1.1\nSWAASR%02XP\n" % {"m32d": 7, "m128s": 6}[board], "")
+    proc = subprocess.Popen([sys.executable, "-m", "orfa", "sim", "--board", board, "--baud",
+                             str(rate), "--autobaud", "--control"],
+                            env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        proc.stdout.readline()
+        with SimControl(proc.stdout.readline().strip()) as ctl:
+            assert ctl.line()["rxen"] == 0
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=10) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+@pytest.mark.parametrize("rate", ["921600", "12345"])
+def test_autobaud_refuses_a_rate_it_does_not_find(rate):
+    """A rate the BAUD=auto build does not detect is one line, exit 2, at
+    once (it waited out --timeout for a reply that could not come)."""
+    require_builds(["m32d"])
+    for args in (["--sim", "m32d", "--baud", rate, "--autobaud", "version"],
+                 ["sim", "--baud", rate, "--autobaud"]):
+        result = orfa(*args)
+        assert (result.returncode, result.stdout, result.stderr) == \
+            (2, "", "orfa: no m32d gateway finds %s baud: BAUD=auto detects 2400 4800 9600"
+             " 14400 19200 28800 38400 57600 76800 115200 230400 460800\n" % rate)
+
+
 def test_sim_board_for_one_command():
     """What a new user types first: `orfa --sim m32d scan` shows the gateway
     itself (0x55 in the 7-bit grid); devices come with the sim options."""

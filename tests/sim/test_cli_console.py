@@ -159,6 +159,30 @@ def test_make_demo_is_quiet_and_labels_the_port(tmp_path):
         term.wait(30)
 
 
+@pytest.mark.parametrize("target", ["demo", "demo-robot"])
+@pytest.mark.parametrize("baud, line", [("460800", "--baud 460800"), ("230400", "--baud 230400"),
+                                        ("auto", "--autobaud"), ("115200", "--baud 115200")])
+def test_make_demo_talks_at_the_rate_it_builds(target, baud, line):
+    """`make demo BAUD=460800` builds the 460800 gateway and its console
+    talks at 460800 (BAUD=auto: the autobaud build, the console's
+    preamble first); it built one rate and opened the console at 115200."""
+    r = subprocess.run(["make", "-n", "-o", "setup", target, "BAUD=" + baud], cwd=ROOT,
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    sim = [l for l in r.stdout.replace("\\\n", " ").splitlines() if "-m orfa sim " in l]
+    assert len(sim) == 1 and sim[0].endswith(" %s --terminal" % line), r.stdout
+
+
+def test_make_demo_at_460800_answers():
+    term = make_demo("BAUD=460800")
+    try:
+        term.write(b"S AA 00 00 S AB 01 P\r")
+        assert term.read_until(lambda out: b"SWAASR07P\r\norfa> " in out, 30), term.out
+    finally:
+        term.write(b"\x04")
+        term.wait(30)
+
+
 def test_make_demo_ends_on_ctrl_c_without_makes_interrupt_line():
     term = make_demo()
     term.write(b"V\r")

@@ -155,3 +155,17 @@ def test_the_example_refuses_a_rate_without_a_build():
     assert (r.returncode, r.stdout) == (1, "")
     assert r.stderr.startswith("control_loop: no m32d gateway at 12345 baud: ")
     assert len(r.stderr.splitlines()) == 1
+
+
+@pytest.mark.parametrize("rate", ["0", "-1", "abc", "1e5", ""])
+def test_the_example_refuses_a_baud_that_is_no_rate(rate):
+    """--baud that is no rate at all is a usage error (exit 2, argparse's
+    line last) before any board starts: 0 and -1 went on to `make BAUD=-1`
+    (exit 1)."""
+    import subprocess
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "control_loop.py"), "--sim",
+                        "--baud=" + rate], capture_output=True, text=True, timeout=60)
+    assert (r.returncode, r.stdout) == (2, "")
+    assert r.stderr.splitlines()[-1] == ("control_loop.py: error: argument --baud: %r is not a"
+                                         " serial rate: a whole number of baud above 0"
+                                         " (460800)" % rate)

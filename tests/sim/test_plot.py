@@ -145,6 +145,23 @@ def test_live_board_with_sim(tmp_path):
     assert width > 1000 and height > 200
 
 
+@pytest.mark.parametrize("board, line", [("m32d", ["--baud", "460800"]),
+                                         ("m128s", ["--baud", "230400"]),
+                                         ("m32d", ["--baud", "230400", "--autobaud"])])
+def test_live_board_with_sim_at_a_fast_rate(board, line, tmp_path):
+    """`orfa --sim B --baud 460800 plot --do ...` simulates the gateway built
+    for that rate (as every --sim command does) and its commands talk at it:
+    the board was the 115200 build, and the first --do got no reply."""
+    require_builds([board])
+    r = orfa("--sim", board, *line, "plot", "--do", "servo 3 1500", "--for", "25ms",
+             "--signals", "servo3", "-o", tmp_path / "p.png")
+    assert (r.returncode, r.stderr) == (0, "")
+    assert r.stdout.startswith("servo3     high ")
+    assert r.stdout.endswith(" us, period 20.00 ms (50.0 Hz), duty 7.5%\n")
+    widths = us_values(r.stdout)
+    assert widths and all(abs(v - 1500) <= 1.1 for v in widths), r.stdout
+
+
 def test_live_window_is_drawn_from_zero_in_ms(tmp_path):
     # --from 0 --to 45ms live is the 45 ms after the commands: the axis
     # runs 0..45 ms (it was microseconds since power-up, 372000-417000)

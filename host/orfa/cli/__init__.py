@@ -44,7 +44,9 @@ def _connection_options(parser, suppress: bool) -> None:
                             " --slave, --adc, --spi (before the command) add devices"
                             % "|".join(BOARDS))
     group.add_argument("--baud", type=baud_rate, default=default(p.DEFAULT_BAUD),
-                       help="serial rate (default %d)" % p.DEFAULT_BAUD)
+                       help="serial rate, the gateway's BAUD (default %d; its builds run %d..%d);"
+                            " --sim runs the gateway built for it"
+                            % (p.DEFAULT_BAUD, p.BAUD_RATES[0], p.BAUD_RATES[-1]))
     group.add_argument("--timeout", type=seconds, default=default(2.0), metavar="S",
                        help="seconds to wait for a reply, above 0, at most %g (default 2)"
                             % MAX_TIMEOUT_S)
@@ -56,7 +58,8 @@ def _connection_options(parser, suppress: bool) -> None:
                        default=default(False),
                        help="addresses are 7-bit (i2c-tools' form), not the protocol's 8-bit")
     group.add_argument("--autobaud", action="store_true", default=default(False),
-                       help="open the line with the BAUD=auto preamble (eight CRs, 20 ms quiet)")
+                       help="open the line with the BAUD=auto preamble (eight CRs, 20 ms quiet);"
+                            " --sim runs the board's BAUD=auto gateway")
 
 
 class Parser(argparse.ArgumentParser):

@@ -228,8 +228,11 @@ def add_sim_devices(parser, suppress: bool = False) -> None:
 
 
 def sim_board(board: str, args, **kw) -> SimBoard:
-    """A SimBoard with the devices of args (not started); two devices at
-    one address are a UsageError."""
+    """A SimBoard with the devices of args (not started), running the
+    gateway for --baud and --autobaud (sim_firmware) unless
+    firmware= names one; two devices at one address are a UsageError."""
+    if kw.get("firmware") is None:
+        kw["firmware"] = sim_firmware(board, args)
     seen = {}
     parts = getattr(args, "part", None) or ()
     for opt, addr in ([("--eeprom", a) for a in getattr(args, "eeprom", None) or ()]
@@ -245,11 +248,24 @@ def sim_board(board: str, args, **kw) -> SimBoard:
                     spi=getattr(args, "spi", None) or (), **kw)
 
 
+def sim_firmware(board: str, args):
+    """The gateway a simulated board runs for --baud and --autobaud: the
+    BAUD=auto build with --autobaud (it finds --baud from the preamble),
+    else the one built for --baud (orfa.locate.gateway_firmware). A rate
+    autobaud does not find is a ValueError saying so."""
+    if not args.autobaud:
+        return gateway_firmware(board, args.baud)
+    if args.baud not in p.AUTOBAUD_RATES:
+        raise ValueError("no %s gateway finds %d baud: BAUD=auto detects %s"
+                         % (board, args.baud, " ".join(map(str, p.AUTOBAUD_RATES))))
+    return gateway_firmware(board, "auto")
+
+
 @contextlib.contextmanager
 def connect(args) -> Iterator[Gateway]:
     """The Gateway of --port URL (or $ORFA_PORT), or of a board --sim starts
     for this one command (stopped when the command ends), its gateway built
-    for --baud (orfa.locate.gateway_firmware). An explicit --sim
+    for --baud (sim_board: with --autobaud, the BAUD=auto one). An explicit --sim
     wins over $ORFA_PORT; --port and --sim both given is a usage error."""
     devices = [opt for opt in ("eeprom", "part", "slave", "adc", "spi")
                if getattr(args, opt, None)]
@@ -259,8 +275,7 @@ def connect(args) -> Iterator[Gateway]:
         if args.port:
             raise UsageError("give --port or --sim, not both")
         try:
-            sim = sim_board(args.sim, args, trace=False, control=args.autobaud,
-                            firmware=gateway_firmware(args.sim, args.baud)).start()
+            sim = sim_board(args.sim, args, trace=False, control=args.autobaud).start()
         except (SimError, ValueError) as exc:
             raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
         try:

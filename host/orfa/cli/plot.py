@@ -267,6 +267,8 @@ def _from_sim(args) -> Tuple[Dict[str, waves.Wave], List[str], Namer, int, str, 
         except (SimError, ValueError) as exc:
             raise UsageError(str(exc)) from None
         try:
+            if args.autobaud:          # the BAUD=auto build finds --baud once, before the commands
+                sim.gateway(args.baud, autobaud=True).close()
             t0 = sim.control.time()
             _run_commands(sim.port, args)
             zero = sim.control.time()

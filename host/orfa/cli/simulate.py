@@ -9,7 +9,6 @@ import signal
 import sys
 
 from .. import protocol as p
-from ..locate import gateway_firmware
 from ..sim import BOARDS, SimError
 from .common import UsageError, add_sim_devices, arg, baud_rate, command, sim_board
 from .common import adc_spec, eeprom_spec, slave_spec  # noqa: F401 (here before)
@@ -50,7 +49,7 @@ def cmd_sim(args) -> int:
         extra += ["--vcd", args.vcd]
     try:
         board = sim_board(args.board, args, trace=False,
-                          firmware=args.firmware or gateway_firmware(args.board, args.baud),
+                          firmware=args.firmware,
                           control=control, extra_args=extra).start()
     except (SimError, ValueError) as exc:
         raise UsageError(getattr(exc, "refused", None) or str(exc)) from None
@@ -66,7 +65,7 @@ def cmd_sim(args) -> int:
             link = args.control or None
             if link:
                 _link(board.control_path, link)
-            print(control_label + (link or board.control_path), flush=True)
+            print(control_label + str(link or board.control_path), flush=True)
         if args.terminal:
             with board.gateway(args.baud, autobaud=args.autobaud) as gw:
                 return run_console(gw)
@@ -86,7 +85,8 @@ def add_parsers(sub, common) -> None:
                                         help="the gateway's board (default %(default)s)"))
     add_sim_devices(cmd)
     cmd.add_argument("--firmware", help="ELF to run (default: the board's gateway built for"
-                     " --baud: build/<board>-gate/orfa.elf at 115200)")
+                     " --baud: build/<board>-gate/orfa.elf at 115200; with --autobaud"
+                     " build/<board>-gate-auto/orfa.elf)")
     cmd.add_argument("--control", nargs="?", const="", metavar="PATH",
                      help="open the control socket (at PATH if given) and print its path")
     cmd.add_argument("--trace", metavar="FILE", help="write the bus and serial trace to FILE")
@@ -97,5 +97,6 @@ def add_parsers(sub, common) -> None:
                      help="the gateway's serial rate, its firmware built for it, and the"
                           " console's (default %(default)s)")
     cmd.add_argument("--autobaud", action="store_true",
-                     help="the console opens with the BAUD=auto preamble (eight CRs,"
-                          " 20 ms of simulated quiet)")
+                     help="run the BAUD=auto gateway (build/<board>-gate-auto); the console"
+                          " opens with its preamble (eight CRs, 20 ms of simulated quiet)"
+                          " at --baud")
