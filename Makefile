@@ -98,12 +98,13 @@ endif
 DRIVERS ?= $(BOARD_DRIVERS)
 
 # BUILD=dir puts one more build elsewhere (the test robot's slaves at their addresses).
-# A gateway at a rate other than the default goes to build/<board>-gate-<BAUD>/
-# (gate-rates' builds, where orfa.locate.gateway_firmware, `orfa --sim B --baud R`
-# and `orfa flash --rate R` find it): build/<board>-gate/ is always the
-# default rate's, the one a program opening the port at 115200 runs.
-gate_build = build/$(1)-gate$(if $(filter-out $(DEFAULT_BAUD),$(2)),-$(2))
-BUILD ?= $(if $(filter gate,$(MODE)),$(call gate_build,$(BOARD),$(BAUD)),build/$(BOARD)-$(MODE))
+# build/<board>-<mode>/ is the build of the variables given, whatever BAUD
+# says (the project's contract: `make BOARD=m32d MODE=gate BAUD=auto` is
+# build/m32d-gate/orfa.elf). The gateways at other rates that the tools run
+# (`orfa --sim B --baud R`, `orfa flash --rate R`: orfa.locate.gateway_firmware)
+# are made apart, in build/<board>-gate-<BAUD>/ (gate_build; make gate-rates).
+BUILD ?= build/$(BOARD)-$(MODE)
+gate_build = build/$(1)-gate-$(2)
 # -fno-move-loop-invariants -mstrict-X: 130 bytes less on the M32-D gateway,
 # no slower where it counts (make bench). -mcall-prologues: register saves
 # through one shared routine, 250 bytes less; interrupt handlers keep their
@@ -332,11 +333,13 @@ soak: setup
 	python3 tools/soak.py --requests $(SOAK_REQUESTS) --seed $(SOAK_SEED)
 
 # The demos' console talks at the rate their gateway is built for (BAUD=460800;
-# BAUD=auto: the autobaud build, found from the console's preamble).
+# BAUD=auto: the autobaud build, found from the console's preamble): orfa sim
+# runs the build for that rate (build/<board>-gate-<BAUD>/), and the default
+# gateway stays the 115200 build.
 DEMO_LINE = $(if $(filter auto,$(BAUD)),--autobaud,--baud $(BAUD))
 
 demo: setup
-	@$(MAKE) -s --no-print-directory BOARD=m32d MODE=gate firmware sim
+	@$(MAKE) -s --no-print-directory BOARD=m32d MODE=gate BAUD=$(DEFAULT_BAUD) firmware sim
 	@PYTHONPATH=host exec python3 -m orfa sim --board m32d --eeprom 0xA0 $(DEMO_LINE) --terminal
 
 # A robot: the M32-D gateway, an M128-S slave at 0x10, an M32-D slave at 0x12,
@@ -344,7 +347,7 @@ demo: setup
 # HMC5883L compass at 3C, a LIS3MDL magnetometer at 38, a BMP280 barometer at
 # EC, a 24LC32 EEPROM at A8), all on one simulated I2C bus.
 demo-robot: setup
-	@$(MAKE) --no-print-directory BOARD=m32d MODE=gate firmware sim
+	@$(MAKE) --no-print-directory BOARD=m32d MODE=gate BAUD=$(DEFAULT_BAUD) firmware sim
 	@$(MAKE) --no-print-directory BOARD=m128s MODE=slave ADDR=0x10 \
 		BUILD=build/robot/m128s-0x10 firmware
 	@$(MAKE) --no-print-directory BOARD=m32d MODE=slave ADDR=0x12 \
