@@ -1,6 +1,7 @@
 """The build's own checks: a slave's bus address (docs/registers.md, "On a
 slave board"), the mode."""
 
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -10,9 +11,14 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 
+#: make as a person's shell runs it, not as a sub-make of `make test`
+#: (MAKELEVEL 1 there: make says some things only to a person's command line).
+TOP_ENV = {k: v for k, v in os.environ.items() if k not in ("MAKELEVEL", "MAKEFLAGS", "MFLAGS")}
+
+
 def make(*args, tmp_path):
     return subprocess.run(["make", "--no-print-directory", "-n", "BUILD=%s" % tmp_path] + list(args),
-                          cwd=ROOT, capture_output=True, text=True, timeout=60)
+                          cwd=ROOT, capture_output=True, text=True, timeout=60, env=TOP_ENV)
 
 
 @pytest.mark.parametrize("addr,why", [
