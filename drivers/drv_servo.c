@@ -73,11 +73,10 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	 * cannot bring back what GPIO had there. Most writes only change
 	 * widths: the claims and releases are looked for only where some
 	 * channel starts or stops. */
-	bool changed = false, starts = false, stops = false;
+	bool starts = false, stops = false;
 	for (uint8_t i = 0; i < len; i += 3) {
 		uint8_t ch = data[i];
 		if (next[ch] != servo.width[ch]) {
-			changed = true;
 			if (!servo.width[ch]) {
 				starts = true;
 				if (!servo_hw_can_claim(ch)) {
@@ -88,16 +87,13 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 			}
 		}
 	}
-	if (!changed) {
-		return REG_OK;  /* the pulses already are so: no new schedule */
-	}
 	for (uint8_t i = 0; starts && i < len; i += 3) {
 		uint8_t ch = data[i];
 		if (next[ch] && !servo.width[ch]) {
 			servo_hw_claim(ch);
 		}
 	}
-	servo_hw_apply(next, servo.width);
+	servo_hw_apply(next);
 	for (uint8_t i = 0; i < len; i += 3) {
 		uint8_t ch = data[i];
 		if (stops && !next[ch] && servo.width[ch]) {
@@ -106,6 +102,11 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 		servo.width[ch] = next[ch];
 	}
 	return REG_OK;
+}
+
+void drv_servo_later(void)
+{
+	servo_hw_later(servo.width);
 }
 
 reg_status_t drv_servo_check(uint8_t reg, const uint8_t *data, uint8_t len)

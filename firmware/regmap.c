@@ -195,6 +195,14 @@ void regmap_safe(void)
 #undef X
 }
 
+void regmap_later(void)
+{
+	/* Each driver's DRV_<name>_LATER(): a call, or nothing. */
+#define X(name) DRV_##name##_LATER();
+	ORFA_DRIVER_LIST
+#undef X
+}
+
 reg_status_t regmap_status(void)
 {
 	return (reg_status_t)selected.status;
