@@ -120,7 +120,7 @@ reg_status_t drv_servo_check(uint8_t reg, const uint8_t *data, uint8_t len)
 	/* Every third byte names a channel (a 1-byte write too): bytes 0, 3,
 	 * 6, ... */
 	uint8_t at = (uint8_t)(len - 1);
-	if (servo_triple_at(at) && data[at] >= SERVO_CHANNELS) {
+	if (data[at] >= SERVO_CHANNELS && servo_triple_at(at)) {
 		return REG_BAD_VALUE;
 	}
 	return REG_OK;

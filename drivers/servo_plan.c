@@ -199,8 +199,8 @@ static __attribute__((noinline)) servo_edge_t *servo_drop(servo_edge_t *p, servo
 	return end;
 }
 
-__attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t *last,
-					  const uint16_t *widths_us)
+__attribute__((noinline))
+void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us)
 {
 	/* The channels whose width in cycles is not the one last planned:
 	 * marked, with their new width. */
