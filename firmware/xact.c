@@ -63,11 +63,19 @@ bool xact_write_received(uint8_t byte)
 	switch (xact.state) {
 	case XACT_SELECT:
 		return xact_write_select(byte);
-	case XACT_DATA:
-		if (xact.len < xact.cap) {
-			xact.buf[xact.len] = byte;
+	case XACT_DATA: {
+		/* as xact_write_taken(1), in place: a TWI slave's path a byte,
+		 * in its interrupt, as short as before that function */
+		if (xact.len >= xact.cap) {
+			return xact_refuse(REG_BAD_LENGTH);
 		}
-		return xact_write_taken(1);
+		xact.buf[xact.len++] = byte;
+		reg_status_t st = regmap_check(xact.buf, xact.len);
+		if (st != REG_OK) {
+			return xact_refuse(st);
+		}
+		return true;
+	}
 	default:
 		return false;
 	}
