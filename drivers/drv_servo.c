@@ -94,13 +94,13 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 		}
 	}
 	servo_hw_apply(next);
-	for (uint8_t i = 0; i < len; i += 3) {
+	for (uint8_t i = 0; stops && i < len; i += 3) {
 		uint8_t ch = data[i];
-		if (stops && !next[ch] && servo.width[ch]) {
+		if (!next[ch] && servo.width[ch]) {
 			servo_hw_release(ch);
 		}
-		servo.width[ch] = next[ch];
 	}
+	memcpy(servo.width, next, sizeof next);
 	return REG_OK;
 }
 
