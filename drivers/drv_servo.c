@@ -60,11 +60,17 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	}
 	uint16_t next[SERVO_CHANNELS];
 	memcpy(next, servo.width, sizeof next);
+	bool onoff = false;  /* a triple turns its channel on or off */
 	for (uint8_t i = 0; i < len; i += 3) {
-		if (data[i] >= SERVO_CHANNELS) {
+		uint8_t ch = data[i];
+		if (ch >= SERVO_CHANNELS) {
 			return REG_BAD_VALUE;  /* nothing applied yet: next is a copy */
 		}
-		next[data[i]] = servo_clamp((uint16_t)(data[i + 1] << 8 | data[i + 2]));
+		uint16_t us = servo_clamp((uint16_t)(data[i + 1] << 8 | data[i + 2]));
+		next[ch] = us;
+		if (!us != !servo.width[ch]) {
+			onoff = true;
+		}
 	}
 	/* Only the channels written can change: the loops below go over the
 	 * triples (a channel written twice is looked at twice, to the same
@@ -74,7 +80,7 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	 * widths: the claims and releases are looked for only where some
 	 * channel starts or stops. */
 	bool starts = false, stops = false;
-	for (uint8_t i = 0; i < len; i += 3) {
+	for (uint8_t i = 0; onoff && i < len; i += 3) {
 		uint8_t ch = data[i];
 		if (next[ch] != servo.width[ch]) {
 			if (!servo.width[ch]) {
