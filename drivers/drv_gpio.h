@@ -16,6 +16,7 @@
 #define DRV_gpio_MINOR 1
 /* The link-loss failsafe leaves it as it is. */
 #define DRV_gpio_SAFE() ((void)0)
+#define DRV_gpio_LATER() ((void)0)
 #define DRV_gpio_WAIT() ((void)0)
 
 REGMAP_DRIVER_API(gpio);

@@ -12,6 +12,7 @@
 #define DRV_motor_MINOR 1
 /* The link-loss failsafe stops both motors. */
 #define DRV_motor_SAFE() drv_motor_safe()
+#define DRV_motor_LATER() ((void)0)
 #define DRV_motor_WAIT() ((void)0)
 
 REGMAP_DRIVER_API(motor);

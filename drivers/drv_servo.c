@@ -60,11 +60,17 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	}
 	uint16_t next[SERVO_CHANNELS];
 	memcpy(next, servo.width, sizeof next);
+	bool onoff = false;  /* a triple turns its channel on or off */
 	for (uint8_t i = 0; i < len; i += 3) {
-		if (data[i] >= SERVO_CHANNELS) {
+		uint8_t ch = data[i];
+		if (ch >= SERVO_CHANNELS) {
 			return REG_BAD_VALUE;  /* nothing applied yet: next is a copy */
 		}
-		next[data[i]] = servo_clamp((uint16_t)(data[i + 1] << 8 | data[i + 2]));
+		uint16_t us = servo_clamp((uint16_t)(data[i + 1] << 8 | data[i + 2]));
+		next[ch] = us;
+		if (!us != !servo.width[ch]) {
+			onoff = true;
+		}
 	}
 	/* Only the channels written can change: the loops below go over the
 	 * triples (a channel written twice is looked at twice, to the same
@@ -73,11 +79,10 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 	 * cannot bring back what GPIO had there. Most writes only change
 	 * widths: the claims and releases are looked for only where some
 	 * channel starts or stops. */
-	bool changed = false, starts = false, stops = false;
-	for (uint8_t i = 0; i < len; i += 3) {
+	bool starts = false, stops = false;
+	for (uint8_t i = 0; onoff && i < len; i += 3) {
 		uint8_t ch = data[i];
 		if (next[ch] != servo.width[ch]) {
-			changed = true;
 			if (!servo.width[ch]) {
 				starts = true;
 				if (!servo_hw_can_claim(ch)) {
@@ -88,24 +93,26 @@ static reg_status_t servo_write_sp(const uint8_t *data, uint8_t len)
 			}
 		}
 	}
-	if (!changed) {
-		return REG_OK;  /* the pulses already are so: no new schedule */
-	}
 	for (uint8_t i = 0; starts && i < len; i += 3) {
 		uint8_t ch = data[i];
 		if (next[ch] && !servo.width[ch]) {
 			servo_hw_claim(ch);
 		}
 	}
-	servo_hw_apply(next, servo.width);
-	for (uint8_t i = 0; i < len; i += 3) {
+	servo_hw_apply(next);
+	for (uint8_t i = 0; stops && i < len; i += 3) {
 		uint8_t ch = data[i];
-		if (stops && !next[ch] && servo.width[ch]) {
+		if (!next[ch] && servo.width[ch]) {
 			servo_hw_release(ch);
 		}
-		servo.width[ch] = next[ch];
 	}
+	memcpy(servo.width, next, sizeof next);
 	return REG_OK;
+}
+
+void drv_servo_later(void)
+{
+	servo_hw_later(servo.width);
 }
 
 reg_status_t drv_servo_check(uint8_t reg, const uint8_t *data, uint8_t len)
@@ -119,7 +126,7 @@ reg_status_t drv_servo_check(uint8_t reg, const uint8_t *data, uint8_t len)
 	/* Every third byte names a channel (a 1-byte write too): bytes 0, 3,
 	 * 6, ... */
 	uint8_t at = (uint8_t)(len - 1);
-	if (servo_triple_at(at) && data[at] >= SERVO_CHANNELS) {
+	if (data[at] >= SERVO_CHANNELS && servo_triple_at(at)) {
 		return REG_BAD_VALUE;
 	}
 	return REG_OK;

@@ -18,10 +18,13 @@
 /* The link-loss failsafe turns every channel off (limp). */
 #define DRV_servo_SAFE() drv_servo_safe()
 #define DRV_servo_WAIT() ((void)0)
+#define DRV_servo_LATER() drv_servo_later()
 
 REGMAP_DRIVER_API(servo);
 /* Every channel's width 0 (no pulses, line low), as a host's writes of
  * [ch][00][00] for each would. */
 void drv_servo_safe(void);
+/* What a write left for later, with the widths it set: servo_hw_later(). */
+void drv_servo_later(void);
 
 #endif

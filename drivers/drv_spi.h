@@ -22,6 +22,7 @@
 #define DRV_spi_MINOR 1
 /* The link-loss failsafe leaves it as it is. */
 #define DRV_spi_SAFE() ((void)0)
+#define DRV_spi_LATER() ((void)0)
 /* An exchange goes on while an interrupt waits (spi_hw.h). */
 #define DRV_spi_WAIT() spi_hw_pump()
 

@@ -26,13 +26,18 @@ void motor_hw_init(void)
 }
 
 /* High for OCR+1 of 368 cycles: OCR = round(pwm * 368 / 255) - 1, with
- * 368 = 255 + 113 taken apart so the division is 16-bit (no 32-bit
- * division linked): pwm * 255 divides exactly. */
-_Static_assert(MOTOR_TOP + 1 >= 255 && 255u * (MOTOR_TOP + 1 - 255) + 127u <= 0xFFFFu,
-	       "pwm * (368 - 255) + 127 fits 16 bits");
+ * 368 = 255 + 113 taken apart: pwm * 255 divides exactly, and
+ * (pwm * 113 + 127) / 255 is (y + y / 256) / 256 with y = pwm * 113 + 128,
+ * the same for every pwm from 1 to 255 (all 255 compared when it was
+ * written; tests/sim/test_drv_motor.py measures the duty on the pins): a
+ * multiply and a few adds, where libgcc's division took ~190 cycles a
+ * motor (~380 a step of the control loop). */
+_Static_assert(MOTOR_TOP == 367, "the division's stand-in is for 368 = 255 + 113");
 static uint16_t motor_ocr(uint8_t pwm)
 {
-	return (uint16_t)(pwm + (uint16_t)(pwm * (uint16_t)(MOTOR_TOP + 1 - 255) + 127u) / 255u - 1);
+	uint16_t y = (uint16_t)(pwm * 113u + 128u);
+
+	return (uint16_t)(pwm + ((uint16_t)(y + (y >> 8)) >> 8) - 1);
 }
 
 void motor_hw_apply(const uint8_t *pwm, const uint8_t *dir, uint8_t lines)

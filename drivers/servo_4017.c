@@ -306,9 +306,14 @@ static uint16_t counter_plan(frame_plan_t *s, uint8_t c, const uint16_t *widths_
 	}
 }
 
-void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
+/* Nothing waits: each counter's frame is planned at once. */
+void servo_hw_later(const uint16_t *widths_us)
 {
-	(void)was_us;  /* each counter's frame is planned afresh */
+	(void)widths_us;
+}
+
+void servo_hw_apply(const uint16_t *widths_us)
+{
 	pulses.pending = 0;  /* the frame interrupt must not take it half written */
 	frame_plan_t *s = &pulses.sched[pulses.cur ^ 1];
 	static const __flash uint8_t unit[SERVO_COUNTERS] = {

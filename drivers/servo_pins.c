@@ -11,7 +11,8 @@
  * whatever else the firmware is doing.
  *
  * The main loop plans a new schedule (edges in time order) when widths
- * change, into the buffer the interrupt is not running, and the interrupt
+ * change, once the write's reply is queued (servo_hw_later()), into the
+ * buffer the interrupt is not running, and the interrupt
  * takes it over at the next frame boundary: a frame never mixes old and
  * new widths.
  */
@@ -103,6 +104,7 @@ static struct {
 	volatile uint8_t active;     /* sched[] the interrupt runs */
 	volatile uint8_t pending;    /* the other one is newer */
 	volatile uint8_t running;
+	uint8_t marked;              /* widths changed since the last plan */
 	const servo_edge_t *edge;    /* the next edge, in sched[active] */
 	const servo_edge_t *end;     /* past sched[active]'s last edge */
 	uint16_t frame;              /* Timer2 tick of the frame's start */
@@ -338,10 +340,9 @@ ISR(TIMER2_COMP_vect)
 void servo_hw_init(void)
 {
 	board_pins_of(BF_SERVO, servo_pin);
-	pulses.running = 0;
-	pulses.pending = 0;
-	pulses.active = 0;
-	pulses.sched[0].n = 0;
+	/* pulses: not running, nothing pending, sched[0] empty and active, as
+	 * static storage starts (this runs once, after reset: 16 B of
+	 * stores less) */
 	/* Timer0 counts every cycle; Timer2 counts every 8th, run free by
 	 * the time base (firmware/clock.c), which counts its overflows. */
 	TCCR0 = _BV(CS00);
@@ -375,8 +376,20 @@ void servo_hw_release(uint8_t ch)
 	pins_release(servo_pin[ch], PIN_SERVO);
 }
 
-void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
+/* The plan waits for servo_hw_later(): it compares the widths then with
+ * those it planned last (servo_plan()). */
+void servo_hw_apply(const uint16_t *widths_us)
 {
+	(void)widths_us;
+	pulses.marked = 1;
+}
+
+void servo_hw_later(const uint16_t *widths_us)
+{
+	if (!pulses.marked) {
+		return;
+	}
+	pulses.marked = 0;
 	uint8_t newer;
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
 		/* The interrupt must not take the buffer half written. */
@@ -391,7 +404,7 @@ void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
 		s = run;
 		run = &pulses.sched[1];
 	}
-	servo_plan(s, newer ? s : run, widths_us, was_us);
+	servo_plan(s, newer ? s : run, widths_us);
 	uint8_t n = s->n;
 
 	ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {

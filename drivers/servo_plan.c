@@ -44,8 +44,12 @@ _Static_assert(SERVO_SLOT * (SERVO_NEIGHBOURS + 1) + SERVO_LONGEST + 2UL * SERVO
 
 static struct {
 	int8_t move[SERVO_CHANNELS];     /* each channel's place: SERVO_SHIFTs off its slot */
-	uint16_t w[SERVO_CHANNELS];      /* width in cycles as last planned; 0 = off */
+	uint16_t w[SERVO_CHANNELS];      /* width in cycles as last marked; 0 = off; with
+					  * SERVO_MARK: changed, not placed yet */
 } placed;
+/* A width in cycles is at most SERVO_LONGEST: bit 15 is free for the mark. */
+#define SERVO_MARK 0x8000u
+_Static_assert(SERVO_LONGEST < SERVO_MARK, "a width in cycles leaves bit 15 free");
 
 /* Cycles for a width in microseconds, rounded to the nearest: us * 7.3728
  * as a 16.16 fixed-point product (a division took 600 cycles a channel). */
@@ -82,7 +86,7 @@ static int16_t servo_clear(const int16_t *d, uint8_t n)
 }
 
 /* Channel ch (its width changed, not 0) at the nearest place clear of the
- * channels placed (changed[] those still to place): 0, -1, +1, -2, ...
+ * channels placed (those SERVO_MARK still marks are still to place): 0, -1, +1, -2, ...
  * SERVO_SHIFTs from its slot, never before the frame's start; where none
  * is clear, it stays where it was (and the interrupt makes its edges as
  * near their cycles as it can). */
@@ -95,7 +99,7 @@ static inline int16_t *servo_near(int16_t *end, uint16_t x)
 	return end;
 }
 
-static __attribute__((noinline)) void servo_place(uint8_t ch, const uint8_t *changed)
+static __attribute__((noinline)) void servo_place(uint8_t ch)
 {
 	/* Each neighbour's edges as distances from this channel's rise at
 	 * move 0; of those, a channel before it can only come near its rise
@@ -114,8 +118,8 @@ static __attribute__((noinline)) void servo_place(uint8_t ch, const uint8_t *cha
 			continue;
 		}
 		uint16_t cw = placed.w[c];
-		if (!cw || (k > 0 && changed[c])) {
-			continue;
+		if (!cw || (cw & SERVO_MARK)) {
+			continue;  /* off, or changed and still to place (after ch) */
 		}
 		uint16_t x = (uint16_t)(k * (int16_t)SERVO_SLOT + placed.move[c] * SERVO_SHIFT);
 		uint16_t y = (uint16_t)(x + cw);
@@ -195,17 +199,17 @@ static __attribute__((noinline)) servo_edge_t *servo_drop(servo_edge_t *p, servo
 	return end;
 }
 
-__attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t *last,
-					  const uint16_t *widths_us, const uint16_t *was_us)
+__attribute__((noinline))
+void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us)
 {
-	uint8_t changed[SERVO_CHANNELS];
+	/* The channels whose width in cycles is not the one last planned:
+	 * marked, with their new width. */
 	uint16_t *w = placed.w;
-
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, w++) {
 		uint16_t us = widths_us[ch];
-		changed[ch] = us != was_us[ch];
-		if (changed[ch]) {
-			*w = us ? servo_cycles(us) : 0;
+		uint16_t cw = us ? servo_cycles(us) : 0;
+		if (cw != *w) {
+			*w = (uint16_t)(cw | SERVO_MARK);
 		}
 	}
 	/* The last schedule, then each changed channel in channel order: placed
@@ -220,10 +224,12 @@ __attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t 
 	servo_edge_t *from = first;  /* no changed channel's rise before this */
 	uint32_t slot = 0;           /* the channel's slot start */
 	for (uint8_t ch = 0; ch < SERVO_CHANNELS; ch++, slot += SERVO_SLOT) {
-		if (!changed[ch]) {
+		uint16_t cw = placed.w[ch];
+		if (!(cw & SERVO_MARK)) {
 			continue;
 		}
-		uint16_t cw = placed.w[ch];
+		cw = (uint16_t)(cw & ~SERVO_MARK);
+		placed.w[ch] = cw;  /* placed now: no longer marked */
 		/* Its fall is after its rise, and stays so however the rise moves
 		 * (the edges it passes move towards where it was). */
 		servo_edge_t *rise = servo_find(from, end, ch);
@@ -237,7 +243,7 @@ __attribute__((noinline)) void servo_plan(servo_sched_t *s, const servo_sched_t 
 			continue;
 		}
 		int8_t move = placed.move[ch];
-		servo_place(ch, changed);
+		servo_place(ch);
 		uint32_t r = slot + (int16_t)(placed.move[ch] * SERVO_SHIFT);
 		servo_edge_t *fall;
 		if (rise == end) {

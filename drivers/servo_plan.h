@@ -49,11 +49,11 @@ static inline uint32_t servo_cycle(const servo_edge_t *e)
 
 /* Plans channel widths in microseconds (0 = off, else 500..2500) into `s`
  * from `last`, the schedule planned before (empty at first; it may be `s`
- * itself) and `was_us`, the widths it had. A channel whose width is the
- * same as before stays where it was; the others are placed in channel
+ * itself). A channel whose width in cycles is the one the last call planned
+ * stays where it was (so the widths may change more than once between two
+ * plans); the others are placed in channel
  * order, each at the nearest place clear of the channels that stayed and
  * of those placed before it. */
-void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us,
-		const uint16_t *was_us);
+void servo_plan(servo_sched_t *s, const servo_sched_t *last, const uint16_t *widths_us);
 
 #endif

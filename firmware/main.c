@@ -25,5 +25,6 @@ int main(void)
 	for (;;) {
 		wdt_reset();
 		front_poll();
+		regmap_later();
 	}
 }

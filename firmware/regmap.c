@@ -134,15 +134,25 @@ bool regmap_select(uint8_t reg)
 	return true;
 }
 
-reg_status_t regmap_check(const uint8_t *data, uint8_t len)
+reg_status_t regmap_check_from(const uint8_t *data, uint8_t from, uint8_t len)
 {
+	if (from >= len) {
+		return REG_OK;  /* nothing new (a frame of its register byte alone) */
+	}
 	if (selected.entry == REGMAP_NO_ENTRY) {
 		return REG_NO_REGISTER;
 	}
 	if (selected.reg == REGMAP_STATUS_REG) {
 		return REG_NOT_WRITABLE;
 	}
-	return regmap_row()->check(selected.off, data, len);
+	reg_status_t (*check)(uint8_t, const uint8_t *, uint8_t) = regmap_row()->check;
+	uint8_t off = selected.off;
+	reg_status_t st;
+
+	do {
+		st = check(off, data, ++from);
+	} while (from < len && st == REG_OK);
+	return st;
 }
 
 reg_status_t regmap_write(const uint8_t *data, uint8_t len)
@@ -191,6 +201,14 @@ void regmap_safe(void)
 {
 	/* Each driver's DRV_<name>_SAFE(): a call, or nothing. */
 #define X(name) DRV_##name##_SAFE();
+	ORFA_DRIVER_LIST
+#undef X
+}
+
+void regmap_later(void)
+{
+	/* Each driver's DRV_<name>_LATER(): a call, or nothing. */
+#define X(name) DRV_##name##_LATER();
 	ORFA_DRIVER_LIST
 #undef X
 }

@@ -64,6 +64,11 @@ typedef enum {
  *       as if the host had written it (drv_name_safe() for motors and
  *       servos), or ((void)0) for a driver that has none. Every driver
  *       says which, so none is forgotten.
+ *   DRV_name_LATER()
+ *       a statement-like macro, called by the main loop after each round
+ *       of the front end (regmap_later()): what a write left to do once
+ *       its reply is on its way (servo_hw_later(): the M32-D's edge plan),
+ *       or ((void)0).
  *   DRV_name_WAIT()
  *       a statement-like macro, called with interrupts off by an interrupt
  *       that waits with them off (the M32-D slave's servo edges,
@@ -87,8 +92,18 @@ void regmap_init(void);
 bool regmap_select(uint8_t reg);
 
 /* Whether a write of the selected register that starts with these `len`
- * bytes can still be taken (drv_name_check). */
-reg_status_t regmap_check(const uint8_t *data, uint8_t len);
+ * bytes can still be taken, data[from..len) having arrived since the last
+ * look: the driver's check (drv_name_check) at each of those lengths in
+ * turn, up to the first that refuses; its reason, or REG_OK. The driver's
+ * check is looked up once for all of them (the gateway hands a frame's
+ * bytes in at once: ~50 cycles a byte less than a call for each). */
+reg_status_t regmap_check_from(const uint8_t *data, uint8_t from, uint8_t len);
+
+/* The newest byte alone (a TWI slave's, one at a time). */
+static inline reg_status_t regmap_check(const uint8_t *data, uint8_t len)
+{
+	return regmap_check_from(data, (uint8_t)(len - 1), len);
+}
 
 /* Delivers one write frame's data to the selected register. */
 reg_status_t regmap_write(const uint8_t *data, uint8_t len);
@@ -105,6 +120,10 @@ uint8_t regmap_read(uint8_t *dst, uint8_t max);
 /* The link-loss failsafe tripped: every driver's DRV_name_SAFE() (motors
  * stop, servos go limp); the status register is left as it is. */
 void regmap_safe(void);
+
+/* Every driver's DRV_name_LATER(): the work a write left for the main loop
+ * (main(), after each front_poll()). */
+void regmap_later(void);
 
 /* The status register's value (what reading register 0x01 gives). */
 reg_status_t regmap_status(void);

@@ -47,21 +47,25 @@ static bool xact_refuse(reg_status_t why)
 	return false;
 }
 
+bool xact_write_select(uint8_t reg)
+{
+	/* After an unmapped register none is selected (regmap.h): a read
+	 * then gives nothing, not the register selected before. */
+	if (!regmap_select(reg)) {
+		return xact_refuse(REG_NO_REGISTER);
+	}
+	xact.state = XACT_DATA;
+	return true;
+}
+
 bool xact_write_received(uint8_t byte)
 {
 	switch (xact.state) {
 	case XACT_SELECT:
-		/* After an unmapped register none is selected (regmap.h): a
-		 * read then gives nothing, not the register selected before. */
-		if (!regmap_select(byte)) {
-			return xact_refuse(REG_NO_REGISTER);
-		}
-		xact.state = XACT_DATA;
-		return true;
+		return xact_write_select(byte);
 	case XACT_DATA: {
-		/* Refused as early as it is known (the buffer is full, the
-		 * driver can take no write that starts so), so a TWI slave can
-		 * refuse the byte after it. */
+		/* as xact_write_taken(1), in place: a TWI slave's path a byte,
+		 * in its interrupt, as short as before that function */
 		if (xact.len >= xact.cap) {
 			return xact_refuse(REG_BAD_LENGTH);
 		}
@@ -75,6 +79,26 @@ bool xact_write_received(uint8_t byte)
 	default:
 		return false;
 	}
+}
+
+bool xact_write_taken(uint8_t n)
+{
+	if (xact.state != XACT_DATA) {
+		return false;  /* refused already (or its register byte was) */
+	}
+	/* Refused as early as it is known (the buffer is full, the driver
+	 * can take no write that starts so), so a TWI slave can refuse the
+	 * byte after it. */
+	uint8_t len = xact.len;
+	if (n > (uint8_t)(xact.cap - len)) {
+		return xact_refuse(REG_BAD_LENGTH);
+	}
+	xact.len = (uint8_t)(len + n);
+	reg_status_t st = regmap_check_from(xact.buf, len, xact.len);
+	if (st != REG_OK) {
+		return xact_refuse(st);
+	}
+	return true;
 }
 
 /* The driver's next answer goes after the bytes already answered, so a

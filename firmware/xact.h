@@ -45,6 +45,16 @@ void xact_write_requested(uint8_t *buf, uint8_t cap);
  * tells why. */
 bool xact_write_received(uint8_t byte);
 
+/* The write frame's first byte, its register, as xact_write_received()
+ * takes it (the frame has just begun). */
+bool xact_write_select(uint8_t reg);
+
+/* The next n data bytes of the write frame at once, already in place in its
+ * buffer: exactly as n calls of xact_write_received() with them would
+ * take them (a front end that handed in the very bytes it parsed: the
+ * gateway). False: refused, as there. */
+bool xact_write_taken(uint8_t n);
+
 /* A read frame begins; driver answers go to `cap` (>= 1) bytes at `buf` (at
  * least REGMAP_READ_MAX for a front end that does not know the read length).
  * False when the selected register cannot be read (status tells). */

@@ -57,10 +57,9 @@ static uint8_t run_local(uint8_t addr, uint8_t *data, uint8_t n)
 		return err;
 	}
 	xact_write_requested(data + 1, n ? (uint8_t)(n - 1) : 0);
-	for (uint8_t k = 0; k < n && err == SG_OK; k++) {
-		if (!xact_write_received(data[k])) {
-			err = SG_ERR_DATA_NACK;
-		}
+	/* the register byte, then the data in place at once */
+	if (n && (!xact_write_select(data[0]) || !xact_write_taken((uint8_t)(n - 1)))) {
+		err = SG_ERR_DATA_NACK;
 	}
 	if (xact_frame_end() != REG_OK) {
 		err = SG_ERR_DATA_NACK;

@@ -19,6 +19,7 @@ REGMAP_DRIVER_API(fake);
 /* Its link-loss safe state: counts the calls. */
 #define DRV_fake_SAFE() drv_fake_safe()
 void drv_fake_safe(void);
+#define DRV_fake_LATER() ((void)0)
 extern unsigned fake_safe_calls;
 /* The time base's count (firmware/clock.h), set by the tests. */
 extern volatile uint16_t clock_wraps;

@@ -136,11 +136,15 @@ void servo_hw_release(uint8_t ch)
 	hw.servo_releases++;
 }
 
-void servo_hw_apply(const uint16_t *widths_us, const uint16_t *was_us)
+void servo_hw_apply(const uint16_t *widths_us)
 {
-	(void)was_us;
 	memcpy(hw.servo_width, widths_us, sizeof hw.servo_width);
 	hw.servo_applies++;
+}
+
+void servo_hw_later(const uint16_t *widths_us)
+{
+	(void)widths_us;
 }
 
 /* --- motor_hw ------------------------------------------------------------- */

@@ -159,7 +159,7 @@ static void step(const uint16_t *us, int taken, long n)
 		running ^= 1;
 	}
 	servo_sched_t *s = &buf[running ^ 1];
-	servo_plan(s, taken ? &buf[running] : s, us, last_us);
+	servo_plan(s, taken ? &buf[running] : s, us);
 	memcpy(last_us, us, sizeof last_us);
 	decode(s, rise, fall, n);
 	int count = 0, ok_width = 1, ok_move = 1, ok_same = 1;
