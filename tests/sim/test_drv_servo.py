@@ -147,6 +147,50 @@ def test_m32d_a_channel_not_written_keeps_its_place(drv):
         check_pulses(drv, pins[ch], us, since)
 
 
+#: docs/registers.md: an M32-D write's widths are planned about a
+#: millisecond after the write's line ends.
+PLAN_WITHIN = F_CPU // 1000
+
+
+def test_m32d_a_write_starts_at_the_first_frame_after_its_plan(drv):
+    """M32-D (docs/registers.md): the board plans a write's edges once its
+    reply is queued, and the interrupt takes a plan over when a frame's
+    last edge is out, for the next frame. Channel 0 alone (its pulse
+    starts the frame and is its last edge), written with its line ending
+    from 3 ms before that last edge to 3 ms after: the next frame runs the
+    new width when the line ended over PLAN_WITHIN before the last edge,
+    the one after when it ended after it; the plan's time is printed."""
+    if drv.board != "m32d" or drv.slave:
+        pytest.skip("the M32-D gateway's own servos only")
+    pin = drv.lay["servo_pins"][0]
+    byte = 10 * F_CPU // 115200
+    set_widths(drv, {0: 1000})
+    settle(drv, 2)
+    made, missed = [], []
+    for k, d in enumerate(range(-3000, 3001, 250)):
+        old, us = (1000, 2000) if k % 2 == 0 else (2000, 1000)
+        line = b"SAA%02X00%04XP\n" % (sp(drv), us)
+        start = drv.highs(pin, drv.now() - 2 * SERVO_FRAME)[-1][0] + 3 * SERVO_FRAME
+        last = start + us_to_cycles(old)                  # that frame's last edge
+        end = drv.ctl.rx(last + d * F_CPU // 1000000 - len(line) * byte, line)
+        drv.wait(start + 3 * SERVO_FRAME - drv.now())
+        assert drv.gw.read_reply() == "SWAAAAP"
+        new = [r for r, high, _ in drv.highs(pin, start)
+               if abs(high - us_to_cycles(us)) <= WIDTH_TOL]
+        # the frame that ran it: the next one's start, or the one after's
+        first = [f for f in (start + SERVO_FRAME, start + 2 * SERVO_FRAME)
+                 if new and abs(new[0] - f) < 64]
+        assert first, (d, start, new[:2])
+        taken = first[0] == start + SERVO_FRAME
+        if end > last:
+            assert not taken, (d, "a plan was taken before its write")
+        elif last - end > PLAN_WITHIN:
+            assert taken, (d, last - end, "the plan came later than the docs say")
+        (made if taken else missed).append(last - end)
+    print("\nm32d: a write's plan was ready %d..%d cycles after its line ended" % (
+        max([c for c in missed if c > 0], default=0), min(made)))
+
+
 def test_m32d_edges_in_a_row_whatever_the_timer_phase(drv):
     """M32-D: channel 1 ends 401 cycles before channel 2 starts (moved 320
     late by the planner) and 425 before channel 0 ends: the interrupt makes
