@@ -1160,6 +1160,8 @@ def main():
         "%14.2f" % (100.0 * results[b]["pipeline"][2] / results[b]["pipeline"][1]) for b in args.boards)
         + "%10s" % ">= 99")
     for i, label in enumerate(("servo write, 1 triple (cycles)", "servo write, 16 triples (cycles)")):
+        # from the request's end to the reply (latency(): the M32-D plans the
+        # edges after that, the note below the table says)
         print("%-*s" % (width, label) + "".join(
             "%14d" % results[b]["servo write"][i][0] for b in args.boards)
             + "%10s" % ("<= 10000" if i == 0 else "< wire"))
@@ -1193,6 +1195,9 @@ def main():
         "%14.1f" % results[b]["speed"] for b in args.boards))
     print()
     print("Targets are the M32-D's (issue 2); flash/RAM budget = ORFA 0.7.5's own M32-D figures.")
+    print("A servo write's cycles run from its request's end to its reply; the M32-D plans the\n"
+          "new edges once the reply is queued (a one-channel write's plan is ready 3700-5500\n"
+          "cycles after its line ends: docs/registers.md, tests/sim/test_drv_servo.py).")
     ok = all(results[b]["pipeline"][0] == n for b in args.boards)
 
     print_ping_pong(args.boards, width)
