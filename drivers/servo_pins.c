@@ -120,7 +120,20 @@ static uint8_t servo_pin[SERVO_CHANNELS];
 _Static_assert((0 BOARD_PINS(SERVO_PIN_ROW)) == SERVO_CHANNELS, "a pin for every servo channel");
 #undef SERVO_PIN_ROW
 
+/*
+ * A channel turned off gives its line back at once (to GPIO, or to the
+ * stopped motor that lent it, which a PWM may start by the next request),
+ * while the interrupt runs the old schedule, the channel's edges in it, up
+ * to the frame a plan without it starts. Its pin is marked SERVO_PIN_GONE
+ * then (a claim takes the mark off): the interrupt writes its port back as
+ * it is, never the line (its fall pulled a motor's steady PWM 255 low for
+ * good, tests/sim/test_drv_motor.py). A bit pin IDs leave free (ports A-D:
+ * 0..31), so no RAM; port_addr[] twice, so a marked pin's port is the same.
+ */
+#define SERVO_PIN_GONE 0x20
+_Static_assert(PIN_ID('D', 7) < SERVO_PIN_GONE, "pin IDs leave bit 5 free");
 static const __flash uint8_t port_addr[] = {
+	_SFR_MEM_ADDR(PORTA), _SFR_MEM_ADDR(PORTB), _SFR_MEM_ADDR(PORTC), _SFR_MEM_ADDR(PORTD),
 	_SFR_MEM_ADDR(PORTA), _SFR_MEM_ADDR(PORTB), _SFR_MEM_ADDR(PORTC), _SFR_MEM_ADDR(PORTD),
 };
 static const __flash uint8_t line_mask[8] = { 1, 2, 4, 8, 16, 32, 64, 128 };
@@ -262,6 +275,9 @@ static inline __attribute__((always_inline)) void servo_interrupt(void)
 		uint8_t pin = servo_pin[e & SERVO_CHAN];
 		volatile uint8_t *reg = (volatile uint8_t *)(uint16_t)port_addr[PIN_PORT(pin)];
 		uint8_t mask = line_mask[pin & 7];
+		if (pin & SERVO_PIN_GONE) {
+			mask = 0;  /* not the servo's line any more: left as it is */
+		}
 		uint8_t lo = pulses.target_t0;
 		uint8_t and_mask = (e & SERVO_FALL) ? (uint8_t)~mask : 0xFF;
 		uint8_t or_mask = (e & SERVO_FALL) ? 0 : mask;
@@ -358,22 +374,25 @@ void servo_hw_init(void)
 
 bool servo_hw_can_claim(uint8_t ch)
 {
-	return pins_can_claim(servo_pin[ch], PIN_SERVO);
+	return pins_can_claim((uint8_t)(servo_pin[ch] & ~SERVO_PIN_GONE), PIN_SERVO);
 }
 
 bool servo_hw_claim(uint8_t ch)
 {
-	uint8_t pin = servo_pin[ch];
+	uint8_t pin = (uint8_t)(servo_pin[ch] & ~SERVO_PIN_GONE);
 	if (!pins_claim(pin, PIN_SERVO)) {
 		return false;
 	}
 	pins_drive(pin, false);  /* output, low */
+	servo_pin[ch] = pin;     /* the interrupt's edges drive it again */
 	return true;
 }
 
 void servo_hw_release(uint8_t ch)
 {
-	pins_release(servo_pin[ch], PIN_SERVO);
+	uint8_t pin = servo_pin[ch];
+	servo_pin[ch] = (uint8_t)(pin | SERVO_PIN_GONE);  /* first: the interrupt leaves it */
+	pins_release(pin, PIN_SERVO);
 }
 
 /* The plan waits for servo_hw_later(): it compares the widths then with

@@ -52,7 +52,11 @@ bool xact_write_select(uint8_t reg);
 /* The next n data bytes of the write frame at once, already in place in its
  * buffer: exactly as n calls of xact_write_received() with them would
  * take them (a front end that handed in the very bytes it parsed: the
- * gateway). False: refused, as there. */
+ * gateway; tests/unit/test_xact.c compares the two) when they fit the
+ * buffer. n bytes that do not fit are refused whole as too long
+ * (REG_BAD_LENGTH) before any is checked, where the bytes one at a time
+ * would have their check first; the gateway's buffer is its frame, so it
+ * never gives more. False: refused, as there. */
 bool xact_write_taken(uint8_t n);
 
 /* A read frame begins; driver answers go to `cap` (>= 1) bytes at `buf` (at

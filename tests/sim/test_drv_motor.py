@@ -201,3 +201,33 @@ def test_servo_14_15_borrow_stopped_motor_lines(drv):
     assert drv.pin("D5") == (0, "out")
     drv.wr(reg(drv, 0), b"\x80")                                 # motor 1 may run again
     check_state(drv, 0x80, 0x80, 0, 0)
+
+
+@pytest.mark.parametrize("pwm", [255, 0x80])
+def test_servo_14_off_then_motor_1_at_once_keeps_the_motor_line(drv, pwm):
+    """Servo 14 turned off gives PD5 back to motor 1 at once (a PWM for it
+    is taken by the very next request), so the servo's old schedule, which
+    the interrupt runs until the frame a plan without channel 14 starts,
+    must not write PD5 any more: its fall pulled motor 1's steady high
+    (PWM 255 is the port's level, the compare output off) low for good,
+    and its rise put a 1.5 ms high into a PWM of 0x80 (read back: 1, the
+    motor kept its register value). Every instant of the frame is tried
+    by writing right after the servo's rise (the fall still to come) and
+    right after its fall (the next frame's pulse still to come)."""
+    sp = drv.lay["servo"] + 1
+    for after in ("rise", "fall"):
+        drv.wr(sp, bytes([14, 0x05, 0xDC]))                   # servo 14: 1500 us
+        drv.wait(2 * SERVO_FRAME + 8192)
+        rise = drv.edges("D5", drv.now() - SERVO_FRAME)[0]
+        at = rise[0] + (1000 if after == "rise" else 11059 + 1000) + 2 * SERVO_FRAME
+        drv.wait(at - drv.now())
+        drv.wr(sp, bytes([14, 0, 0]))                          # servo 14 off
+        drv.wr(reg(drv, 0), bytes([pwm]))                      # motor 1 at once
+        drv.wait(3 * SERVO_FRAME)
+        since = drv.now()
+        drv.wait(60 * PWM_PERIOD)
+        check_pwm(drv, "D5", pwm, since)
+        if pwm != 255:
+            m = drv.measure("D5", since - 3 * SERVO_FRAME + 4 * PWM_PERIOD)
+            assert m["high"][1] < PWM_PERIOD, (after, "a servo pulse on motor 1's line", m)
+        drv.wr(reg(drv, 0), b"\x00")

@@ -516,3 +516,29 @@ def test_m32d_servo_on_an_adc_line_is_refused(drv):
     assert drv.rd(drv.lay["adc"], 2) == b"\x01\x04"
     since = settle(drv, 3)
     check_pulses(drv, "A3", 1500, since)
+
+
+def test_m32d_a_channel_turned_off_leaves_its_line_to_gpio_at_once(drv):
+    """M32-D: a channel turned off is GPIO's line at once; the edges of it
+    that the frame running (or the next, before the plan without it is
+    taken over) still holds must not reach it: GPIO makes it an output,
+    high, with the very next requests, and it stays high (the old
+    schedule's fall pulled it low)."""
+    if drv.board != "m32d":
+        pytest.skip("the M32-D's own pins")
+    pin = drv.lay["servo_pins"][0]
+    port = drv.lay["gpio_ports"].index(pin[0])
+    bit = bytes([1 << int(pin[1])])
+    set_widths(drv, {0: 1500})
+    settle(drv, 2)
+    fall = drv.edges(pin, drv.now() - SERVO_FRAME)[-1]
+    assert fall[1] == 0, fall
+    drv.wait(fall[0] + 2 * SERVO_FRAME + 1000 - drv.now())     # just after a fall
+    set_widths(drv, {0: 0})
+    drv.wr(drv.lay["gpio_mode"] + port, bit + bit)             # output ...
+    drv.wr(drv.lay["gpio_val"] + port, bit + bit)              # ... high
+    since = drv.now()
+    drv.wait(3 * SERVO_FRAME)
+    assert drv.edges(pin, since) == [], pin
+    assert drv.pin(pin) == (1, "out"), pin
+    drv.wr(drv.lay["gpio_mode"] + port, b"\x00" + bit)

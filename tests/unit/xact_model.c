@@ -41,6 +41,24 @@ void xact_model_gateway(const frame_t *f, result_t *r)
 	r->status = xact_model_status();
 }
 
+void xact_model_local(const frame_t *f, result_t *r)
+{
+	uint8_t bytes[1 + SLAVE_BUF];
+	if (f->read) {
+		xact_model_gateway(f, r);  /* the same calls */
+		return;
+	}
+	memset(r, 0, sizeof *r);
+	bytes[0] = f->reg;
+	memcpy(bytes + 1, f->data, f->n);
+	xact_write_requested(bytes + 1, f->n);
+	if (xact_write_select(bytes[0]) && xact_write_taken(f->n)) {
+		r->acks = (uint8_t)(1 + f->n);
+	}
+	r->end = xact_frame_end();
+	r->status = xact_model_status();
+}
+
 /* The slave's way (i2c_slave/): its own 64-byte buffer, bytes one at a time
  * with no length known; the master stops after n. */
 void xact_model_slave(const frame_t *f, result_t *r)

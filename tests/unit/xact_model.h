@@ -36,8 +36,16 @@ typedef struct {
  * frame reads the register its own select named). */
 uint8_t xact_model_status(void);
 
-/* The gateway's way (serialgate/sg_exec.c run_local). */
+/* The gateway's way before it took a write frame's data in one call: the
+ * bytes in place, one xact_write_received() each (acks: where a refusal
+ * lands, as a slave's). */
 void xact_model_gateway(const frame_t *f, result_t *r);
+
+/* The gateway's way now (serialgate/sg_exec.c run_local): the register
+ * byte with xact_write_select(), the data in place with one
+ * xact_write_taken(); acks: all of the frame's bytes or none (the gateway
+ * replies all or an error). */
+void xact_model_local(const frame_t *f, result_t *r);
 
 /* A slave's way: its own buffer, bytes one at a time. */
 void xact_model_slave(const frame_t *f, result_t *r);
