@@ -186,8 +186,14 @@ def test_a_flood_before_the_first_reply_ends_in_no_reset(board):
     with start(board) as sim, serial.Serial(sim.port, rate, timeout=REPLY_TIMEOUT) as port:
         ctl = sim.control
         ctl.wait(1000)                      # the simulator reads the port's rate
-        at = ctl.rx_after(1000, AUTOBAUD_PREAMBLE)
-        at = first = ctl.rx(at + F_CPU // 50, blob)    # a host waits 20 ms
+        # the preamble, then 20 ms of quiet (as a host waits), then the
+        # flood: one batch, so its spacing is the simulator's, however late
+        # a loaded machine hands the requests over (two requests let the
+        # simulator run past the flood's cycle in between)
+        quiet = 1000 + len(AUTOBAUD_PREAMBLE) * per_char + F_CPU // 50
+        replies = ctl.requests(["rx +1000 %s" % AUTOBAUD_PREAMBLE.hex().upper(),
+                                "wait %d" % quiet, "rx +1 %s" % blob.hex().upper()])
+        at = first = int(replies[2])
         while at < first + F_CPU * 3 // 5:
             try:
                 at = ctl.rx(at, blob)
