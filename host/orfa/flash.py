@@ -243,18 +243,17 @@ def _number(text: str) -> int:
 
 
 def _rate(text: str):
-    """--rate: "auto", or a rate in baud (whether a gateway is built for it
-    is firmware_hex's to say)."""
+    """--rate: "auto", or a rate as --baud takes it (cli.common.baud_rate;
+    whether a gateway is built for it is firmware_hex's to say)."""
+    import argparse
+    from .cli.common import baud_rate
     if text == "auto":
         return text
     try:
-        rate = int(text)
-    except ValueError:
-        rate = 0
-    if rate <= 0:
-        import argparse
-        raise argparse.ArgumentTypeError("%r is not a serial rate (460800) or auto" % text)
-    return rate
+        return baud_rate(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError("%r is not a serial rate (460800) or auto"
+                                         % text) from None
 
 
 def add_parser(subparsers) -> None:
